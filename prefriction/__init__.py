@@ -1,0 +1,28 @@
+"""prefriction: pre-sliding friction hysteresis (Ruderman 2023, Dahl model).
+
+Public API, re-exported from private modules:
+
+- models: :class:`Dahl`, :class:`Oscillator`, :class:`FrictionModel`
+- analytics: :mod:`prefriction.dahl` (exact and approximate reversal maps, energies)
+- exact reference: :func:`exact_reversals`
+- simulation: :func:`simulate`
+- energy analysis: :mod:`prefriction.energy`
+"""
+
+from __future__ import annotations
+
+from .errors import PrefrictionError, SolverError
+from .models import Dahl, FrictionModel, Oscillator
+from .reversals import ReversalTable
+from .units import Scales
+
+__all__ = [
+    "Dahl",
+    "FrictionModel",
+    "Oscillator",
+    "PrefrictionError",
+    "ReversalTable",
+    "Scales",
+    "SolverError",
+]
+__version__ = "0.1.0"

@@ -1,0 +1,37 @@
+"""Command line: ``prefriction {table,bench,paper} ...``.
+
+Each subcommand lives in its own module, imported only when it runs, with a
+``main(argv) -> int`` entry point that parses its own options.
+"""
+
+from __future__ import annotations
+
+import importlib
+import sys
+
+COMMANDS = {
+    "table": ("prefriction.table", "exact reversal table of an unforced Dahl oscillator"),
+    "bench": ("prefriction.bench", "error against run time of simulate and its peers"),
+    "paper": ("prefriction.paper", "reproduce the paper's figures and write a report"),
+}
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Dispatch ``argv`` (default ``sys.argv[1:]``) to a subcommand; return its exit code."""
+    args = list(sys.argv[1:] if argv is None else argv)
+    if not args or args[0] in ("-h", "--help"):
+        print("usage: prefriction COMMAND [options]\n\ncommands:")
+        for name, (_, text) in COMMANDS.items():
+            print(f"  {name:<8} {text}")
+        print("\n'prefriction COMMAND --help' shows the options of a command.")
+        return 0
+    name, rest = args[0], args[1:]
+    if name not in COMMANDS:
+        print(f"prefriction: unknown command {name!r}; choose one of {', '.join(COMMANDS)}", file=sys.stderr)
+        return 2
+    module = importlib.import_module(COMMANDS[name][0])
+    return int(module.main(rest) or 0)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
