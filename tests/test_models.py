@@ -1,0 +1,79 @@
+"""Models, validation and normalised units."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from prefriction import Dahl, Oscillator, Scales
+
+
+def test_dahl_stores_floats_and_is_immutable():
+    d = Dahl(sigma=1e4, Fc=2, gamma=0)
+    assert (d.sigma, d.Fc, d.gamma) == (1e4, 2.0, 0.0)
+    with pytest.raises(AttributeError):
+        d.sigma = 1.0  # type: ignore[misc]
+
+
+@pytest.mark.parametrize("name", ["sigma", "Fc"])
+@pytest.mark.parametrize("bad", [0.0, -1.0, math.inf, math.nan])
+def test_dahl_rejects_nonpositive_or_nonfinite(name, bad):
+    kwargs = {"sigma": 1.0, "Fc": 1.0, name: bad}
+    with pytest.raises(ValueError, match=rf"{name} must be finite and > 0, got {bad!r}"):
+        Dahl(**kwargs)
+
+
+@pytest.mark.parametrize("bad", [-0.5, math.inf])
+def test_dahl_rejects_bad_gamma(bad):
+    with pytest.raises(ValueError, match=r"gamma must be finite and >= 0"):
+        Dahl(1.0, 1.0, gamma=bad)
+
+
+def test_dahl_rejects_non_numbers_and_unknown_keywords():
+    with pytest.raises(TypeError, match="sigma must be a real number"):
+        Dahl("1", 1.0)  # type: ignore[arg-type]
+    with pytest.raises(TypeError, match="Fc must be a real number"):
+        Dahl(1.0, True)  # type: ignore[arg-type]
+    with pytest.raises(TypeError):
+        Dahl(1.0, 1.0, shape=2)  # type: ignore[call-arg]
+
+
+@pytest.mark.parametrize("gamma", [0.0, 0.5, 1.0, 2.0])
+def test_dahl_slope_is_rest_stiffness_at_zero_force(gamma):
+    d = Dahl(1.0, 1.0, gamma)
+    assert d.slope(0.0) == pytest.approx(1.0)
+    f = np.array([-1.0, -0.5, 0.5])
+    np.testing.assert_allclose(d.slope(f), (1.0 - f) ** gamma)
+
+
+def test_oscillator_validation():
+    d = Dahl(1e4, 1.0)
+    assert Oscillator(d).mass == 1.0 and not Oscillator(d).forced
+    with pytest.raises(ValueError, match=r"mass must be finite and > 0, got -1.0"):
+        Oscillator(d, mass=-1.0)
+    with pytest.raises(TypeError, match="friction must be a FrictionModel"):
+        Oscillator(1.0)  # type: ignore[arg-type]
+    with pytest.raises(TypeError, match="u must be None, a callable"):
+        Oscillator(d, u=3.0)  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match="strictly increasing"):
+        Oscillator(d, u=([0.0, 0.0], [1.0, 2.0]))
+    with pytest.raises(ValueError, match="equal length"):
+        Oscillator(d, u=([0.0, 1.0], [1.0]))
+    with pytest.raises(ValueError, match="finite"):
+        Oscillator(d, u=([0.0, 1.0], [1.0, math.nan]))
+    forced = Oscillator(d, u=([0.0, 1.0], [1.0, 2.0]))
+    assert forced.forced
+    with pytest.raises(ValueError):
+        forced.u[1][0] = 5.0  # samples are read-only
+
+
+@pytest.mark.parametrize("sigma,Fc,m", [(1e4, 1.0, 1.0), (1e10, 3e-3, 1e-6), (1e-2, 50.0, 1e3)])
+def test_scales_are_consistent_units(sigma, Fc, m):
+    s = Scales.of(Oscillator(Dahl(sigma, Fc), mass=m))
+    assert s.x == pytest.approx(Fc / sigma)
+    assert s.v == pytest.approx(s.x / s.t)  # velocity unit = length / time
+    assert s.E == pytest.approx(s.F * s.x)  # energy unit = force x length
+    assert m * s.v**2 == pytest.approx(s.E)  # kinetic energy m v^2 in energy units
+    assert sigma * s.t**2 / m == pytest.approx(1.0)  # natural period of the rest-stiffness spring
