@@ -1,0 +1,132 @@
+"""Linear output feedback around the pre-sliding oscillator, for :func:`prefriction.simulate`.
+
+A :class:`LinearFeedback` closes the loop ``m x'' = u - F`` with a linear controller in
+state-space form, all in SI units:
+
+- error ``e(t) = r(t) - x(t)`` [m], with ``r`` the position reference;
+- force ``u = C xc + D e`` [N] (plus ``system.u(t)`` if the oscillator has an input force too);
+- continuous controller (``Ts is None``): ``xc' = A xc + B e``, integrated together with the
+  plant in the same CasADi right-hand side;
+- sampled-data controller (``Ts > 0``): ``xc[k+1] = A xc[k] + B e[k]`` with ``e[k] = e(k Ts)``,
+  the force ``u[k] = C xc[k] + D e[k]`` held constant (zero-order hold) over
+  ``[k Ts, (k+1) Ts)``; reversals inside a sample interval are located as in the open loop.
+
+``simulate(system, v0, feedback=LinearFeedback(...), t_end=..., ...)`` returns, besides the
+reversal table, samples ``t, x, v, F, u, xc`` at the requested sample times (``dense=``) and, for
+a sampled controller, always at the sample instants ``k Ts``.
+
+Example: proportional-derivative control is ``A = [[-1/tau]], B = [[1/tau]], C = [[-kd/tau]],
+D = [[kp + kd/tau]]`` (a filtered derivative); a pure gain ``kp`` is ``A, B, C`` empty
+(shapes (0, 0), (0, 1), (1, 0)) and ``D = [[kp]]``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Callable, Optional, Union
+
+import numpy as np
+
+from ._validation import check_finite, check_positive
+
+Reference = Union[float, Callable[[Any], Any], tuple]
+
+
+def _as_matrix(name: str, value: Any, shape: tuple[int, int]) -> np.ndarray:
+    """Return ``value`` as a read-only float matrix of ``shape``; ``ValueError`` otherwise."""
+    arr = np.array(value, dtype=float, ndmin=2)
+    if arr.size == 0:
+        arr = np.zeros(shape)
+    if arr.shape != shape:
+        raise ValueError(f"{name} must have shape {shape}, got {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} must be finite (every entry), got {arr.tolist()!r}")
+    arr.setflags(write=False)
+    return arr
+
+
+def _check_reference(r: Reference) -> Reference:
+    """Validate a reference: a finite constant [m], a callable ``r(t)`` [m], or samples ``(t, r)``."""
+    if callable(r):
+        return r
+    if isinstance(r, tuple):
+        if len(r) != 2:
+            raise ValueError(f"reference samples must be a pair (t, r), got a tuple of length {len(r)}")
+        t = np.asarray(r[0], dtype=float)
+        val = np.asarray(r[1], dtype=float)
+        if t.ndim != 1 or val.shape != t.shape or t.size < 2:
+            raise ValueError(
+                "reference samples must be a pair (t, r) of 1-D arrays of equal length >= 2, "
+                f"got shapes {t.shape} and {val.shape}"
+            )
+        if not (np.all(np.isfinite(t)) and np.all(np.isfinite(val))):
+            raise ValueError("reference samples must be finite (t and r), got NaN or inf")
+        if np.any(np.diff(t) <= 0):
+            raise ValueError("reference sample times t must be strictly increasing")
+        t.setflags(write=False)
+        val.setflags(write=False)
+        return (t, val)
+    return check_finite("reference", r)
+
+
+@dataclass(frozen=True, eq=False)
+class LinearFeedback:
+    """Linear position controller ``u = C xc + D e``, ``e = r - x`` (SI units), continuous or sampled.
+
+    Parameters
+    ----------
+    A, B, C, D : array_like
+        Controller matrices, shapes ``(n, n)``, ``(n, 1)``, ``(1, n)``, ``(1, 1)`` with ``n >= 0``
+        controller states. Units: ``e`` in m, ``u`` in N, ``xc`` in any unit the matrices agree on.
+        Continuous time (``Ts is None``): ``xc' = A xc + B e``. Sampled (``Ts > 0``):
+        ``xc[k+1] = A xc[k] + B e[k]``.
+    Ts : float or None, default None
+        Sample period [s] of a discrete-time controller with zero-order hold on ``u``;
+        ``None`` for a continuous-time controller.
+    reference : float, callable or (t, r) samples, default 0.0
+        Position reference ``r(t)`` [m]: a constant, a callable of time ``t`` [s] that accepts a
+        CasADi symbol (``numpy`` ufuncs and arithmetic do), or samples ``(t, r)`` interpolated
+        linearly and held constant outside the sample range.
+    xc0 : array_like or None, default None
+        Initial controller state, shape ``(n,)``; zeros if ``None``.
+
+    Raises
+    ------
+    ValueError
+        If a matrix has the wrong shape or non-finite entries, ``Ts`` is not positive, or the
+        reference samples are malformed.
+    """
+
+    A: Any = field(default_factory=lambda: np.zeros((0, 0)))
+    B: Any = field(default_factory=lambda: np.zeros((0, 1)))
+    C: Any = field(default_factory=lambda: np.zeros((1, 0)))
+    D: Any = 0.0
+    Ts: Optional[float] = None
+    reference: Reference = 0.0
+    xc0: Any = None
+
+    def __post_init__(self) -> None:
+        a = np.array(self.A, dtype=float, ndmin=2) if np.size(self.A) else np.zeros((0, 0))
+        n = a.shape[0]
+        object.__setattr__(self, "A", _as_matrix("A", self.A, (n, n)))
+        object.__setattr__(self, "B", _as_matrix("B", self.B, (n, 1)))
+        object.__setattr__(self, "C", _as_matrix("C", self.C, (1, n)))
+        object.__setattr__(self, "D", _as_matrix("D", self.D, (1, 1)))
+        if self.Ts is not None:
+            object.__setattr__(self, "Ts", check_positive("Ts", self.Ts))
+        object.__setattr__(self, "reference", _check_reference(self.reference))
+        xc0 = np.zeros(n) if self.xc0 is None else np.array(self.xc0, dtype=float).reshape(-1)
+        if xc0.shape != (n,) or not np.all(np.isfinite(xc0)):
+            raise ValueError(f"xc0 must be a finite vector of length {n}, got {self.xc0!r}")
+        xc0.setflags(write=False)
+        object.__setattr__(self, "xc0", xc0)
+
+    @property
+    def n_states(self) -> int:
+        """Number of controller states ``n``."""
+        return self.A.shape[0]
+
+    @property
+    def sampled(self) -> bool:
+        """True for a sampled-data (discrete-time, zero-order hold) controller."""
+        return self.Ts is not None
