@@ -15,6 +15,7 @@ from .errors import PrefrictionError, SolverError
 from .models import Dahl, FrictionModel, Oscillator
 from .reversals import ReversalTable
 from .units import Scales
+from . import energy
 
 __all__ = [
     "Dahl",
@@ -24,5 +25,6 @@ __all__ = [
     "ReversalTable",
     "Scales",
     "SolverError",
+    "energy",
 ]
 __version__ = "0.1.0"

@@ -618,7 +618,7 @@ def bound_check(E_p: Any, *, friction: Dahl, E_0: Optional[float] = None) -> Bou
 
     Parameters
     ----------
-    E_p : array_like
+    E_p : float or array_like
         Potential energy at the reversals [J], length >= 1.
     friction : Dahl
         The friction model.
@@ -630,9 +630,9 @@ def bound_check(E_p: Any, *, friction: Dahl, E_0: Optional[float] = None) -> Bou
     BoundCheck
     """
     friction = _check_friction(friction)
-    E_p = np.asarray(E_p, dtype=float)
+    E_p = np.atleast_1d(np.asarray(E_p, dtype=float))
     if E_p.ndim != 1 or E_p.size < 1:
-        raise ValueError(f"E_p must be a non-empty 1-D array, got shape {E_p.shape}")
+        raise ValueError(f"E_p must be a number or a non-empty 1-D array, got shape {E_p.shape}")
     scale = friction.Fc**2 / friction.sigma
     bound = 0.5 * scale
     sharp = scale * float(branch_potential(-1.0, friction.gamma))
