@@ -15,6 +15,7 @@ from .errors import PrefrictionError, SolverError
 from .models import Dahl, FrictionModel, Oscillator
 from .reversals import ReversalTable
 from .units import Scales
+from .simulate import SimulationResult, simulate
 from . import energy
 
 __all__ = [
@@ -24,7 +25,9 @@ __all__ = [
     "PrefrictionError",
     "ReversalTable",
     "Scales",
+    "SimulationResult",
     "SolverError",
     "energy",
+    "simulate",
 ]
 __version__ = "0.1.0"

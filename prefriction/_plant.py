@@ -1,0 +1,283 @@
+"""CasADi model of the Dahl oscillator on a branch, with reversal, saturation and rest events.
+
+The integrated state is normalised (DESIGN.md section 2) and, per call, scaled by amplitude
+parameters so that the error control of the integrator is relative to the current motion.
+Time inside one call is ``tau`` in ``[0, n_out]``; the control ``dur`` of each output interval
+(one unit of ``tau``) is its duration in normalised time, so one compiled Function serves any
+output grid.
+
+State vector (indices in :class:`Layout`):
+
+``xh, vh, Fh``
+    ``x~ = xref + Ax xh``, ``v~ = Av vh``, ``F~ = AF Fh``;
+``tt``
+    normalised absolute time ``t~``;
+``s, n, frozen, sat, rest``
+    branch direction (+-1), reversals so far, stop flag (set when ``n`` reaches ``nstop``), the
+    saturation flag (``|F| = Fc``, ``F' = 0``; reached at finite distance when gamma < 1) and the
+    rest flag (``v = 0`` and ``u = F``; only with an input force);
+``Wh``
+    input work since the last reversal, ``W~ = AE Wh`` (forced systems only);
+``Eh``
+    work of the friction force since t = 0, ``E_f~ = Efref + AE Eh`` (dense output only), (2.8);
+``xch``
+    continuous controller states, ``xc = S * xch``;
+register
+    the newest ``K`` reversals, newest first: ``(t~, x~, F~, W~)`` each.
+
+Events (the integrator fires when an indicator goes from positive to negative):
+
+0. reversal, indicator ``s v``: at the crossing the acceleration ``a~ = u~ - F~`` decides:
+   ``s a~ < -eps``: a reversal (register shift, ``s -> -s``); ``s a~ > eps``: the velocity
+   touches zero and keeps its sign (nothing changes); otherwise the mass is at rest.
+1. saturation, indicator ``1 - s F~``: ``F~ = s`` exactly and ``F' = 0`` until the next reversal.
+2. end of rest, indicator ``eps_rest - |a~|``: the mass moves again in direction ``sign(a~)``,
+   a reversal if that differs from ``s``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Callable
+
+import casadi as ca
+import numpy as np
+
+__all__ = ["EPS_TOUCH", "EPS_REST", "Layout", "PlantSpec", "build_integrator"]
+
+EPS_TOUCH = 1e-14
+"""Normalised acceleration below which a zero velocity is rest, not a reversal or a touch."""
+EPS_REST = 1e-12
+"""Normalised net force above which a resting mass moves again."""
+
+
+@dataclass(frozen=True)
+class PlantSpec:
+    """Structure of the integrated model (everything that changes the generated code).
+
+    ``pform``: for gamma < 1 the force state is ``p = 1 - (1 - s F~)^(1 - gamma)`` instead of
+    ``F~``: ``p`` grows linearly with the distance travelled (``p' = (1 - gamma) s v~``), so the
+    right-hand side stays smooth up to saturation (``p = 1``), which is an event with a
+    transversal crossing, and ``F~ = s (1 - (1 - p)^(1 / (1 - gamma)))`` keeps full relative
+    accuracy for small forces.
+
+    ``u_kind`` / ``r_kind``: ``"none"``, ``"callable"`` (traced into the model), ``"samples"``
+    (piecewise linear, one segment per output interval, passed as controls) or, for ``r_kind``,
+    ``"const"``. ``fb``: ``"none"``, ``"continuous"`` (``n_c`` controller states in the model)
+    or ``"sampled"`` (held force passed as a control).
+    """
+
+    u_kind: str = "none"
+    u_fun: Callable[[Any], Any] | None = None
+    fb: str = "none"
+    n_c: int = 0
+    r_kind: str = "none"
+    r_fun: Callable[[Any], Any] | None = None
+    energy: bool = False
+    K: int = 4
+    n_out: int = 1
+    method: str = "erk"
+    pform: bool = False
+
+
+    @property
+    def forced(self) -> bool:
+        """True if any force besides friction acts (input or feedback)."""
+        return self.u_kind != "none" or self.fb != "none"
+
+
+class Layout:
+    """Index map of the state, parameter and control vectors for a :class:`PlantSpec`."""
+
+    def __init__(self, spec: PlantSpec) -> None:
+        names = ["xh", "vh", "Fh", "tt", "s", "n", "frozen", "sat", "rest"]
+        if spec.forced:
+            names.append("Wh")
+        if spec.energy:
+            names.append("Eh")
+        self.state = {k: i for i, k in enumerate(names)}
+        self.xc = slice(len(names), len(names) + spec.n_c)
+        self.reg = len(names) + spec.n_c
+        self.reg_width = 4 if spec.forced else 3
+        self.nx = self.reg + spec.K * self.reg_width
+        self.n_active = 3 + int(spec.forced) + int(spec.energy) + spec.n_c
+        pnames = ["Ax", "Av", "AF", "AE", "xref", "Efref", "nstop", "gamma", "tunit", "xunit", "Fc"]
+        if spec.r_kind == "const":
+            pnames.append("r")
+        self.param = {k: i for i, k in enumerate(pnames)}
+        n = spec.n_c
+        self.p_A = len(pnames)
+        self.p_B = self.p_A + n * n
+        self.p_C = self.p_B + n
+        self.p_D = self.p_C + n
+        self.p_S = self.p_D + (1 if spec.fb == "continuous" else 0)
+        self.np = self.p_S + n
+        cnames = ["dur"]
+        if spec.u_kind == "samples" or spec.r_kind == "samples":
+            cnames.append("tl")
+        if spec.u_kind == "samples":
+            cnames += ["ua", "ub"]
+        if spec.r_kind == "samples":
+            cnames += ["ra", "rb"]
+        if spec.fb == "sampled":
+            cnames.append("uhold")
+        self.control = {k: i for i, k in enumerate(cnames)}
+        self.nu = len(cnames)
+
+
+def _signal(kind: str, fun: Callable[[Any], Any] | None, t_si: ca.SX, c: dict, prefix: str, p: dict) -> Any:
+    """Symbolic value (SI) of an input or reference signal at time ``t_si``."""
+    if kind == "callable":
+        return fun(t_si)
+    if kind == "samples":
+        return c[prefix + "a"] + c[prefix + "b"] * (t_si - c["tl"])
+    if kind == "const":
+        return p["r"]
+    return 0.0
+
+
+def trace_signal(fun: Callable[[Any], Any], what: str) -> ca.SX:
+    """Evaluate ``fun`` on a CasADi symbol; ``TypeError`` with advice if it cannot be traced."""
+    t = ca.SX.sym("t")
+    try:
+        val = fun(t)
+        val = ca.SX(val) if not isinstance(val, ca.SX) else val
+    except Exception as exc:  # any failure of user code on a symbol means: not traceable
+        raise TypeError(
+            f"{what} must accept a CasADi symbol for time t (use numpy ufuncs such as np.sin, "
+            f"arithmetic, or casadi functions; no if/else on t, no float(t)); calling it on a symbol "
+            f"failed with {type(exc).__name__}: {exc}. Pass samples (t, values) instead."
+        ) from None
+    if val.numel() != 1:
+        raise TypeError(f"{what} must return a scalar, got shape {val.shape}")
+    return val
+
+
+def build_integrator(spec: PlantSpec, tol: float, atol: float) -> ca.Function:
+    """CasADi integrator (``spec.method``) over ``spec.n_out`` output intervals, with events.
+
+    Parameters
+    ----------
+    spec : PlantSpec
+        Model structure.
+    tol, atol : float
+        Relative and absolute tolerance of the scaled state, already corrected for the
+        root-mean-square error norm over all states (see :func:`prefriction.simulate`).
+    """
+    L = Layout(spec)
+    X = ca.SX.sym("X", L.nx)
+    P = ca.SX.sym("P", L.np)
+    U = ca.SX.sym("U", L.nu)
+    st = {k: X[i] for k, i in L.state.items()}
+    p = {k: P[i] for k, i in L.param.items()}
+    c = {k: U[i] for k, i in L.control.items()}
+    n = spec.n_c
+    x = p["xref"] + p["Ax"] * st["xh"]
+    v = p["Av"] * st["vh"]
+    s = st["s"]
+    g = p["gamma"]
+    if spec.pform:
+        pp = p["AF"] * st["Fh"]
+        F = -s * ca.expm1(ca.log1p(-ca.fmin(pp, 1.0 - 1e-16)) / (1.0 - g))  # finite derivatives at p = 1
+    else:
+        F = p["AF"] * st["Fh"]
+    t_si = st["tt"] * p["tunit"]
+    u = _signal(spec.u_kind, spec.u_fun, t_si, c, "u", p) / p["Fc"]
+    xc = ca.SX(0, 1)
+    if spec.fb != "none":
+        r = _signal(spec.r_kind, spec.r_fun, t_si, c, "r", p) / p["xunit"]
+        e = r - x
+        if spec.fb == "continuous":
+            A = ca.reshape(P[L.p_A:L.p_B], n, n)
+            B = P[L.p_B:L.p_C]
+            C = ca.reshape(P[L.p_C:L.p_D], 1, n)
+            S = P[L.p_S:L.np]
+            xc = S * X[L.xc]
+            u = u + (ca.mtimes(C, xc) if n else 0.0) + P[L.p_D] * e
+        else:
+            u = u + c["uhold"] / p["Fc"]
+    acc = u - F
+    run = 1.0 - st["frozen"]
+    run_m = run * (1.0 - st["rest"])
+    if spec.pform:
+        dF = (1.0 - g) * s * v * (1.0 - st["sat"])  # dp/dt
+    else:
+        dF = v * ca.fmax(1.0 - s * F, 1e-300) ** g  # > 0: no NaN in derivatives of pow
+    dot = {
+        "xh": run_m * v / p["Ax"],
+        "vh": run_m * acc / p["Av"],
+        "Fh": run_m * dF / p["AF"],
+        "tt": run,
+    }
+    if spec.forced:
+        dot["Wh"] = run_m * u * v / p["AE"]
+    if spec.energy:
+        dot["Eh"] = run_m * F * v / p["AE"]
+    ode = ca.SX.zeros(L.nx)
+    for k, val in dot.items():
+        ode[L.state[k]] = val
+    if spec.fb == "continuous" and n:
+        ode[L.xc] = run * (ca.mtimes(A, xc) + B * e) / S
+    ode = c["dur"] * ode
+    zero = ca.vertcat(
+        ca.if_else(run_m > 0.5, s * st["vh"], 1.0),
+        ca.if_else(run_m * (1.0 - st["sat"]) > 0.5, 1.0 - pp, 1.0) if spec.pform else 1.0,
+        ca.if_else(run * st["rest"] > 0.5, EPS_REST - ca.fabs(acc), 1.0),
+    )
+    dae = {"x": X, "p": P, "u": U, "ode": ode, "zero": zero}
+
+    # transition: the state just after an event
+    idx = ca.SX.sym("index")
+    t_ev = ca.SX.sym("t")
+    reg = X[L.reg:]
+    W = p["AE"] * st["Wh"] if spec.forced else None
+    entry = [st["tt"], x, F] + ([W] if spec.forced else [])
+    shifted = ca.vertcat(*entry, reg[: -L.reg_width])
+
+    def with_(changes: dict, base: ca.SX = X) -> ca.SX:
+        out = ca.SX(base)
+        for k, val in changes.items():
+            if k == "reg":
+                out[L.reg:] = val
+            else:
+                out[L.state[k]] = val
+        return out
+
+    def force_state(new_s: Any) -> Any:
+        """Scaled force state on the branch of direction ``new_s`` for the current force."""
+        if not spec.pform:
+            return st["Fh"]
+        return -ca.expm1((1.0 - g) * ca.log1p(-new_s * F)) / p["AF"]
+
+    def reversal(new_s: Any, extra: dict) -> ca.SX:
+        n1 = st["n"] + 1
+        ch = {"reg": shifted, "n": n1, "s": new_s, "sat": 0.0, "Fh": force_state(new_s),
+              "frozen": ca.if_else(n1 >= p["nstop"], 1.0, 0.0)}
+        if spec.forced:
+            ch["Wh"] = 0.0
+        ch.update(extra)
+        return with_(ch)
+
+    sa = s * acc
+    on_zero_v = ca.if_else(
+        sa < -EPS_TOUCH,
+        reversal(-s, {}),
+        ca.if_else(sa > EPS_TOUCH, X, with_({"rest": 1.0, "vh": 0.0})),
+    )
+    on_saturation = with_({"sat": 1.0, "Fh": 1.0 / p["AF"]})
+    new_dir = ca.if_else(acc > 0, 1.0, -1.0)
+    on_move = ca.if_else(new_dir != s, reversal(new_dir, {"rest": 0.0}), with_({"rest": 0.0}))
+    post = ca.if_else(idx == 0, on_zero_v, ca.if_else(idx == 1, on_saturation, on_move))
+    trans = ca.Function(
+        "transition", [idx, t_ev, X, ca.SX(0, 1), P, U], [post, ca.SX(0, 1)],
+        ca.event_in(), ca.event_out(),
+    )
+    opts = {
+        "transition": trans,
+        "max_events": spec.n_out * (4 * spec.K + 16),
+        "reltol": tol,
+        "abstol": atol,
+        "max_num_steps": 200000,
+    }
+    grid = [float(j) for j in range(1, spec.n_out + 1)]
+    return ca.integrator(f"dahl_{spec.method}_{spec.n_out}", spec.method, dae, 0.0, grid, opts)
