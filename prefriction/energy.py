@@ -193,8 +193,8 @@ def find_reversals(t: Any, v: Any, *, x: Any = None, F: Any = None) -> SampledRe
     as the root of the velocity of the cubic Hermite interpolant of ``x`` (third order);
     without, linearly in ``v``. The position there is the Hermite interpolant; the force is
     extrapolated along the incoming branch linearly in ``x`` (``F`` is a function of ``x`` on
-    a branch, so this is accurate to second order in the step), or linearly in ``t`` when the
-    incoming branch has a single sample.
+    a branch, so this is accurate to second order in the step); linearly in ``t`` when the
+    incoming branch has a single sample or no positions are given.
 
     Parameters
     ----------
@@ -842,13 +842,20 @@ def analyze_samples(
     friction, mass = _check_dahl(system)
     method = _check_method(method)
     t, x, v, F = _samples(t=t, x=x, v=v, F=F)
+    over = np.abs(F) > friction.Fc * (1.0 + _ROUNDING)
+    if np.any(over):
+        i = int(np.flatnonzero(over)[0])
+        raise ValueError(
+            f"F must lie in [-Fc, Fc] = [{-friction.Fc!r}, {friction.Fc!r}] (every sample), got F[{i}] = {float(F[i])!r}"
+        )
     rev = find_reversals(t, v, x=x, F=F)
     if len(rev) == 0:
         raise ValueError(
             f"v changes sign nowhere in the {t.size} samples (t from {float(t[0])!r} to {float(t[-1])!r} s): "
             "no reversal to analyse; simulate longer"
         )
-    E_p = branch_energy(rev.F, rev.direction, friction=friction)
+    # the samples obey |F| <= Fc; extrapolation to a reversal may overshoot near saturation
+    E_p = branch_energy(np.clip(rev.F, -friction.Fc, friction.Fc), rev.direction, friction=friction)
     s0 = rev.initial_direction
     E_0 = float(kinetic_energy(v[0], mass=mass) + branch_energy(F[0], s0, friction=friction))
     if system.forced:

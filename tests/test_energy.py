@@ -475,6 +475,8 @@ def test_model_validation_messages():
     with pytest.raises(TypeError, match="system must be a prefriction.Oscillator"):
         energy.analyze_samples([0, 1], [0, 1], [1, -1], [0, 0], system=d)
     t = np.linspace(0, 1, 4)
+    with pytest.raises(ValueError, match=r"F must lie in \[-Fc, Fc\] = \[-2.0, 2.0\] \(every sample\), got F\[2\] = -2.1"):
+        energy.analyze_samples(t, t, [1.0, -1.0, 1.0, -1.0], [0.0, 1.0, -2.1, 0.0], system=Oscillator(d))
     with pytest.raises(ValueError, match="v changes sign nowhere in the 4 samples"):
         energy.analyze_samples(t, t, np.ones(4), np.zeros(4), system=Oscillator(d))
     with pytest.raises(ValueError, match="v is zero at every sample: nothing moves"):
