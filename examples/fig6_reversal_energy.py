@@ -1,0 +1,109 @@
+"""Figure 6 of the paper: potential energy at consecutive reversals, sigma/Fc in {10, 100, 1000}.
+
+(a) The paper's figure: starting from the reversal of largest energy, ``F_i = -Fc``
+(``E_p = 0.3069 Fc^2/sigma``; the paper does not state its starting point), the exact reversal
+map gives ``|F_{i+n}|/Fc`` and (3.14) the potential energy ``E_p(i+n)``; ``Fc = 1 N`` (not
+stated). Dashed: the asymptotic law ``9 Fc^2 / (8 sigma n^2)`` (DESIGN.md section 2).
+
+(b) The same in normalised units ``E_p sigma/Fc^2``, where the exact sequence is one curve for
+every sigma/Fc, against the recursion the paper proposes, (3.13) then (3.14): with (3.13)
+corrected it decays geometrically (ratio of amplitudes -> 5/6), with (3.13) as printed it
+collapses hyperexponentially and depends on sigma/Fc. The paper reads an exponential drop; the
+exact drop is algebraic, ``~ n^-2``, and the ratio of consecutive energies tends to 1.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from prefriction import dahl
+from prefriction.paper import printed_313_displacement
+from prefriction.plotting import COLORS, add_note, new_figure, save
+
+FC = 1.0  # Coulomb force [N]; not stated in the paper
+RATIOS = (10.0, 100.0, 1000.0)  # sigma/Fc [1/m], as in the paper
+A0 = 1.0  # |F_i|/Fc at the first reversal; not stated in the paper
+N_REVERSALS = 20  # reversals after the first; not stated in the paper
+
+
+def iterate(step, a0: float, n: int) -> np.ndarray:
+    """``[a0, step(a0), step(step(a0)), ...]``, ``n + 1`` amplitudes."""
+    out = np.empty(n + 1)
+    out[0] = a0
+    for k in range(n):
+        out[k + 1] = float(step(out[k]))
+    return out
+
+
+def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
+    """Draw Figure 6 into ``outdir/fig6_reversal_energy.png``.
+
+    Returns
+    -------
+    dict
+        ``n`` (0..N, reversal index after ``i``), ``amplitudes`` (``|F_{i+n}|/Fc``, exact map),
+        ``E_p`` (dict ratio -> energies [J]), ``law`` (dict ratio -> ``9 Fc^2/(8 sigma n^2)``
+        [J], n >= 1), ``ratio_consecutive`` (``E_p(n+1)/E_p(n)``, the same for every sigma),
+        ``amplitudes_corrected_313`` and ``amplitudes_printed_313`` (dict ratio -> sequence) of
+        the paper's recursion; ``png``.
+    """
+    n_rev = 8 if quick else N_REVERSALS
+    amplitudes = np.asarray(dahl.amplitude_sequence(A0, n_rev), dtype=float)[: n_rev + 1]
+    n = np.arange(amplitudes.size)
+    fig, axes = new_figure(1, 2, size=(11.5, 4.6))
+    ax = axes[0, 0]
+    energies, laws = {}, {}
+    for color, ratio in zip(COLORS, RATIOS):
+        sigma = ratio * FC
+        e_p = np.asarray(dahl.potential_energy(-amplitudes * FC, sigma, FC), dtype=float)
+        law = 9.0 * FC**2 / (8.0 * sigma * n[1:] ** 2.0)
+        energies[ratio], laws[ratio] = e_p, law
+        ax.semilogy(n, e_p, "o-", color=color, ms=4, label=rf"$\sigma/F_c$ = {ratio:g} m$^{{-1}}$")
+        ax.semilogy(n[1:], law, "--", color=color, lw=1.0)
+    ax.plot([], [], "k--", lw=1.0, label=r"$9F_c^2/(8\sigma n^2)$ (asymptotic)")
+    ax.set_xlabel(r"reversal number $n$ after reversal $i$ [-]")
+    ax.set_ylabel(r"potential energy $E_p(i+n)$ (3.14) [J]")
+    ax.set_xticks(n[:: 2 if n_rev > 10 else 1])
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(loc="upper right", fontsize=9)
+    ax.set_title("(a) exact reversal map")
+
+    ax = axes[0, 1]
+    normalised = amplitudes - np.log1p(amplitudes)  # E_p sigma/Fc^2, (3.9)
+    corrected = iterate(dahl.next_amplitude_paper, A0, n.size - 1)
+    ax.semilogy(n, normalised, "ko-", ms=4, lw=2.0, label="exact map (every $\\sigma/F_c$)")
+    with np.errstate(divide="ignore"):
+        ax.semilogy(n, corrected - np.log1p(corrected), "s--", color="0.45", ms=3,
+                    label="paper's recursion, corrected (3.13)")
+        printed = {}
+        for color, ratio in zip(COLORS, RATIOS):
+            seq = iterate(lambda a, r=ratio: -np.expm1(-printed_313_displacement(a, r)), A0, n.size - 1)
+            printed[ratio] = seq
+            e = seq - np.log1p(seq)
+            keep = e > 0.0
+            ax.semilogy(n[keep], e[keep], ":", marker="^", color=color, ms=3,
+                        label=rf"(3.13) as printed, $\sigma/F_c$ = {ratio:g} m$^{{-1}}$")
+    ax.set_ylim(1e-12, 1.0)
+    ax.set_xticks(n[:: 2 if n_rev > 10 else 1])
+    ax.set_xlabel(r"reversal number $n$ after reversal $i$ [-]")
+    ax.set_ylabel(r"normalised potential energy $E_p\,\sigma/F_c^2$ [-]")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(loc="center right", fontsize=8)
+    ax.set_title("(b) exact map against the paper's recursion")
+    fig.suptitle("Fig. 6: potential energy at consecutive reversals")
+    add_note(fig, f"Fc = {FC:g} N, first reversal at F_i = -Fc (both not stated in the paper). "
+                  "Printed (3.13) values below 1e-12 are off the plot.")
+    png = save(fig, outdir, "fig6_reversal_energy.png")
+    first = energies[RATIOS[0]]
+    return {
+        "n": n, "amplitudes": amplitudes, "E_p": energies, "law": laws,
+        "ratio_consecutive": first[1:] / first[:-1], "amplitudes_corrected_313": corrected,
+        "amplitudes_printed_313": printed, "Fc": FC, "png": png,
+    }
+
+
+if __name__ == "__main__":
+    print(main(sys.argv[1] if len(sys.argv) > 1 else ".")["png"])

@@ -1,0 +1,95 @@
+"""Figure 7 of the paper: energy time series of the simulated oscillator (2.1) with (3.4).
+
+The unforced oscillator ``m x'' + F = 0`` with Dahl friction (gamma = 1) is simulated by
+:func:`prefriction.simulate` for sigma/Fc in {10, 100, 1000} 1/m. The paper states neither the
+mass nor the initial state; we take ``m = 1 kg`` (the paper's unity mass), ``Fc = 1 N``,
+``x(0) = 0``, ``F(0) = 0`` and ``v(0) = 0.1 m/s`` (so the first excursion reaches
+``sigma m v0^2/(2 Fc^2)`` = 0.05, 0.5 and 5 in units of ``Fc^2/sigma``: the larger sigma/Fc, the
+deeper the first excursion slides). ``E_f`` is the work of the restoring force by integrated
+power (2.8), counted from the last reversal as in (2.8)-(2.9); between two reversals
+``E_k + E_f`` is constant. Markers: the potential energy (3.9) of each reversal, which the
+kinetic energy must reach at the next force zero crossing.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from prefriction import Dahl, Oscillator, dahl, simulate
+from prefriction.plotting import COLORS, add_note, new_figure, save
+
+MASS = 1.0  # [kg], the paper's unity mass
+FC = 1.0  # [N]; not stated in the paper
+V0 = 0.1  # initial velocity [m/s]; not stated in the paper
+RATIOS = (10.0, 100.0, 1000.0)  # sigma/Fc [1/m]; the paper shows "different" ratios
+T_END = 10.0  # [s]
+
+
+def energy_since_reversal(t: np.ndarray, E_f: np.ndarray, t_rev: np.ndarray) -> np.ndarray:
+    """Restoring-force work (2.8) counted from the most recent reversal before each sample."""
+    idx = np.searchsorted(t_rev, t, side="right") - 1
+    base = np.where(idx >= 0, np.interp(t_rev[np.maximum(idx, 0)], t, E_f), 0.0)
+    return E_f - base
+
+
+def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
+    """Simulate and draw Figure 7 into ``outdir/fig7_energy_time_series.png``.
+
+    Returns
+    -------
+    dict
+        ``runs[ratio]`` with dense ``t`` [s], ``E_k``, ``E_f`` (since t = 0), ``E_f_half``
+        (since the last reversal) [J], ``t_rev``, ``F_rev`` (reversal times [s] and forces [N]),
+        ``E_p_rev`` ((3.9) at each reversal [J]), ``E_k_peak`` (largest sampled ``E_k`` in each
+        half-cycle after a reversal [J]), ``balance`` (max ``|E_k + E_f - E_k(0)| / E_k(0)``);
+        ``mass``, ``v0``, ``t_end``; ``png``.
+    """
+    t_end = 3.0 if quick else T_END
+    fig, axes = new_figure(len(RATIOS), 1, size=(8.0, 7.5), sharex=True)
+    runs: dict[float, dict] = {}
+    for ax, color, ratio in zip(axes[:, 0], COLORS, RATIOS):
+        system = Oscillator(Dahl(sigma=ratio * FC, Fc=FC), mass=MASS)
+        grid = np.linspace(0.0, t_end, int(t_end * (1000 if quick else 4000)) + 1)
+        res = simulate(system, V0, t_end=t_end, dense=grid)
+        t, E_k, E_f = res.t, res.E_k, res.E_f
+        rev = res.reversals
+        E_f_half = energy_since_reversal(t, E_f, rev.t)
+        E_p_rev = np.asarray(dahl.potential_energy(-np.abs(rev.F), ratio * FC, FC), dtype=float)
+        peaks = []
+        for k, t0 in enumerate(rev.t):
+            t1 = rev.t[k + 1] if k + 1 < len(rev.t) else t[-1]
+            sel = (t > t0) & (t < t1)
+            peaks.append(float(E_k[sel].max()) if k + 1 < len(rev.t) and sel.any() else np.nan)
+        E_k0 = 0.5 * MASS * V0**2
+        runs[ratio] = {
+            "t": t, "E_k": E_k, "E_f": E_f, "E_f_half": E_f_half, "t_rev": np.asarray(rev.t),
+            "F_rev": np.asarray(rev.F), "E_p_rev": E_p_rev, "E_k_peak": np.asarray(peaks),
+            "balance": float(np.max(np.abs(E_k + E_f - E_k0)) / E_k0),
+        }
+        floor = 1e-7 * E_k0
+        ax.semilogy(t, np.maximum(E_k, floor), color=color, lw=1.2, label=r"$E_k = m\dot x^2/2$")
+        ax.semilogy(t, np.maximum(np.abs(E_f_half), floor), color="k", lw=0.7, ls="--",
+                    label=r"$|E_f|$, power integrated from the last reversal (2.8)")
+        t_peak = [float(t[(t > rev.t[k]) & (t < rev.t[k + 1])][np.argmax(E_k[(t > rev.t[k]) & (t < rev.t[k + 1])])])
+                  for k in range(len(rev.t) - 1)]
+        ax.plot(t_peak, E_p_rev[: len(t_peak)], "o", color=COLORS[3], ms=3.5, mfc="none",
+                label=r"$E_p$ (3.9) of the preceding reversal")
+        ax.set_ylim(1e-6 * E_k0, 300 * E_k0)
+        ax.set_ylabel("energy [J]")
+        ax.set_title(rf"$\sigma/F_c$ = {ratio:g} m$^{{-1}}$: {len(rev.t)} reversals", fontsize=10)
+        ax.grid(True, which="both", alpha=0.3)
+    axes[0, 0].legend(loc="upper right", ncol=3, fontsize=7.5)
+    axes[-1, 0].set_xlabel("time $t$ [s]")
+    axes[-1, 0].set_xlim(0.0, t_end)
+    fig.suptitle("Fig. 7: energy time series of the simulated oscillator (2.1) with (3.4)")
+    add_note(fig, f"m = {MASS:g} kg, Fc = {FC:g} N, x(0) = 0, F(0) = 0, v(0) = {V0:g} m/s "
+                  "(mass and initial state not stated in the paper); gamma = 1.")
+    png = save(fig, outdir, "fig7_energy_time_series.png")
+    return {"runs": runs, "mass": MASS, "v0": V0, "Fc": FC, "t_end": t_end, "png": png}
+
+
+if __name__ == "__main__":
+    print(main(sys.argv[1] if len(sys.argv) > 1 else ".")["png"])

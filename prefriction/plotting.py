@@ -1,0 +1,75 @@
+"""Shared plot helpers: Agg-only figures with a note strip, saved as PNG.
+
+Figures are built with :class:`matplotlib.figure.Figure` directly (no pyplot), so that
+they render with the Agg canvas whatever backend the user has configured and leave no
+global state behind.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Union
+
+import numpy as np
+from matplotlib.figure import Figure
+
+PathLike = Union[str, Path]
+
+#: Colours for parameter families (colour-blind safe, matplotlib's tab10 order).
+COLORS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b")
+
+
+def new_figure(
+    nrows: int = 1,
+    ncols: int = 1,
+    *,
+    size: tuple[float, float] = (7.0, 4.5),
+    sharex: bool = False,
+    sharey: bool = False,
+) -> tuple[Figure, np.ndarray]:
+    """Create a constrained-layout figure and its axes.
+
+    Parameters
+    ----------
+    nrows, ncols : int
+        Grid of axes.
+    size : (float, float)
+        Width and height [inch].
+    sharex, sharey : bool
+        Share the axes' x or y limits.
+
+    Returns
+    -------
+    fig : matplotlib.figure.Figure
+    axes : numpy.ndarray of Axes, shape ``(nrows, ncols)``
+    """
+    fig = Figure(figsize=size, layout="constrained")
+    axes = fig.subplots(nrows, ncols, sharex=sharex, sharey=sharey, squeeze=False)
+    return fig, axes
+
+
+def add_note(fig: Figure, text: str, *, lines: int = 1) -> None:
+    """Write ``text`` in a strip along the bottom of ``fig`` (e.g. parameters the paper leaves open).
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        A figure created by :func:`new_figure`.
+    text : str
+        Note, possibly several lines separated by ``\\n``.
+    lines : int
+        Number of text lines, used to reserve the strip's height.
+    """
+    height_in = fig.get_figheight()
+    strip = min(0.4, (0.2 + 0.17 * lines) / height_in)
+    fig.get_layout_engine().set(rect=(0.0, strip, 1.0, 1.0 - strip))
+    fig.text(0.01, strip / 2.0, text, ha="left", va="center", fontsize=8, color="0.25")
+
+
+def save(fig: Figure, outdir: PathLike, name: str, *, dpi: int = 130) -> Path:
+    """Save ``fig`` as ``outdir/name`` (PNG), creating ``outdir`` if needed; return the path."""
+    out = Path(outdir)
+    out.mkdir(parents=True, exist_ok=True)
+    path = out / name
+    fig.savefig(path, dpi=dpi)
+    return path
