@@ -1,0 +1,312 @@
+"""Linearised plants, linear closed loops, stability margins and pole-placement designs.
+
+Two linearisations of the stage ``m x'' = u - F`` with Dahl friction (3.2):
+
+- pre-sliding (``regime="presliding"``): near a rest point the friction is a spring of rest
+  stiffness ``sigma`` (the slope of (3.2) at ``F = 0``), ``P(s) = 1 / (m s^2 + sigma)``;
+- sliding (``regime="sliding"``): in gross sliding the friction is the constant ``+-Fc`` and
+  drops out of the small-signal model, ``P(s) = 1 / (m s^2)``.
+
+The linear loop is ``x = P u``, ``u = C (r - x)``; a discrete controller (``dt > 0``) is closed
+around the ZOH discretisation ``control.c2d(P, dt, "zoh")``, exact at the sample instants.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+from typing import Optional
+
+import control
+import numpy as np
+
+from prefriction._validation import check_interval, check_positive
+from prefriction.models import Oscillator
+
+from ._pid import PID
+
+REGIMES = ("presliding", "sliding")
+
+
+class UnstableLoopWarning(UserWarning):
+    """The linear closed loop of a design is not asymptotically stable (its poles are in the message)."""
+
+
+def _check_system(system: Oscillator) -> Oscillator:
+    if not isinstance(system, Oscillator):
+        raise TypeError(f"system must be a prefriction.Oscillator, got {system!r} of type {type(system).__name__}")
+    return system
+
+
+def _check_regime(regime: str) -> str:
+    if regime not in REGIMES:
+        raise ValueError(f"regime must be one of {REGIMES}, got {regime!r}")
+    return regime
+
+
+def as_lti(controller: "PID | control.LTI") -> control.StateSpace:
+    """Controller as a SISO, proper ``control.StateSpace`` from the error [m] to the force [N].
+
+    Raises
+    ------
+    TypeError
+        If ``controller`` is neither a :class:`PID` nor a python-control LTI system.
+    ValueError
+        If it is not SISO, not proper (a transfer function with more zeros than poles) or has
+        non-finite coefficients.
+    """
+    if isinstance(controller, PID):
+        return controller.ss()
+    if not isinstance(controller, (control.TransferFunction, control.StateSpace)):
+        raise TypeError(
+            "controller must be a controllers.PID or a python-control TransferFunction/StateSpace "
+            f"from the error e [m] to the force u [N], got {controller!r} of type {type(controller).__name__}"
+        )
+    if controller.ninputs != 1 or controller.noutputs != 1:
+        raise ValueError(
+            f"controller must be SISO (1 input e, 1 output u), got {controller.ninputs} inputs "
+            f"and {controller.noutputs} outputs"
+        )
+    if isinstance(controller, control.TransferFunction):
+        num = np.trim_zeros(np.atleast_1d(np.squeeze(controller.num[0][0])), "f")
+        den = np.trim_zeros(np.atleast_1d(np.squeeze(controller.den[0][0])), "f")
+        if len(num) > len(den):
+            raise ValueError(
+                f"controller must be proper (degree of numerator <= degree of denominator), "
+                f"got numerator degree {len(num) - 1} > denominator degree {len(den) - 1}; "
+                "add a derivative filter, e.g. kd s / (tau s + 1)"
+            )
+        sys = control.ss(controller)
+    else:
+        sys = controller
+    mats = (sys.A, sys.B, sys.C, sys.D)
+    if not all(np.all(np.isfinite(M)) for M in mats):
+        raise ValueError("controller matrices must be finite, got NaN or inf")
+    return sys
+
+
+def linear_plant(system: Oscillator, regime: str = "presliding", Ts: Optional[float] = None) -> control.StateSpace:
+    """Linearised stage from the force ``u`` [N] to the position ``x`` [m].
+
+    Parameters
+    ----------
+    system : prefriction.Oscillator
+        Mass ``m`` [kg] and friction model with rest stiffness ``sigma`` [N/m].
+    regime : {"presliding", "sliding"}
+        ``1 / (m s^2 + sigma)`` (friction as its rest-stiffness spring, slope of (3.2) at
+        ``F = 0``) or ``1 / (m s^2)`` (gross sliding, Coulomb force constant).
+    Ts : float, optional
+        Sample time [s]: return the exact ZOH discretisation (``control.c2d``).
+
+    Returns
+    -------
+    control.StateSpace
+        States ``x`` [m], ``v`` [m/s]; input ``u``; output ``x``.
+    """
+    _check_system(system)
+    _check_regime(regime)
+    m = system.mass
+    k = system.friction.sigma if regime == "presliding" else 0.0
+    P = control.ss([[0.0, 1.0], [-k / m, 0.0]], [[0.0], [1.0 / m]], [[1.0, 0.0]], [[0.0]],
+                   inputs="u", outputs="x", states=["x", "v"], name="plant")
+    if Ts is not None:
+        P = control.c2d(P, check_positive("Ts", Ts), method="zoh")
+    return P
+
+
+def closed_loop(
+    system: Oscillator, controller: "PID | control.LTI", *, regime: str = "presliding", warn: bool = True
+) -> control.StateSpace:
+    """Linear closed loop from the reference ``r`` [m] to the position ``x`` [m].
+
+    ``T = P C / (1 + P C)`` built with ``control.feedback``. A discrete controller (``dt > 0``)
+    is closed around the ZOH-discretised plant, exact at the sample instants. If the loop is
+    not asymptotically stable a :class:`UnstableLoopWarning` lists its poles (``warn=True``).
+    """
+    C = as_lti(controller)
+    Ts = _sample_time(C)
+    P = linear_plant(system, regime, Ts)
+    T = control.feedback(P * C, 1)
+    if warn:
+        warn_if_unstable(T, what=f"linear {regime} closed loop", stacklevel=2)
+    return T
+
+
+def _sample_time(C: control.StateSpace) -> Optional[float]:
+    if C.dt is None or C.dt == 0:
+        return None
+    if C.dt is True:
+        raise ValueError("controller is discrete with an unspecified sample time (dt=True); give it dt > 0")
+    return float(C.dt)
+
+
+def is_stable(sys: control.LTI) -> bool:
+    """True if every pole has negative real part (continuous) or modulus < 1 (discrete)."""
+    p = control.poles(sys)
+    if p.size == 0:
+        return True
+    if sys.isdtime(strict=True):
+        return bool(np.max(np.abs(p)) < 1.0)
+    return bool(np.max(p.real) < 0.0)
+
+
+def warn_if_unstable(sys: control.LTI, *, what: str, stacklevel: int = 2) -> bool:
+    """Warn (``UnstableLoopWarning``) with the poles of ``sys`` if it is not asymptotically stable."""
+    if is_stable(sys):
+        return False
+    p = control.poles(sys)
+    domain = "|z| < 1 (discrete)" if sys.isdtime(strict=True) else "Re(s) < 0"
+    warnings.warn(
+        f"{what} is not asymptotically stable: poles {np.array2string(p, precision=6)} "
+        f"(stable needs {domain}); the simulation is allowed but will not settle",
+        UnstableLoopWarning,
+        stacklevel=stacklevel + 1,
+    )
+    return True
+
+
+@dataclass(frozen=True)
+class Margins:
+    """Stability margins of the loop gain ``L = C P`` from ``control.stability_margins``.
+
+    Attributes
+    ----------
+    gain_margin : float
+        Gain margin [-] (``inf`` if the phase never crosses -180 deg). On the pre-sliding plant
+        the undamped resonance at ``sqrt(sigma/m)`` makes the phase cross -180 deg where
+        ``|L| = inf``: python-control then reports a gain margin of about 0, a lower margin
+        that only says "with the gain reduced to zero the loop is marginal".
+    phase_margin : float
+        Phase margin [deg].
+    stability_margin : float
+        Smallest distance of the Nyquist curve from -1 [-].
+    w_phase_crossover : float
+        Frequency where the gain margin is read [rad/s].
+    w_gain_crossover : float
+        Frequency where ``|L| = 1`` [rad/s].
+    """
+
+    gain_margin: float
+    phase_margin: float
+    stability_margin: float
+    w_phase_crossover: float
+    w_gain_crossover: float
+
+    def __str__(self) -> str:
+        gm_db = 20 * math.log10(self.gain_margin) if 0 < self.gain_margin < math.inf else self.gain_margin
+        return (
+            f"gain margin {self.gain_margin:.4g} ({gm_db:.3g} dB) at {self.w_phase_crossover:.5g} rad/s, "
+            f"phase margin {self.phase_margin:.4g} deg at {self.w_gain_crossover:.5g} rad/s, "
+            f"stability margin {self.stability_margin:.4g}"
+        )
+
+
+def margins(system: Oscillator, controller: "PID | control.LTI", *, regime: str = "presliding") -> Margins:
+    """Gain, phase and stability margins of ``L = C P`` (``control.stability_margins``).
+
+    A discrete controller is evaluated with the ZOH-discretised plant.
+    """
+    C = as_lti(controller)
+    P = linear_plant(system, regime, _sample_time(C))
+    gm, pm, sm, wpc, wgc, _ = control.stability_margins(P * C)
+    return Margins(float(gm), float(pm), float(sm), float(wpc), float(wgc))
+
+
+def _plant_numbers(system: Oscillator, regime: str) -> tuple[float, float]:
+    _check_system(system)
+    _check_regime(regime)
+    return system.mass, (system.friction.sigma if regime == "presliding" else 0.0)
+
+
+def design_pd(
+    system: Oscillator, *, wn: float, zeta: float = 0.7, regime: str = "presliding", N: float = 10.0
+) -> PID:
+    """PD gains that place the closed-loop poles of the linearised stage at ``wn``, ``zeta``.
+
+    Characteristic polynomial ``m s^2 + kd s + (k + kp)`` (``k = sigma`` pre-sliding, 0
+    sliding) matched to ``m (s^2 + 2 zeta wn s + wn^2)``: ``kp = m wn^2 - k``,
+    ``kd = 2 zeta wn m``. The derivative filter ``tau = 1 / (N wn)`` adds a fast pole; the
+    loop with the filter is checked and an :class:`UnstableLoopWarning` names its poles if
+    it is unstable.
+
+    Parameters
+    ----------
+    system : prefriction.Oscillator
+        The stage (mass [kg], friction model with ``sigma`` [N/m]).
+    wn : float
+        Natural frequency of the placed pole pair [rad/s], the target bandwidth.
+        Pre-sliding needs ``wn >= sqrt(sigma / m)`` (``kp >= 0``).
+    zeta : float, default 0.7
+        Damping ratio of the pair [-], ``0 <= zeta <= 10``.
+    regime : {"presliding", "sliding"}
+        Linearisation designed on (see :func:`linear_plant`).
+    N : float, default 10.0
+        Derivative filter pole at ``N wn`` [-].
+    """
+    m, k = _plant_numbers(system, regime)
+    wn = check_positive("wn", wn)
+    zeta = check_interval("zeta", zeta, 0.0, 10.0)
+    N = check_positive("N", N)
+    kp = m * wn * wn - k
+    if kp < 0.0:
+        raise ValueError(
+            f"wn must be >= sqrt(sigma/m) = {math.sqrt(k / m):.6g} rad/s for a pre-sliding PD design "
+            f"(kp = m wn^2 - sigma >= 0), got wn={wn!r}"
+        )
+    ctrl = PID(kp=kp, kd=2.0 * zeta * wn * m, tau=1.0 / (N * wn))
+    warn_if_unstable(closed_loop(system, ctrl, regime=regime, warn=False), what=f"PD design ({regime})", stacklevel=2)
+    return ctrl
+
+
+def design_pid(
+    system: Oscillator,
+    *,
+    wn: float,
+    zeta: float = 0.7,
+    alpha: float = 1.0,
+    regime: str = "presliding",
+    N: float = 10.0,
+    u_max: Optional[float] = None,
+    t_track: Optional[float] = None,
+) -> PID:
+    """PID gains that place the closed-loop poles at ``wn``, ``zeta`` and a real pole ``-alpha wn``.
+
+    ``m s^3 + kd s^2 + (k + kp) s + ki = m (s^2 + 2 zeta wn s + wn^2)(s + alpha wn)``:
+    ``kd = m (2 zeta + alpha) wn``, ``kp = m (1 + 2 zeta alpha) wn^2 - k``,
+    ``ki = m alpha wn^3`` (``k = sigma`` pre-sliding, 0 sliding). Derivative filter
+    ``tau = 1 / (N wn)``; the filtered loop is checked and an :class:`UnstableLoopWarning`
+    names its poles if it is unstable. ``u_max`` and ``t_track`` set the anti-windup of
+    :class:`PID` (used by :func:`controllers.simulate_loop`).
+
+    Parameters
+    ----------
+    system : prefriction.Oscillator
+        The stage.
+    wn : float
+        Natural frequency of the placed pair [rad/s] (target bandwidth).
+    zeta : float, default 0.7
+        Damping ratio of the pair [-], ``0 <= zeta <= 10``.
+    alpha : float, default 1.0
+        Real pole at ``-alpha wn`` [-], ``0 < alpha < inf``.
+    regime, N, u_max, t_track
+        As in :func:`design_pd` and :class:`PID`.
+    """
+    m, k = _plant_numbers(system, regime)
+    wn = check_positive("wn", wn)
+    zeta = check_interval("zeta", zeta, 0.0, 10.0)
+    alpha = check_positive("alpha", alpha)
+    N = check_positive("N", N)
+    kp = m * (1.0 + 2.0 * zeta * alpha) * wn * wn - k
+    if kp < 0.0:
+        wmin = math.sqrt(k / (m * (1.0 + 2.0 * zeta * alpha)))
+        raise ValueError(
+            f"wn must be >= sqrt(sigma / (m (1 + 2 zeta alpha))) = {wmin:.6g} rad/s for a pre-sliding "
+            f"PID design (kp >= 0), got wn={wn!r}"
+        )
+    ctrl = PID(
+        kp=kp, ki=m * alpha * wn ** 3, kd=m * (2.0 * zeta + alpha) * wn, tau=1.0 / (N * wn),
+        u_max=u_max, t_track=t_track,
+    )
+    warn_if_unstable(closed_loop(system, ctrl, regime=regime, warn=False), what=f"PID design ({regime})", stacklevel=2)
+    return ctrl

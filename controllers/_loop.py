@@ -1,0 +1,307 @@
+"""Closed-loop simulation of a python-control controller around the reversal-aware Dahl stage.
+
+:func:`simulate_loop` turns any SISO, proper python-control LTI controller (error ``e = r - x``
+[m] to force ``u`` [N]) into a :class:`prefriction._feedback.LinearFeedback` and runs
+:func:`prefriction.simulate`, which integrates ``m x'' = u - F`` with the Dahl friction (3.2)
+and lands on every velocity reversal (also inside a sample interval of a sampled controller).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Callable, Optional, Union
+
+import control
+import numpy as np
+
+import prefriction
+from prefriction._feedback import LinearFeedback
+from prefriction._validation import check_finite, check_positive
+from prefriction.models import Oscillator
+from prefriction.reversals import ReversalTable
+from prefriction.simulate import SimulationResult
+
+from ._linear import _check_system, _sample_time, as_lti, closed_loop
+from ._pid import PID
+
+Reference = Union[float, Callable[[Any], Any], tuple]
+
+DISCRETIZATIONS = ("zoh", "foh", "tustin", "bilinear", "backward_diff", "forward_diff", "euler", "gbt", "matched")
+
+
+@dataclass(frozen=True, eq=False)
+class LoopResult:
+    """Result of :func:`simulate_loop`, SI units.
+
+    Attributes
+    ----------
+    t : numpy.ndarray
+        Output times [s]: the sample instants ``k Ts`` (sampled controller) or the requested
+        output times (continuous controller).
+    reference : numpy.ndarray
+        Reference ``r(t)`` [m].
+    x, v, F : numpy.ndarray
+        Position [m], velocity [m/s], friction force [N].
+    u : numpy.ndarray
+        Control force [N] (for a sampled controller the value held from ``t[k]`` on).
+    error : numpy.ndarray
+        ``r - x`` [m].
+    xc : numpy.ndarray
+        Controller states, shape ``(len(t), n)``.
+    reversals : prefriction.ReversalTable
+        Every velocity reversal, located by the simulator (times, positions, forces, energies).
+    Ts : float or None
+        Sample time of the controller [s]; ``None`` for a continuous controller.
+    controller : control.StateSpace
+        The controller that ran (after ``c2d`` if the loop discretised it).
+    kp : float or None
+        Static gain of the controller at ``s = 0`` (or ``z = 1``) if it is finite and
+        positive (PD), ``None`` otherwise: then ``Fc / kp`` bounds the residual error.
+    Fc : float
+        Coulomb force of the stage [N].
+    simulation : prefriction.simulate.SimulationResult
+        The raw result of :func:`prefriction.simulate` (run statistics, work of the input).
+    """
+
+    t: np.ndarray
+    reference: np.ndarray
+    x: np.ndarray
+    v: np.ndarray
+    F: np.ndarray
+    u: np.ndarray
+    error: np.ndarray
+    xc: np.ndarray
+    reversals: ReversalTable
+    Ts: Optional[float]
+    controller: control.StateSpace
+    kp: Optional[float]
+    Fc: float
+    simulation: SimulationResult
+
+    @property
+    def residual_error(self) -> float:
+        """Error ``r - x`` at the last output time [m]."""
+        return float(self.error[-1])
+
+    @property
+    def error_bound(self) -> Optional[float]:
+        """``Fc / kp`` [m], the bound of the residual error of a PD loop at rest; ``None`` otherwise."""
+        return None if self.kp is None else self.Fc / self.kp
+
+    def settling_time(self, band: float = 0.02) -> float:
+        """First time [s] after which ``x`` stays within ``band`` of the step around its final value.
+
+        The step is ``|x[-1] - x[0]|`` (not the reference: a PD loop with friction stops short).
+        ``nan`` if the position does not move.
+        """
+        band = check_positive("band", band)
+        step = abs(self.x[-1] - self.x[0])
+        if step == 0.0:
+            return math.nan
+        outside = np.nonzero(np.abs(self.x - self.x[-1]) > band * step)[0]
+        if outside.size == 0:
+            return float(self.t[0])
+        k = outside[-1] + 1
+        return float(self.t[min(k, len(self.t) - 1)])
+
+    def summary(self) -> str:
+        """A few readable lines: controller, settling, residual error (against ``Fc/kp``), reversals."""
+        kind = f"sampled, Ts = {self.Ts:.4g} s" if self.Ts is not None else "continuous"
+        lines = [
+            f"closed loop ({kind}), t_end = {self.t[-1]:.6g} s, {len(self.t)} output samples",
+            f"  reference at t_end      {self.reference[-1]: .6e} m",
+            f"  position at t_end       {self.x[-1]: .6e} m",
+            f"  settling time (2 %)     {self.settling_time():.6g} s",
+            f"  residual error r - x    {self.residual_error: .6e} m",
+        ]
+        if self.error_bound is not None:
+            ratio = abs(self.residual_error) / self.error_bound
+            lines.append(f"  PD bound Fc/kp          {self.error_bound: .6e} m  (|e| / bound = {ratio:.4f})")
+        lines += [
+            f"  friction force at t_end {self.F[-1]: .6e} N  (|F|/Fc = {abs(self.F[-1]) / self.Fc:.4f})",
+            f"  peak control force      {np.max(np.abs(self.u)): .6e} N",
+            f"  velocity reversals      {len(self.reversals)}",
+        ]
+        return "\n".join(lines)
+
+
+def _check_reference(reference: Reference) -> Reference:
+    """Validate a reference and return it (samples as float arrays); errors name ``reference``."""
+    if callable(reference):
+        return reference
+    if isinstance(reference, tuple):
+        if len(reference) != 2:
+            raise ValueError(f"reference samples must be a pair (t, r), got a tuple of length {len(reference)}")
+        t = np.asarray(reference[0], dtype=float)
+        r = np.asarray(reference[1], dtype=float)
+        if t.ndim != 1 or r.ndim != 1 or t.shape != r.shape or t.size < 2:
+            raise ValueError(
+                "reference samples (t, r) must be 1-D arrays of equal length >= 2, "
+                f"got t with shape {t.shape} and r with shape {r.shape}"
+            )
+        if not (np.all(np.isfinite(t)) and np.all(np.isfinite(r))):
+            raise ValueError("reference samples (t, r) must be finite, got NaN or inf")
+        if np.any(np.diff(t) <= 0):
+            raise ValueError("reference sample times t must be strictly increasing")
+        return (t, r)
+    if isinstance(reference, (list, np.ndarray)):
+        raise TypeError(
+            "reference must be a number [m], a callable r(t) or a pair (t, r) of sample arrays; "
+            f"got a bare {type(reference).__name__}: pass (t, r) with the sample times"
+        )
+    return check_finite("reference", reference)
+
+
+def _evaluate(reference: Reference, t: np.ndarray) -> np.ndarray:
+    """Numeric reference at times ``t`` [s] (samples: linear, held constant outside their range)."""
+    if isinstance(reference, tuple):
+        return np.interp(t, reference[0], reference[1])
+    if callable(reference):
+        vals = np.empty(t.shape)
+        for i, ti in enumerate(t):
+            v = reference(float(ti))
+            vals[i] = float(v) if np.ndim(v) == 0 or np.size(v) == 1 else math.nan
+            if not math.isfinite(vals[i]):
+                raise ValueError(f"reference r(t) must return a finite scalar [m], got {v!r} at t={ti!r} s")
+        return vals
+    return np.full(t.shape, float(reference))
+
+
+def _dc_gain(C: control.StateSpace) -> Optional[float]:
+    try:
+        with np.errstate(all="ignore"):
+            g = complex(np.squeeze(control.dcgain(C)))
+    except (ValueError, np.linalg.LinAlgError):
+        return None
+    if not math.isfinite(g.real) or g.real <= 0.0 or abs(g.imag) > 1e-9 * abs(g.real):
+        return None
+    return g.real
+
+
+def simulate_loop(
+    system: Oscillator,
+    controller: "PID | control.LTI",
+    reference: Reference,
+    t_end: float,
+    *,
+    Ts: Optional[float] = None,
+    discretization: str = "zoh",
+    x0: float = 0.0,
+    v0: float = 0.0,
+    F0: float = 0.0,
+    xc0: Any = None,
+    t_out: Any = None,
+    rtol: float = 1e-8,
+    jit: bool = True,
+) -> LoopResult:
+    """Simulate the positioning loop ``u = C(r - x)`` around the Dahl stage, every reversal located.
+
+    The plant is :func:`prefriction.simulate`'s: ``m x'' = u - F`` with Dahl friction (3.2),
+    integrated in normalised units, with each velocity reversal located (inside a sample
+    interval too) and the hysteresis branch switched there.
+
+    Parameters
+    ----------
+    system : prefriction.Oscillator
+        The stage: mass [kg] and :class:`prefriction.Dahl` friction. An input force of the
+        oscillator (``system.u``) acts as a disturbance added to the control force.
+    controller : controllers.PID or control.TransferFunction or control.StateSpace
+        SISO, proper controller from the error ``e = r - x`` [m] to the force ``u`` [N].
+        Continuous (its states are integrated with the plant) or discrete with ``dt > 0``
+        (sampled-data loop: ``u[k] = C xc[k] + D e[k]`` held constant over each sample
+        interval, zero-order hold), e.g. from ``control.c2d``.
+    reference : float, callable or (t, r)
+        Position reference [m]: a number (a step at ``t = 0``), a callable ``r(t)`` of time
+        [s], or samples ``(t, r)`` of equal length (linear between samples, held constant
+        outside them). With a continuous controller a callable must accept a CasADi symbol
+        (numpy ufuncs and arithmetic, no ``if`` on ``t``); with a sampled controller any
+        Python callable works (it is read at the sample instants only).
+    t_end : float
+        End time [s], ``0 < t_end < inf``.
+    Ts : float, optional
+        Sample time [s], ``0 < Ts < inf``. Default: the discrete controller's ``dt``; ``None``
+        for a continuous controller. Given with a continuous controller, the controller is
+        discretised with ``control.c2d(controller, Ts, method=discretization)``.
+    discretization : str, default "zoh"
+        ``control.c2d`` method used when a continuous controller is given with ``Ts``.
+    x0, v0, F0 : float, default 0.0
+        Initial position [m], velocity [m/s] and friction force [N] (``|F0| <= Fc``).
+    xc0 : array_like, optional
+        Initial controller state (zeros by default).
+    t_out : array_like, optional
+        Output times [s] of a continuous loop, increasing in ``[0, t_end]`` (default 2001
+        equally spaced). Not allowed with a sampled controller (its outputs are at ``k Ts``).
+    rtol : float, default 1e-8
+        Relative tolerance of the simulator, ``1e-13 <= rtol <= 1e-2``.
+    jit : bool, default True
+        Let the simulator compile its integrator (cached on disk).
+
+    Returns
+    -------
+    LoopResult
+        Samples ``t, reference, x, v, F, u, error`` and the reversal table; ``summary()``.
+
+    Raises
+    ------
+    ValueError
+        Non-positive or non-finite ``t_end`` or ``Ts``; ``Ts`` different from the discrete
+        controller's ``dt``; malformed reference samples (lengths differ, not increasing,
+        not finite); an improper or non-SISO controller; ``t_out`` with a sampled controller.
+    TypeError
+        Wrong argument types, unknown keyword arguments, a reference callable that cannot be
+        traced in a continuous loop.
+    NotImplementedError
+        A :class:`PID` with a force limit ``u_max`` (anti-windup): not supported by the
+        simulator's linear feedback yet (see the package notes).
+    prefriction.SolverError
+        If the integration fails.
+
+    Warns
+    -----
+    UnstableLoopWarning
+        If the loop closed around the pre-sliding linearisation ``1/(m s^2 + sigma)`` is not
+        asymptotically stable (the poles are in the message).
+    """
+    _check_system(system)
+    t_end = check_positive("t_end", t_end)
+    reference = _check_reference(reference)
+    if Ts is not None:
+        Ts = check_positive("Ts", Ts)
+    if discretization not in DISCRETIZATIONS:
+        raise ValueError(f"discretization must be one of {DISCRETIZATIONS}, got {discretization!r}")
+    if isinstance(controller, PID) and controller.u_max is not None:
+        raise NotImplementedError(
+            f"u_max={controller.u_max!r}: force saturation with anti-windup is not supported by "
+            "prefriction.simulate's linear feedback; use u_max=None (linear PID)"
+        )
+    C = as_lti(controller)
+    dt = _sample_time(C)
+    if dt is not None:
+        if Ts is not None and not math.isclose(Ts, dt, rel_tol=1e-12):
+            raise ValueError(f"Ts={Ts!r} differs from the discrete controller's sample time dt={dt!r}; omit Ts")
+        Ts = dt
+    elif Ts is not None:
+        C = control.c2d(C, Ts, method=discretization)
+    closed_loop(system, C, regime="presliding", warn=True)
+
+    fb_reference = reference
+    if Ts is not None:
+        if t_out is not None:
+            raise ValueError("t_out is not allowed with a sampled controller: its outputs are at the sample instants k Ts")
+        if callable(reference):  # read at the sample instants only: any Python callable works
+            tk = Ts * np.arange(int(math.floor(t_end / Ts * (1 + 1e-12))) + 2)
+            fb_reference = (tk, _evaluate(reference, tk))
+        dense: Any = False
+    else:
+        if t_out is None:
+            dense = np.linspace(0.0, t_end, 2001)
+        else:
+            dense = np.asarray(t_out, dtype=float)
+    fb = LinearFeedback(A=C.A, B=C.B, C=C.C, D=C.D, Ts=Ts, reference=fb_reference, xc0=xc0)
+    sim = prefriction.simulate(system, v0, x0=x0, F0=F0, t_end=t_end, rtol=rtol, dense=dense, feedback=fb, jit=jit)
+    r = _evaluate(reference, sim.t)
+    return LoopResult(
+        t=sim.t, reference=r, x=sim.x, v=sim.v, F=sim.F, u=sim.u, error=r - sim.x, xc=sim.xc,
+        reversals=sim.reversals, Ts=Ts, controller=C, kp=_dc_gain(C), Fc=system.friction.Fc, simulation=sim,
+    )
