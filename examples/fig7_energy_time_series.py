@@ -29,7 +29,10 @@ T_END = 10.0  # [s]
 
 
 def energy_since_reversal(t: np.ndarray, E_f: np.ndarray, t_rev: np.ndarray) -> np.ndarray:
-    """Restoring-force work (2.8) counted from the most recent reversal before each sample."""
+    """Restoring-force work (2.8) counted from the most recent reversal before each sample.
+
+    ``E_f`` at a reversal is interpolated linearly; exact when the reversal times are samples.
+    """
     idx = np.searchsorted(t_rev, t, side="right") - 1
     base = np.where(idx >= 0, np.interp(t_rev[np.maximum(idx, 0)], t, E_f), 0.0)
     return E_f - base
@@ -52,7 +55,8 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
     runs: dict[float, dict] = {}
     for ax, color, ratio in zip(axes[:, 0], COLORS, RATIOS):
         system = Oscillator(Dahl(sigma=ratio * FC, Fc=FC), mass=MASS)
-        grid = np.linspace(0.0, t_end, int(t_end * (1000 if quick else 4000)) + 1)
+        t_rev = simulate(system, V0, t_end=t_end).reversals.t  # sample the reversals exactly
+        grid = np.union1d(np.linspace(0.0, t_end, int(t_end * (1000 if quick else 4000)) + 1), t_rev)
         res = simulate(system, V0, t_end=t_end, dense=grid)
         t, E_k, E_f = res.t, res.E_k, res.E_f
         rev = res.reversals
