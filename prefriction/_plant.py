@@ -77,7 +77,12 @@ class PlantSpec:
     K: int = 4
     n_out: int = 1
     method: str = "erk"
-    pform: bool = False
+    gamma: float = 1.0
+
+    @property
+    def pform(self) -> bool:
+        """True if the force state is ``p`` (gamma < 1), see the class docstring."""
+        return self.gamma < 1.0
 
 
     @property
@@ -101,7 +106,7 @@ class Layout:
         self.reg_width = 4 if spec.forced else 3
         self.nx = self.reg + spec.K * self.reg_width
         self.n_active = 3 + int(spec.forced) + int(spec.energy) + spec.n_c
-        pnames = ["Ax", "Av", "AF", "AE", "xref", "Efref", "nstop", "gamma", "tunit", "xunit", "Fc"]
+        pnames = ["Ax", "Av", "AF", "AE", "xref", "Efref", "nstop", "snap", "tunit", "xunit", "Fc"]
         if spec.r_kind == "const":
             pnames.append("r")
         self.param = {k: i for i, k in enumerate(pnames)}
@@ -134,6 +139,16 @@ def _signal(kind: str, fun: Callable[[Any], Any] | None, t_si: ca.SX, c: dict, p
     if kind == "const":
         return p["r"]
     return 0.0
+
+
+def _power(w: ca.SX, g: float) -> ca.SX:
+    """``w ** g`` for ``w >= 0``: products for small integer ``g`` (fast, exact derivatives)."""
+    if float(g).is_integer() and 0 <= g <= 8:
+        out = ca.SX(1.0)
+        for _ in range(int(g)):
+            out = out * w
+        return out
+    return ca.fmax(w, 1e-300) ** g  # w > 0: the derivative of pow stays finite
 
 
 def trace_signal(fun: Callable[[Any], Any], what: str) -> ca.SX:
@@ -175,7 +190,7 @@ def build_integrator(spec: PlantSpec, tol: float, atol: float) -> ca.Function:
     x = p["xref"] + p["Ax"] * st["xh"]
     v = p["Av"] * st["vh"]
     s = st["s"]
-    g = p["gamma"]
+    g = spec.gamma
     if spec.pform:
         pp = p["AF"] * st["Fh"]
         F = -s * ca.expm1(ca.log1p(-ca.fmin(pp, 1.0 - 1e-16)) / (1.0 - g))  # finite derivatives at p = 1
@@ -202,7 +217,7 @@ def build_integrator(spec: PlantSpec, tol: float, atol: float) -> ca.Function:
     if spec.pform:
         dF = (1.0 - g) * s * v * (1.0 - st["sat"])  # dp/dt
     else:
-        dF = v * ca.fmax(1.0 - s * F, 1e-300) ** g  # > 0: no NaN in derivatives of pow
+        dF = v * _power(ca.fmax(1.0 - s * F, 0.0), g)
     dot = {
         "xh": run_m * v / p["Ax"],
         "vh": run_m * acc / p["Av"],
@@ -244,10 +259,16 @@ def build_integrator(spec: PlantSpec, tol: float, atol: float) -> ca.Function:
         return out
 
     def force_state(new_s: Any) -> Any:
-        """Scaled force state on the branch of direction ``new_s`` for the current force."""
+        """Scaled force state on the branch of direction ``new_s`` for the current force.
+
+        For gamma < 1 a reversal closer than ``snap`` to saturation is a reversal at
+        saturation: the two events coincide to the tolerance (gamma = 0 reaches both at once
+        in its undamped oscillation; resolving their order by round-off would bleed energy).
+        """
         if not spec.pform:
             return st["Fh"]
-        return -ca.expm1((1.0 - g) * ca.log1p(-new_s * F)) / p["AF"]
+        Fs = ca.if_else(1.0 - pp < p["snap"], s, F)
+        return -ca.expm1((1.0 - g) * ca.log1p(-new_s * Fs)) / p["AF"]
 
     def reversal(new_s: Any, extra: dict) -> ca.SX:
         n1 = st["n"] + 1

@@ -142,9 +142,22 @@ def _segment(value: Any, t: float, t_next: float) -> tuple[float, float, float]:
     ts, vs = value
     if t_next <= ts[0] or t >= ts[-1]:
         return t, float(np.interp(t, ts, vs)), 0.0
-    k = int(np.clip(np.searchsorted(ts, t, side="right") - 1, 0, len(ts) - 2))
+    mid = 0.5 * (t + t_next)  # robust to round-off when t is a sample time
+    k = int(np.clip(np.searchsorted(ts, mid, side="right") - 1, 0, len(ts) - 2))
     slope = (vs[k + 1] - vs[k]) / (ts[k + 1] - ts[k])
     return float(ts[k]), float(vs[k]), float(slope)
+
+
+def _force_scale(system: Oscillator, u_kind: str, fb: Optional[LinearFeedback], r_kind: str,
+                 x0: float, t_end: float) -> float:
+    """Size [N] of the applied force: input samples, or 257 evaluations over [0, t_end], plus the
+    feedback force ``|D| max |r - x0| + |C xc0|``; used for the error-control scale."""
+    t = np.linspace(0.0, t_end, 257)
+    scale = float(np.max(np.abs(_eval_signal(system.u, u_kind, t)))) if system.forced else 0.0
+    if fb is not None:
+        r = _eval_signal(fb.reference, r_kind, t)
+        scale += abs(fb.D[0, 0]) * float(np.max(np.abs(r - x0))) + float(np.abs(fb.C[0] @ fb.xc0))
+    return scale
 
 
 def _integrator(spec: PlantSpec, tol: float, atol: float, jit: bool) -> tuple[ca.Function, float, str]:
@@ -189,10 +202,13 @@ class _Run:
 
     # --- state conversion -------------------------------------------------------------
     def _scales(self) -> dict:
+        """Amplitude scales of the next call (normalised units): the state and, if forced, the
+        force scale of the input and the largest amplitude so far (a motion can grow)."""
         v, F = self.st["v"], self.st["F"]
         A = math.hypot(v, F)
         if self.spec.forced:
-            A = max(A, 1.0)
+            self.A_max = max(getattr(self, "A_max", 0.0), A)
+            A = max(A, self.force_scale, 0.1 * self.A_max)
         A = max(A, 1e-300)
         return {"Ax": max(A, 0.5 * A * A), "Av": A, "AF": min(A, 1.0), "AE": A * A}
 
@@ -204,7 +220,7 @@ class _Run:
         P[L.param["xref"]] = self.st["x"]
         P[L.param["Efref"]] = self.st["Ef"]
         P[L.param["nstop"]] = nstop
-        P[L.param["gamma"]] = self.gamma
+        P[L.param["snap"]] = self.snap
         P[L.param["tunit"]] = sc.t
         P[L.param["xunit"]] = sc.x
         P[L.param["Fc"]] = sc.F
@@ -293,10 +309,10 @@ class _Run:
             tl = ta
             if self.spec.u_kind == "samples":
                 tl, ua, ub = _segment(sys.u, ta, tb)
-                U[L.control["ua"]], U[L.control["ub"]] = ua - ub * (ta - tl), ub
+                U[L.control["ua"]], U[L.control["ub"]] = ua + ub * (ta - tl), ub
             if self.spec.r_kind == "samples":
                 tl2, ra, rb = _segment(fb.reference, ta, tb)
-                U[L.control["ra"]], U[L.control["rb"]] = ra - rb * (ta - tl2), rb
+                U[L.control["ra"]], U[L.control["rb"]] = ra + rb * (ta - tl2), rb
             U[L.control["tl"]] = ta
         if "uhold" in L.control:
             U[L.control["uhold"]] = self.st["uhold"]
@@ -538,12 +554,14 @@ def simulate(
         r_kind=r_kind if fb_kind == "continuous" else "none",
         r_fun=(feedback.reference if r_kind == "callable" and fb_kind == "continuous" else None),
         energy=want_dense, K=_K, n_out=_N_DENSE if want_dense else 1, method=method,
-        pform=system.friction.gamma < 1.0,
+        gamma=system.friction.gamma,
     )
     L = Layout(spec)
     tol = rtol * _CAL * math.sqrt(L.n_active / L.nx)
     tol_abs = atol * _CAL * math.sqrt(L.n_active / L.nx)
     run = _Run(system, spec, feedback, tol, tol_abs, jit)
+    run.snap = rtol
+    run.force_scale = _force_scale(system, u_kind, feedback, r_kind, x0, t_end_si) / Fc if forced else 0.0
 
     # initial state (normalised)
     u0 = _eval_signal(system.u, u_kind, np.array([0.0]))[0] if system.forced else 0.0
@@ -581,11 +599,8 @@ def simulate(
         Ts = feedback.Ts / sc.t
         xc = xc0.copy()
         k = 0
-        stopped = False
-        while not stopped:
-            tk = k * Ts
-            if tk > t_end_n * (1 + 1e-12):
-                break
+        while True:
+            tk = min(k * Ts, t_end_n)
             t_si = tk * sc.t
             e = _eval_signal(feedback.reference, r_kind, np.array([t_si]))[0] - run.st["x"] * sc.x
             uk = float(feedback.C[0] @ xc + feedback.D[0, 0] * e)
@@ -593,9 +608,10 @@ def simulate(
             run.st["xc"] = xc.copy()
             samples.append(run.sample())
             u_hist.append(uk + _eval_signal(system.u, u_kind, np.array([t_si]))[0])
+            if tk >= t_end_n * (1 - 1e-12):
+                break
             xc = feedback.A @ xc + feedback.B[:, 0] * e
-            stopped = run.advance(min((k + 1) * Ts, t_end_n), n_target)
-            if (k + 1) * Ts >= t_end_n * (1 - 1e-12):
+            if run.advance(min((k + 1) * Ts, t_end_n), n_target):
                 break
             k += 1
         status = "reversals" if len(run.rev) >= n_target else "t_end"
