@@ -16,6 +16,7 @@ import control
 import numpy as np
 
 import prefriction
+from prefriction._branch import force_after_distance
 from prefriction._feedback import LinearFeedback
 from prefriction._validation import check_finite, check_positive
 from prefriction.models import Oscillator
@@ -55,11 +56,11 @@ class LoopResult:
         Sample time of the controller [s]; ``None`` for a continuous controller.
     controller : control.StateSpace
         The controller that ran (after ``c2d`` if the loop discretised it).
+    system : prefriction.Oscillator
+        The stage that was simulated.
     kp : float or None
         Static gain of the controller at ``s = 0`` (or ``z = 1``) if it is finite and
         positive (PD), ``None`` otherwise: then ``Fc / kp`` bounds the residual error.
-    Fc : float
-        Coulomb force of the stage [N].
     simulation : prefriction.simulate.SimulationResult
         The raw result of :func:`prefriction.simulate` (run statistics, work of the input).
     """
@@ -75,9 +76,14 @@ class LoopResult:
     reversals: ReversalTable
     Ts: Optional[float]
     controller: control.StateSpace
+    system: Oscillator
     kp: Optional[float]
-    Fc: float
     simulation: SimulationResult
+
+    @property
+    def Fc(self) -> float:
+        """Coulomb force of the stage [N]."""
+        return self.system.friction.Fc
 
     @property
     def residual_error(self) -> float:
@@ -88,6 +94,31 @@ class LoopResult:
     def error_bound(self) -> Optional[float]:
         """``Fc / kp`` [m], the bound of the residual error of a PD loop at rest; ``None`` otherwise."""
         return None if self.kp is None else self.Fc / self.kp
+
+    def friction_loop(self, points_per_branch: int = 200) -> tuple[np.ndarray, np.ndarray]:
+        """Friction force-displacement curve ``F(x)`` [m, N] through every reversal, exact between them.
+
+        The Dahl model is rate-independent: between two reversals ``F`` is the branch (3.4)/(3.5)
+        through the previous reversal as a function of ``x`` alone. The curve joins the initial
+        state, each reversal of :attr:`reversals` and the final state along these branches, so
+        it is exact however coarse the output samples are (e.g. 10 kHz samples of a stage whose
+        half-cycles last a fraction of a millisecond).
+        """
+        sigma, Fc, gamma = self.system.friction.sigma, self.Fc, self.system.friction.gamma
+        xs = np.concatenate(([self.x[0]], self.reversals.x, [self.x[-1]]))
+        Fs = np.concatenate(([self.F[0]], self.reversals.F, [self.F[-1]]))
+        cx, cF = [xs[:1]], [Fs[:1]]
+        frac = np.linspace(0.0, 1.0, max(int(points_per_branch), 2))[1:]
+        for i in range(len(xs) - 1):
+            dx = xs[i + 1] - xs[i]
+            if dx == 0.0:
+                continue
+            s = 1.0 if dx > 0 else -1.0
+            xi = np.abs(dx) * frac * sigma / Fc
+            f = force_after_distance(np.full(xi.shape, s * Fs[i] / Fc), xi, gamma)
+            cx.append(xs[i] + dx * frac)
+            cF.append(s * Fc * f)
+        return np.concatenate(cx), np.concatenate(cF)
 
     def settling_time(self, band: float = 0.02) -> float:
         """First time [s] after which ``x`` stays within ``band`` of the step around its final value.
@@ -303,5 +334,5 @@ def simulate_loop(
     r = _evaluate(reference, sim.t)
     return LoopResult(
         t=sim.t, reference=r, x=sim.x, v=sim.v, F=sim.F, u=sim.u, error=r - sim.x, xc=sim.xc,
-        reversals=sim.reversals, Ts=Ts, controller=C, kp=_dc_gain(C), Fc=system.friction.Fc, simulation=sim,
+        reversals=sim.reversals, Ts=Ts, controller=C, system=system, kp=_dc_gain(C), simulation=sim,
     )

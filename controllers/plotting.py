@@ -1,0 +1,91 @@
+"""Figures of closed-loop step responses, saved to PNG files.
+
+Uses ``matplotlib.figure.Figure`` directly (Agg canvas, no pyplot state, no backend change).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Mapping
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from ._loop import LoopResult
+
+
+def _scale(values: np.ndarray) -> tuple[float, str]:
+    """Factor and unit label that bring a displacement [m] to um or nm."""
+    peak = float(np.max(np.abs(values))) if values.size else 0.0
+    return (1e6, "um") if peak >= 1e-7 else (1e9, "nm")
+
+
+def plot_steps(
+    results: Mapping[str, LoopResult], path: "str | Path", *, title: str, bound: "float | None" = None
+) -> Path:
+    """One row per loop: position, control force, friction loop ``F(x)``, and ``|e|`` against ``Fc/kp``.
+
+    Parameters
+    ----------
+    results : mapping of str to LoopResult
+        Row label (e.g. ``"step 1 um"``) and its loop result.
+    path : str or Path
+        PNG file to write.
+    title : str
+        Figure title.
+    bound : float, optional
+        Error level [m] drawn as ``Fc/kp`` in the error panels; default each result's
+        ``error_bound`` (PD loops; ``None`` for loops with an integrator).
+
+    Returns
+    -------
+    Path
+        The written file.
+    """
+    n = len(results)
+    fig = Figure(figsize=(17, 3.6 * n + 0.6))
+    axes = fig.subplots(n, 4, squeeze=False)
+    for row, (label, res) in zip(axes, results.items()):
+        k, unit = _scale(res.reference)
+        t_ms = res.t * 1e3
+        ax = row[0]
+        ax.plot(t_ms, res.reference * k, "k--", lw=1, label="reference r")
+        ax.plot(t_ms, res.x * k, lw=1.2, label="position x")
+        ax.set(xlabel="time t [ms]", ylabel=f"position [{unit}]", title=f"{label}: position")
+        ax.legend(loc="lower right")
+        ax = row[1]
+        ax.step(t_ms, res.u, where="post" if res.Ts else "pre", lw=1, label="control force u (ZOH)" if res.Ts else "control force u")
+        ax.plot(t_ms, res.F, lw=1, label="friction force F")
+        ax.set(xlabel="time t [ms]", ylabel="force [N]", title=f"{label}: forces")
+        fmax = max(float(np.max(np.abs(res.F))), 1e-12)
+        if np.max(np.abs(res.u)) > 20 * fmax:  # derivative kick dwarfs the friction force
+            ax.set_yscale("symlog", linthresh=10.0 ** np.ceil(np.log10(fmax)))
+        ax.legend(loc="upper right")
+        ax = row[2]
+        lx, lF = res.friction_loop()
+        ax.plot(lx * k, lF, lw=1.2, label="Dahl branches (3.4)")
+        ax.plot(res.x * k, res.F, ".", ms=3, color="0.3", label="output samples")
+        rv = res.reversals
+        if len(rv):
+            ax.plot(rv.x * k, rv.F, "o", ms=4, mfc="none", label=f"reversals ({len(rv)})")
+        if np.max(np.abs(lF)) > 0.2 * res.Fc:
+            ax.axhline(res.Fc, color="0.5", lw=0.8, ls=":")
+            ax.axhline(-res.Fc, color="0.5", lw=0.8, ls=":", label="+-Fc")
+        ax.set(xlabel=f"position x [{unit}]", ylabel="friction force F [N]", title=f"{label}: friction loop")
+        ax.legend(loc="lower right")
+        ax = row[3]
+        err = np.abs(res.error)
+        ax.semilogy(t_ms, np.where(err > 0, err, np.nan) * k, lw=1, label="|e| = |r - x|")
+        level = res.error_bound if bound is None else bound
+        if level is not None:
+            ax.axhline(level * k, color="C3", ls="--", label=f"Fc/kp = {level * k:.3g} {unit}")
+        ax.set(xlabel="time t [ms]", ylabel=f"|error| [{unit}]", title=f"{label}: error")
+        ax.legend(loc="best")
+        for a in row:
+            a.grid(True, alpha=0.3)
+    fig.suptitle(title)
+    fig.tight_layout()
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
+    return path
