@@ -158,7 +158,7 @@ def warn_if_unstable(sys: control.LTI, *, what: str, stacklevel: int = 2) -> boo
     p = control.poles(sys)
     domain = "|z| < 1 (discrete)" if sys.isdtime(strict=True) else "Re(s) < 0"
     warnings.warn(
-        f"{what} is not asymptotically stable: poles {np.array2string(p, precision=6)} "
+        f"{what} is not asymptotically stable: poles [{', '.join(f'{z.real:.7g}{z.imag:+.7g}j' for z in p)}] "
         f"(stable needs {domain}); the simulation is allowed but will not settle",
         UnstableLoopWarning,
         stacklevel=stacklevel + 1,

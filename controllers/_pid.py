@@ -132,8 +132,20 @@ class PID:
         return control.ss(*self._matrices(), inputs="e", outputs="u", name="controller")
 
     def tf(self) -> control.TransferFunction:
-        """Continuous linear controller ``kp + ki/s + kd s/(tau s + 1)`` as ``control.TransferFunction``."""
-        return control.tf(self.ss())
+        """Continuous linear controller ``kp + ki/s + kd s/(tau s + 1)`` as ``control.TransferFunction``.
+
+        Built from the polynomial coefficients (not converted from :meth:`ss`, which would
+        cost digits).
+        """
+        integ = np.array([1.0, 0.0]) if self.has_integrator else np.array([1.0])
+        filt = np.array([self.tau, 1.0]) if self.kd > 0.0 else np.array([1.0])
+        den = np.polymul(integ, filt)
+        num = self.kp * den
+        if self.has_integrator:
+            num = np.polyadd(num, self.ki * filt)
+        if self.kd > 0.0:
+            num = np.polyadd(num, self.kd * np.polymul([1.0, 0.0], integ))
+        return control.tf(num, den, inputs="e", outputs="u", name="controller")
 
     def c2d(self, Ts: float, method: str = "zoh") -> control.StateSpace:
         """Discrete linear controller for sample time ``Ts`` [s] (``control.c2d``, default ZOH)."""
