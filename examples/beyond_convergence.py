@@ -29,13 +29,15 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
     dict
         ``n`` (1..N), ``a`` (``a_n = |F_n|/Fc`` after n reversals of the map from ``a_0``),
         ``law`` (``3/(2n)``), ``offset`` (``1/a_n - 2n/3``, bounded if the law holds),
-        ``rel_dev`` (``a_n / (3/(2n)) - 1``); ``png``.
+        ``rel_dev`` (``a_n / (3/(2n)) - 1``), ``refined`` (the law with its corrections,
+        :func:`prefriction.dahl.asymptotic_amplitude`); ``png``.
     """
     n_rev = 2_000 if quick else N_REVERSALS
     seq = np.asarray(dahl.amplitude_sequence(A0, n_rev), dtype=float)
     a = seq[1 : n_rev + 1] if seq.size > n_rev else seq
     n = np.arange(1, a.size + 1, dtype=float)
     law = 1.5 / n
+    refined = np.asarray(dahl.asymptotic_amplitude(n, A0), dtype=float)
     offset = 1.0 / a - 2.0 * n / 3.0
     rel_dev = a / law - 1.0
 
@@ -43,6 +45,8 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
     ax = axes[0, 0]
     ax.loglog(n, a, color=COLORS[0], lw=2.0, label=r"exact map: $a_n = |F_n|/F_c$")
     ax.loglog(n, law, color=COLORS[3], ls="--", lw=1.3, label=r"asymptotic law $3/(2n)$")
+    ax.loglog(n, refined, color=COLORS[1], ls=":", lw=1.6,
+              label=r"with corrections: $15m/(10m^2 - 1)$, $m = n + n_0$")
     ax.set_xlabel("number of reversals $n$ [-]")
     ax.set_ylabel(r"reversal amplitude $|F_n|/F_c$ [-]")
     ax.grid(True, which="both", alpha=0.3)
@@ -62,7 +66,8 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
     add_note(fig, f"a_0 = {A0:g} (reversal from sliding). Universal in normalised units: "
                   "no sigma, Fc or m enters the map.")
     png = save(fig, outdir, "beyond_convergence.png")
-    return {"n": n, "a": a, "law": law, "offset": offset, "rel_dev": rel_dev, "a0": A0, "png": png}
+    return {"n": n, "a": a, "law": law, "refined": refined, "offset": offset, "rel_dev": rel_dev,
+            "a0": A0, "png": png}
 
 
 if __name__ == "__main__":

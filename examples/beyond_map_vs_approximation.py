@@ -20,7 +20,6 @@ from pathlib import Path
 import numpy as np
 
 from prefriction import dahl
-from prefriction.paper import printed_313_displacement
 from prefriction.plotting import COLORS, add_note, new_figure, save
 
 TABLE_AMPLITUDES = (1.0, 0.8, 0.6, 0.4, 0.2, 0.1, 0.01, 1e-4)
@@ -49,15 +48,15 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
     y_exact, y_approx = displacement(a_exact), displacement(a_approx)
     err_x = y_approx / y_exact - 1.0
     err_f = a_approx / a_exact - 1.0
-    err_printed = printed_313_displacement(a, PRINTED_RATIO) / y_exact - 1.0
 
     ta = np.asarray(TABLE_AMPLITUDES)
     te, tp = np.asarray(dahl.next_amplitude(ta), float), np.asarray(dahl.next_amplitude_paper(ta), float)
     tye, typ = displacement(te), displacement(tp)
+    tyr = displacement(dahl.next_amplitude_paper(ta, sigma_over_Fc=PRINTED_RATIO))
     table = [
         (float(ai), float(ei), float(pi), float(yp / ye - 1.0), float(pi / ei - 1.0),
-         float(printed_313_displacement(ai, PRINTED_RATIO) / ye - 1.0))
-        for ai, ei, pi, ye, yp in zip(ta, te, tp, tye, typ)
+         float(yr / ye - 1.0))
+        for ai, ei, pi, ye, yp, yr in zip(ta, te, tp, tye, typ, tyr)
     ]
 
     fig, axes = new_figure(1, 2, size=(11.0, 4.4))

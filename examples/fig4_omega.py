@@ -56,7 +56,7 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
         ax.plot(x, omega, "k--", lw=1.6, label=r"$\Omega(x)$ (3.10)")
         stars, slopes, cross = {}, {}, {}
         for i, (color, ai) in enumerate(zip(COLORS, AMPLITUDES)):
-            star = np.asarray(dahl.omega_star(x, sigma, FC, -ai * FC), dtype=float)
+            star = np.asarray(dahl.omega_star(x, -ai * FC, sigma, FC), dtype=float)
             stars[ai] = star
             slopes[ai] = float((star[0] - star[1]) / (x[1] - x[0]))
             cross[ai] = secant_crossing(slopes[ai] * FC / sigma) * FC / sigma

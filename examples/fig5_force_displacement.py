@@ -18,7 +18,6 @@ from pathlib import Path
 import numpy as np
 
 from prefriction import dahl
-from prefriction.paper import printed_313_displacement
 from prefriction.plotting import COLORS, add_note, new_figure, save
 
 SIGMA = 1.0  # rest stiffness [N/m]; not stated in the paper
@@ -42,20 +41,20 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
     printed_notes = []
     for color, Fc in zip(COLORS, FCS):
         F_i = -A_I * Fc
-        x_i = Fc / SIGMA * np.log(Fc / (Fc - F_i))  # (3.8)
+        x_i = float(dahl.reversal_abscissa(F_i, SIGMA, Fc))  # (3.8)
         a_next = float(dahl.next_amplitude(A_I))
         x_next = -np.log1p(-a_next) * Fc / SIGMA
-        x_next_approx = -np.log1p(-float(dahl.next_amplitude_paper(A_I))) * Fc / SIGMA
-        x_next_printed = float(printed_313_displacement(A_I, SIGMA / Fc)) * Fc / SIGMA
+        x_next_approx = float(dahl.next_reversal_position_paper(F_i, SIGMA, Fc))
+        x_next_printed = float(dahl.next_reversal_position_paper(F_i, SIGMA, Fc, printed=True))
         x = np.linspace(x_i, x_next, 50 if quick else 300)
-        F = Fc - (Fc - F_i) * np.exp(-SIGMA / Fc * (x - x_i))  # (3.5)
+        F = dahl.branch_force(x, x_i, F_i, SIGMA, Fc)  # (3.5)
         curves[Fc] = {
             "x": x, "F": F, "x_i": x_i, "F_i": F_i, "x_next": x_next, "F_next": a_next * Fc,
             "x_next_approx": x_next_approx, "x_next_printed": x_next_printed,
         }
         ax.plot(x, F, color=color, lw=1.8, label=rf"$F_c$ = {Fc:g} N")
         ax.plot([x_i, x_next], [F_i, a_next * Fc], "o", color=color, ms=5)
-        ax.plot(x_next_approx, Fc - (Fc - F_i) * np.exp(-SIGMA / Fc * (x_next_approx - x_i)),
+        ax.plot(x_next_approx, dahl.branch_force(x_next_approx, x_i, F_i, SIGMA, Fc),
                 "x", color=color, ms=8, mew=1.5)
         ax.axhline(Fc, color=color, lw=0.8, ls=":")
         ax.axhline(-Fc, color=color, lw=0.8, ls=":")

@@ -20,7 +20,6 @@ from pathlib import Path
 import numpy as np
 
 from prefriction import dahl
-from prefriction.paper import printed_313_displacement
 from prefriction.plotting import COLORS, add_note, new_figure, save
 
 FC = 1.0  # Coulomb force [N]; not stated in the paper
@@ -80,7 +79,7 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
                     label="paper's recursion, corrected (3.13)")
         printed = {}
         for color, ratio in zip(COLORS, RATIOS):
-            seq = iterate(lambda a, r=ratio: -np.expm1(-printed_313_displacement(a, r)), A0, n.size - 1)
+            seq = iterate(lambda a, r=ratio: dahl.next_amplitude_paper(a, sigma_over_Fc=r), A0, n.size - 1)
             printed[ratio] = seq
             e = seq - np.log1p(seq)
             keep = e > 0.0

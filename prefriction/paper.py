@@ -7,9 +7,6 @@ erratum in (3.13) and every place where the toolbox disagrees with the paper, wi
 
 The examples live in the source tree (``examples/`` beside the package); they are found next
 to the package or, for a non-editable install, in ``./examples`` of the working directory.
-
-Also holds :func:`printed_313_displacement`, (3.13) exactly as printed, used by the figures
-that show what the erratum does.
 """
 
 from __future__ import annotations
@@ -37,33 +34,6 @@ FIGURES = (
     "beyond_energy_envelope",
     "beyond_gamma_loops",
 )
-
-
-def printed_313_displacement(a: np.ndarray, sigma_over_fc: float) -> np.ndarray:
-    """Next reversal from (3.13) exactly as printed, in units of ``Fc/sigma``.
-
-    (3.13) reads ``x_{i+1} = (E_p/Fc) (1 - (Fc/sigma) (Fc/(Fc - F_i))^{3/5})^{-1}``. Solving
-    (3.12) with ``K`` from (3.11) gives ``(1 - (Fc/(Fc - F_i))^{3/5})^{-1}`` instead: the printed
-    form has an extra factor ``Fc/sigma`` [m] inside the bracket, where a pure number belongs,
-    so it agrees with the corrected form only when ``sigma/Fc = 1 m^-1``. Evaluated here with
-    ``Fc = 1 N`` and the given number ``sigma/Fc`` [1/m], at the reversal ``F_i = -a Fc``.
-
-    Parameters
-    ----------
-    a : array_like
-        Reversal amplitudes ``|F_i|/Fc`` in [0, 1].
-    sigma_over_fc : float
-        The ratio ``sigma/Fc`` [1/m] (with ``Fc = 1 N``).
-
-    Returns
-    -------
-    numpy.ndarray
-        ``x_{i+1} sigma/Fc`` [-]; negative or huge where the printed form breaks down
-        (``sigma/Fc < 1``).
-    """
-    a = np.asarray(a, dtype=float)
-    c = a - np.log1p(a)  # E_p sigma/Fc^2, (3.9)
-    return c / (1.0 - (1.0 / sigma_over_fc) * (1.0 + a) ** -0.6)
 
 
 def examples_dir() -> Path:

@@ -8,12 +8,10 @@ import matplotlib
 
 matplotlib.use("Agg")
 
-import mpmath as mp
-import numpy as np
 import pytest
 
 from prefriction import cli
-from prefriction.paper import FIGURES, examples_dir, printed_313_displacement
+from prefriction.paper import FIGURES, examples_dir
 
 
 def test_paper_command_writes_report_and_every_png(tmp_path, capsys):
@@ -43,17 +41,6 @@ def test_paper_command_needs_out(capsys):
         cli.main(["paper"])
     assert err.value.code == 2
     assert "--out" in capsys.readouterr().err
-
-
-def test_printed_313_against_mpmath():
-    a = np.array([1.0, 0.6, 0.2, 1e-3])
-    for ratio in (0.5, 1.0, 10.0, 1000.0):
-        got = printed_313_displacement(a, ratio)
-        for ai, gi in zip(a, got):
-            am = mp.mpf(ai)
-            E_p = am - mp.log(1 + am)  # (3.9), sigma = ratio, Fc = 1: in units Fc^2/sigma
-            ref = E_p / (1 - (1 / mp.mpf(ratio)) * (1 / (1 + am)) ** mp.mpf("0.6"))
-            assert gi == pytest.approx(float(ref), rel=1e-12)
 
 
 def test_examples_dir_holds_every_figure_script():
