@@ -17,6 +17,7 @@ from .reversals import ReversalTable
 from .units import Scales
 from .simulate import SimulationResult, simulate
 from . import energy
+from . import dahl
 
 __all__ = [
     "Dahl",
@@ -27,6 +28,7 @@ __all__ = [
     "Scales",
     "SimulationResult",
     "SolverError",
+    "dahl",
     "energy",
     "simulate",
 ]
