@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import importlib.util
+import sys
 import time
 import traceback
 from pathlib import Path
@@ -356,6 +357,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", required=True, type=Path, help="output directory (created if missing)")
     parser.add_argument("--quick", action="store_true", help="coarser grids and fewer reversals (for tests)")
     args = parser.parse_args(argv)
+    try:
+        where = examples_dir()
+    except FileNotFoundError as exc:
+        print(f"prefriction paper: {exc}", file=sys.stderr)
+        return 2
+    print(f"figure scripts: {where}")
     start = time.perf_counter()
     results = run_all(args.out, quick=args.quick)
     total = time.perf_counter() - start
