@@ -46,8 +46,8 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
     dict
         ``runs[ratio]`` with dense ``t`` [s], ``E_k``, ``E_f`` (since t = 0), ``E_f_half``
         (since the last reversal) [J], ``t_rev``, ``F_rev`` (reversal times [s] and forces [N]),
-        ``E_p_rev`` ((3.9) at each reversal [J]), ``E_k_peak`` (largest sampled ``E_k`` in each
-        half-cycle after a reversal [J]), ``balance`` (max ``|E_k + E_f - E_k(0)| / E_k(0)``);
+        ``E_p_rev`` ((3.9) at each reversal [J]), ``E_k_peak`` (largest sampled ``E_k`` between
+        reversal k and k+1 [J], one fewer than the reversals), ``balance`` (max ``|E_k + E_f - E_k(0)| / E_k(0)``);
         ``mass``, ``v0``, ``t_end``; ``png``.
     """
     t_end = 3.0 if quick else T_END
@@ -62,11 +62,12 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
         rev = res.reversals
         E_f_half = energy_since_reversal(t, E_f, rev.t)
         E_p_rev = np.asarray(dahl.potential_energy(-np.abs(rev.F), ratio * FC, FC), dtype=float)
-        peaks = []
-        for k, t0 in enumerate(rev.t):
-            t1 = rev.t[k + 1] if k + 1 < len(rev.t) else t[-1]
-            sel = (t > t0) & (t < t1)
-            peaks.append(float(E_k[sel].max()) if k + 1 < len(rev.t) and sel.any() else np.nan)
+        peaks, t_peak = [], []  # largest sampled E_k in each complete half-cycle
+        for t0, t1 in zip(rev.t[:-1], rev.t[1:]):
+            inside = np.flatnonzero((t > t0) & (t < t1))
+            j = inside[np.argmax(E_k[inside])]
+            peaks.append(float(E_k[j]))
+            t_peak.append(float(t[j]))
         E_k0 = 0.5 * MASS * V0**2
         runs[ratio] = {
             "t": t, "E_k": E_k, "E_f": E_f, "E_f_half": E_f_half, "t_rev": np.asarray(rev.t),
@@ -77,8 +78,6 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
         ax.semilogy(t, np.maximum(E_k, floor), color=color, lw=1.2, label=r"$E_k = m\dot x^2/2$")
         ax.semilogy(t, np.maximum(np.abs(E_f_half), floor), color="k", lw=0.7, ls="--",
                     label=r"$|E_f|$, power integrated from the last reversal (2.8)")
-        t_peak = [float(t[(t > rev.t[k]) & (t < rev.t[k + 1])][np.argmax(E_k[(t > rev.t[k]) & (t < rev.t[k + 1])])])
-                  for k in range(len(rev.t) - 1)]
         ax.plot(t_peak, E_p_rev[: len(t_peak)], "o", color=COLORS[3], ms=3.5, mfc="none",
                 label=r"$E_p$ (3.9) of the preceding reversal")
         ax.set_ylim(1e-6 * E_k0, 300 * E_k0)
