@@ -1,0 +1,213 @@
+"""controllers.simulate_loop: linear-regime match with python-control, PD bound, PID integral action.
+
+References: python-control's own linear closed loops (``control.feedback`` of the textbook
+plant and controller, ``control.forced_response``; for sampled loops the exact ZOH
+discretisation ``control.c2d`` of the plant), the static balance ``|e| <= Fc/kp`` of a PD loop
+at rest, the final value theorem, and the closed-form Dahl branch (3.4) for gamma = 1.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import control
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import controllers
+import prefriction
+
+M, SIGMA = 1.0, 1e6
+TS = 1e-4
+
+
+def linear_stage():
+    """Fc so large that |F|/Fc stays below 1e-8: the Dahl friction is the spring sigma."""
+    return prefriction.Oscillator(prefriction.Dahl(sigma=SIGMA, Fc=1e8), mass=M)
+
+
+def stage(Fc=1.0):
+    return prefriction.Oscillator(prefriction.Dahl(sigma=SIGMA, Fc=Fc), mass=M)
+
+
+def plant_tf():
+    return control.tf([1.0], [M, 0.0, SIGMA])
+
+
+def pid_tf(kp, ki, kd, tau):
+    """kp + ki/s + kd s/(tau s + 1) over the common denominator s (tau s + 1) (PD: tau s + 1)."""
+    if ki == 0.0:
+        return control.tf([kd + kp * tau, kp], [tau, 1.0])
+    return control.tf([kd + kp * tau, kp + ki * tau, ki], [tau, 1.0, 0.0])
+
+
+def rel_err(a, b):
+    return float(np.max(np.abs(a - b)) / np.max(np.abs(b)))
+
+
+GAINS = [  # kp [N/m], ki [N/(m s)], kd [N s/m], tau [s]
+    (2e6, 0.0, 2000.0, 5e-5),
+    (1.1e6, 8e8, 2300.0, 1e-4),
+]
+
+
+@pytest.mark.parametrize("kp, ki, kd, tau", GAINS)
+def test_linear_regime_continuous_matches_python_control(kp, ki, kd, tau):
+    system = linear_stage()
+    r0 = 1e-6
+    C = controllers.PID(kp=kp, ki=ki, kd=kd, tau=tau)
+    res = controllers.simulate_loop(system, C, r0, 0.02)
+    T = control.feedback(plant_tf() * pid_tf(kp, ki, kd, tau), 1)
+    lin = control.forced_response(T, res.t, np.full(res.t.shape, r0)).outputs
+    assert rel_err(res.x, lin) <= 1e-6
+    U = control.feedback(pid_tf(kp, ki, kd, tau), plant_tf())  # r -> u
+    assert rel_err(res.u, control.forced_response(U, res.t, np.full(res.t.shape, r0)).outputs) <= 1e-6
+    assert res.Ts is None and len(res.t) == 2001
+
+
+@pytest.mark.parametrize("kp, ki, kd, tau", GAINS)
+def test_linear_regime_sampled_matches_exact_discretised_loop(kp, ki, kd, tau):
+    system = linear_stage()
+    r0 = 1e-6
+    Cd = control.c2d(pid_tf(kp, ki, kd, tau), TS, "zoh")
+    res = controllers.simulate_loop(system, Cd, r0, 0.02)
+    Tz = control.feedback(control.c2d(plant_tf(), TS, "zoh") * Cd, 1)
+    lin = control.forced_response(Tz, res.t, np.full(res.t.shape, r0)).outputs
+    np.testing.assert_allclose(res.t, TS * np.arange(len(res.t)), rtol=0, atol=1e-15)
+    assert rel_err(res.x, lin) <= 1e-6
+    assert res.Ts == TS
+
+
+def test_linear_regime_references_callable_and_samples():
+    system = linear_stage()
+    kp, kd, tau = 2e6, 2000.0, 5e-5
+    ramp = lambda t: 1e-6 * (1.0 - np.exp(-t / 2e-3))  # noqa: E731  (CasADi-traceable)
+    res = controllers.simulate_loop(system, controllers.pd(kp, kd, tau=tau), ramp, 0.01)
+    T = control.feedback(plant_tf() * pid_tf(kp, 0.0, kd, tau), 1)
+    lin = control.forced_response(T, res.t, ramp(res.t)).outputs
+    assert rel_err(res.x, lin) <= 1e-6
+    np.testing.assert_allclose(res.reference, ramp(res.t), rtol=1e-14)
+    # sampled loop: samples (t, r), linear between them, read at the instants k Ts
+    Cd = control.c2d(pid_tf(kp, 0.0, kd, tau), TS, "zoh")
+    Tz = control.feedback(control.c2d(plant_tf(), TS, "zoh") * Cd, 1)
+    samples = (np.array([0.0, 0.004, 0.01]), np.array([2e-7, 1e-6, 1e-6]))
+    res_s = controllers.simulate_loop(system, Cd, samples, 0.01)
+    lin_s = control.forced_response(Tz, res_s.t, np.interp(res_s.t, *samples)).outputs
+    assert rel_err(res_s.x, lin_s) <= 1e-6
+    # a plain Python callable (not CasADi-traceable) is fine in a sampled loop
+    late = lambda t: 1e-6 if t >= 5e-4 else 2e-7  # noqa: E731
+    res_c = controllers.simulate_loop(system, Cd, late, 0.01)
+    r = np.where(res_c.t >= 5e-4, 1e-6, 2e-7)
+    np.testing.assert_array_equal(res_c.reference, r)
+    assert rel_err(res_c.x, control.forced_response(Tz, res_c.t, r).outputs) <= 1e-6
+
+
+@settings(max_examples=4, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+@given(wn_ratio=st.floats(1.3, 3.0), zeta=st.floats(0.5, 1.0), step=st.floats(2e-7, 3e-6))
+def test_pd_settles_within_fc_over_kp(wn_ratio, zeta, step):
+    system = stage()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", controllers.UnstableLoopWarning)
+        pd = controllers.design_pd(system, wn=wn_ratio * np.sqrt(SIGMA / M), zeta=zeta)
+        res = controllers.simulate_loop(system, pd.c2d(TS), step, 0.04)
+    bound = 1.0 / pd.kp  # Fc / kp
+    tail = res.t >= 0.03
+    assert np.all(np.abs(res.error[tail]) <= bound)
+    assert abs(res.residual_error) <= bound * (1 - 1e-9)
+    # at rest the friction balances the proportional force: F = kp e (static gain of the ZOH PD)
+    assert abs(res.v[-1]) <= 1e-9 * step * np.sqrt(SIGMA / M)
+    assert res.F[-1] == pytest.approx(pd.kp * res.residual_error, rel=1e-6)
+    assert res.error_bound == pytest.approx(bound, rel=1e-12)
+
+
+@settings(max_examples=3, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+@given(wn_hz=st.floats(110.0, 200.0), zeta=st.floats(0.6, 0.9), step=st.floats(2e-7, 3e-6))
+def test_pid_drives_error_to_zero(wn_hz, zeta, step):
+    system = stage()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", controllers.UnstableLoopWarning)
+        c = controllers.design_pid(system, wn=2 * np.pi * wn_hz, zeta=zeta)
+        res = controllers.simulate_loop(system, c.c2d(TS), step, 0.08)
+    assert abs(res.residual_error) <= 1e-6 * step
+    assert res.kp is None and res.error_bound is None  # integrator: no finite static gain
+
+
+def test_samples_lie_on_closed_form_dahl_branches():
+    """gamma = 1: between reversals s F/Fc = 1 - (1 - s F_i/Fc) exp(-s (x - x_i) sigma/Fc), (3.4)."""
+    system = stage()
+    res = controllers.simulate_loop(system, controllers.design_pd(system, wn=3000.0).c2d(TS), 1e-6, 0.01)
+    xs = np.concatenate(([0.0], res.reversals.x))
+    Fs = np.concatenate(([0.0], res.reversals.F))
+    ts = np.concatenate(([0.0], res.reversals.t))
+    assert len(res.reversals) >= 2
+    for k, (t, x, F) in enumerate(zip(res.t, res.x, res.F)):
+        i = np.searchsorted(ts, t, side="right") - 1
+        if i + 1 < len(ts):
+            s = np.sign(xs[i + 1] - xs[i])
+        else:
+            s = np.sign(x - xs[i]) or 1.0
+        f = 1.0 - (1.0 - s * Fs[i]) * np.exp(-s * (x - xs[i]) * SIGMA)
+        assert s * F == pytest.approx(f, abs=1e-7), k
+    lx, lF = res.friction_loop()
+    assert lx[0] == 0.0 and lF[0] == 0.0 and lx[-1] == res.x[-1]
+    np.testing.assert_allclose(lF[-1], res.F[-1], rtol=1e-6)
+
+
+def test_summary_is_readable():
+    system = stage()
+    res = controllers.simulate_loop(system, controllers.design_pd(system, wn=3000.0), 1e-6, 0.01)
+    text = res.summary()
+    for key in ("residual error", "Fc/kp", "velocity reversals", "settling time"):
+        assert key in text
+    assert f"{len(res.reversals)}" in text
+
+
+def test_argument_errors():
+    system = stage()
+    pd = controllers.pd(2e6, 2000.0)
+    with pytest.raises(ValueError, match=r"reference samples \(t, r\) must be 1-D arrays of equal length >= 2, "
+                                         r"got t with shape \(3,\) and r with shape \(2,\)"):
+        controllers.simulate_loop(system, pd, (np.array([0.0, 1.0, 2.0]), np.array([0.0, 1e-6])), 0.01)
+    with pytest.raises(ValueError, match="strictly increasing"):
+        controllers.simulate_loop(system, pd, (np.array([0.0, 0.0]), np.array([0.0, 1e-6])), 0.01)
+    with pytest.raises(ValueError, match=r"Ts must be finite and > 0, got 0.0"):
+        controllers.simulate_loop(system, pd, 1e-6, 0.01, Ts=0.0)
+    with pytest.raises(ValueError, match=r"Ts must be finite and > 0, got -0.0001"):
+        controllers.simulate_loop(system, pd, 1e-6, 0.01, Ts=-1e-4)
+    with pytest.raises(ValueError, match=r"t_end must be finite and > 0, got nan"):
+        controllers.simulate_loop(system, pd, 1e-6, float("nan"))
+    with pytest.raises(ValueError, match="differs from the discrete controller's sample time"):
+        controllers.simulate_loop(system, pd.c2d(1e-4), 1e-6, 0.01, Ts=2e-4)
+    with pytest.raises(ValueError, match="t_out is not allowed with a sampled controller"):
+        controllers.simulate_loop(system, pd.c2d(1e-4), 1e-6, 0.01, t_out=[0.0, 0.01])
+    with pytest.raises(ValueError, match="reference must be finite"):
+        controllers.simulate_loop(system, pd, float("inf"), 0.01)
+    with pytest.raises(TypeError, match=r"pass \(t, r\) with the sample times"):
+        controllers.simulate_loop(system, pd, [0.0, 1e-6], 0.01)
+    with pytest.raises(TypeError, match="unexpected keyword argument 'ts'"):
+        controllers.simulate_loop(system, pd, 1e-6, 0.01, ts=1e-4)
+    with pytest.raises(ValueError, match="unspecified sample time"):
+        controllers.simulate_loop(system, control.tf([1.0], [1.0, -0.5], True), 1e-6, 0.01)
+    with pytest.raises(NotImplementedError, match="u_max"):
+        controllers.simulate_loop(system, controllers.PID(kp=1e6, ki=1e8, u_max=5.0), 1e-6, 0.01, Ts=1e-4)
+
+
+def test_unstable_loop_warns_and_still_runs():
+    system = stage()
+    bad = controllers.PID(kp=1e5, ki=1e12).c2d(TS)
+    with pytest.warns(controllers.UnstableLoopWarning, match="poles"):
+        res = controllers.simulate_loop(system, bad, 1e-7, 20 * TS)
+    assert len(res.t) >= 19
+
+
+def test_continuous_controller_with_ts_is_discretised():
+    system = linear_stage()
+    pd = controllers.pd(2e6, 2000.0, tau=5e-5)
+    res = controllers.simulate_loop(system, pd, 1e-6, 0.005, Ts=TS, discretization="tustin")
+    ref = control.c2d(pid_tf(2e6, 0.0, 2000.0, 5e-5), TS, "tustin")
+    w = np.array([100.0, 5000.0])
+    np.testing.assert_allclose(np.squeeze(control.frequency_response(res.controller, w).complex),
+                               np.squeeze(control.frequency_response(ref, w).complex), rtol=1e-9)
+    assert res.Ts == TS
