@@ -25,6 +25,7 @@ from prefriction.simulate import SimulationResult
 
 from ._linear import _check_system, _sample_time, as_lti, closed_loop
 from ._pid import PID
+from ._saturated import simulate_saturated
 
 Reference = Union[float, Callable[[Any], Any], tuple]
 
@@ -61,8 +62,9 @@ class LoopResult:
     kp : float or None
         Static gain of the controller at ``s = 0`` (or ``z = 1``) if it is finite and
         positive (PD), ``None`` otherwise: then ``Fc / kp`` bounds the residual error.
-    simulation : prefriction.simulate.SimulationResult
-        The raw result of :func:`prefriction.simulate` (run statistics, work of the input).
+    simulation : prefriction.simulate.SimulationResult or None
+        The raw result of :func:`prefriction.simulate` (run statistics, work of the input);
+        ``None`` for a saturated (``u_max``) loop, which calls the simulator once per sample.
     """
 
     t: np.ndarray
@@ -78,7 +80,7 @@ class LoopResult:
     controller: control.StateSpace
     system: Oscillator
     kp: Optional[float]
-    simulation: SimulationResult
+    simulation: Optional[SimulationResult]
 
     @property
     def Fc(self) -> float:
@@ -241,7 +243,10 @@ def simulate_loop(
         SISO, proper controller from the error ``e = r - x`` [m] to the force ``u`` [N].
         Continuous (its states are integrated with the plant) or discrete with ``dt > 0``
         (sampled-data loop: ``u[k] = C xc[k] + D e[k]`` held constant over each sample
-        interval, zero-order hold), e.g. from ``control.c2d``.
+        interval, zero-order hold), e.g. from ``control.c2d``. A :class:`PID` with a force
+        limit ``u_max`` (sampled loops only) saturates the force and corrects its integrator
+        by back-calculation (see :mod:`controllers._saturated`); this path calls the
+        simulator once per sample and is several times slower.
     reference : float, callable or (t, r)
         Position reference [m]: a number (a step at ``t = 0``), a callable ``r(t)`` of time
         [s], or samples ``(t, r)`` of equal length (linear between samples, held constant
@@ -283,8 +288,8 @@ def simulate_loop(
         Wrong argument types, unknown keyword arguments, a reference callable that cannot be
         traced in a continuous loop.
     NotImplementedError
-        A :class:`PID` with a force limit ``u_max`` (anti-windup): not supported by the
-        simulator's linear feedback yet (see the package notes).
+        A :class:`PID` with a force limit ``u_max`` in a continuous loop (the simulator's
+        continuous feedback is linear; the force limit is simulated for sampled loops).
     prefriction.SolverError
         If the integration fails.
 
@@ -301,11 +306,7 @@ def simulate_loop(
         Ts = check_positive("Ts", Ts)
     if discretization not in DISCRETIZATIONS:
         raise ValueError(f"discretization must be one of {DISCRETIZATIONS}, got {discretization!r}")
-    if isinstance(controller, PID) and controller.u_max is not None:
-        raise NotImplementedError(
-            f"u_max={controller.u_max!r}: force saturation with anti-windup is not supported by "
-            "prefriction.simulate's linear feedback; use u_max=None (linear PID)"
-        )
+    saturated = isinstance(controller, PID) and controller.u_max is not None
     C = as_lti(controller)
     dt = _sample_time(C)
     if dt is not None:
@@ -315,6 +316,23 @@ def simulate_loop(
     elif Ts is not None:
         C = control.c2d(C, Ts, method=discretization)
     closed_loop(system, C, regime="presliding", warn=True)
+    if saturated:
+        if Ts is None:
+            raise NotImplementedError(
+                f"u_max={controller.u_max!r}: force saturation with anti-windup is simulated for sampled "
+                "controllers only (prefriction.simulate's continuous feedback is linear); give Ts"
+            )
+        if t_out is not None:
+            raise ValueError("t_out is not allowed with a sampled controller: its outputs are at the sample instants k Ts")
+        out = simulate_saturated(
+            system, C, controller.back_calculation_gain(), controller.u_max,
+            lambda t: _evaluate(reference, t), t_end, Ts, x0=x0, v0=v0, F0=F0, xc0=xc0, rtol=rtol, jit=jit,
+        )
+        return LoopResult(
+            t=out["t"], reference=out["reference"], x=out["x"], v=out["v"], F=out["F"], u=out["u"],
+            error=out["reference"] - out["x"], xc=out["xc"], reversals=out["reversals"], Ts=Ts, controller=C,
+            system=system, kp=None, simulation=None,
+        )
 
     fb_reference = reference
     if Ts is not None:

@@ -190,8 +190,11 @@ def test_argument_errors():
         controllers.simulate_loop(system, pd, 1e-6, 0.01, ts=1e-4)
     with pytest.raises(ValueError, match="unspecified sample time"):
         controllers.simulate_loop(system, control.tf([1.0], [1.0, -0.5], True), 1e-6, 0.01)
-    with pytest.raises(NotImplementedError, match="u_max"):
-        controllers.simulate_loop(system, controllers.PID(kp=1e6, ki=1e8, u_max=5.0), 1e-6, 0.01, Ts=1e-4)
+    with pytest.raises(NotImplementedError, match="u_max=5.0: force saturation .* sampled controllers only"):
+        controllers.simulate_loop(system, controllers.PID(kp=1e6, ki=1e8, u_max=5.0), 1e-6, 0.01)
+    forced = prefriction.Oscillator(system.friction, mass=M, u=lambda t: 0.1 * np.sin(t))
+    with pytest.raises(ValueError, match=r"u_max needs an oscillator without its own input force"):
+        controllers.simulate_loop(forced, controllers.PID(kp=1e6, ki=1e8, u_max=5.0), 1e-6, 0.01, Ts=TS)
 
 
 def test_unstable_loop_warns_and_still_runs():
@@ -211,3 +214,56 @@ def test_continuous_controller_with_ts_is_discretised():
     np.testing.assert_allclose(np.squeeze(control.frequency_response(res.controller, w).complex),
                                np.squeeze(control.frequency_response(ref, w).complex), rtol=1e-9)
     assert res.Ts == TS
+
+
+def _saturated_reference(kp, ki, kd, tau, t_track, u_max, r0, n):
+    """Independent sampled loop: exact ZOH plant 1/(m s^2 + sigma), PID with clip and back-calculation."""
+    Pz = control.c2d(control.ss([[0.0, 1.0], [-SIGMA / M, 0.0]], [[0.0], [1.0 / M]], [[1.0, 0.0]], [[0.0]]), TS)
+    Ad, Bd = np.asarray(Pz.A), np.asarray(Pz.B)[:, 0]
+    a = np.exp(-TS / tau)
+    z, I, xf, xs, us = np.zeros(2), 0.0, 0.0, [], []
+    for _ in range(n):
+        e = r0 - z[0]
+        v = kp * e + ki * I + kd / tau * (e - xf)
+        u = min(max(v, -u_max), u_max)
+        xs.append(z[0])
+        us.append(u)
+        I += TS * e + TS / (ki * t_track) * (u - v)
+        xf = a * xf + (1.0 - a) * e
+        z = Ad @ z + Bd * u
+    return np.array(xs), np.array(us)
+
+
+def test_saturated_pid_linear_regime_matches_independent_loop():
+    kp, ki, kd, tau, t_track, u_max, r0 = 1.1e6, 8e8, 2300.0, 1e-4, 2e-3, 2.0, 3e-6
+    c = controllers.PID(kp=kp, ki=ki, kd=kd, tau=tau, u_max=u_max, t_track=t_track)
+    res = controllers.simulate_loop(linear_stage(), c, r0, 0.01, Ts=TS)
+    x_ref, u_ref = _saturated_reference(kp, ki, kd, tau, t_track, u_max, r0, len(res.t))
+    assert np.max(np.abs(u_ref)) == u_max  # the force limit is active
+    assert rel_err(res.x, x_ref) <= 1e-6
+    assert rel_err(res.u, u_ref) <= 1e-6
+
+
+def test_saturated_path_without_saturation_equals_linear_path():
+    system = stage()
+    c = controllers.design_pid(system, wn=2 * np.pi * 150)
+    lin = controllers.simulate_loop(system, c, 2e-6, 0.02, Ts=TS)
+    big = controllers.simulate_loop(system, controllers.PID(kp=c.kp, ki=c.ki, kd=c.kd, tau=c.tau, u_max=1e9),
+                                    2e-6, 0.02, Ts=TS)
+    n = min(len(lin.t), len(big.t))
+    assert big.simulation is None and lin.simulation is not None
+    assert rel_err(big.x[:n], lin.x[:n]) <= 1e-8
+    assert len(big.reversals) == len(lin.reversals) >= 2
+    np.testing.assert_allclose(big.reversals.x, lin.reversals.x, rtol=1e-8)
+    np.testing.assert_allclose(big.reversals.E_d, lin.reversals.E_d, rtol=1e-6)
+
+
+def test_anti_windup_reduces_overshoot_with_dahl_friction():
+    system = stage()
+    c = controllers.design_pid(system, wn=2 * np.pi * 150, u_max=3.0)
+    r0 = 5e-6  # five pre-sliding ranges: gross sliding, the force limit is hit
+    aw = controllers.simulate_loop(system, c, r0, 0.03, Ts=TS)
+    no_aw = controllers.simulate_loop(system, controllers.PID(kp=c.kp, ki=c.ki, kd=c.kd, tau=c.tau, u_max=3.0,
+                                                              t_track=1e6), r0, 0.03, Ts=TS)
+    assert np.max(np.abs(aw.u)) == 3.0 and np.max(np.abs(no_aw.u)) == 3.0
+    assert np.max(aw.x) - r0 < 0.8 * (np.max(no_aw.x) - r0)
