@@ -70,6 +70,18 @@ def test_stage_pid_example(tmp_path):
         assert s["reversals"] >= 1 and len(s["reversal_x"]) == s["reversals"]
 
 
+def test_stage_antiwindup_example(tmp_path):
+    out = load("stage_antiwindup").main(tmp_path)
+    check_png(out["path"])
+    aw, clip = out["cases"]["anti-windup"], out["cases"]["clipping only"]
+    for c in (aw, clip):
+        assert c["peak_force"] == out["u_max"]  # the limit is reached and respected
+        assert abs(c["residual_error"]) <= 1e-2 * out["step"]  # integral action still removes the error
+    assert 0.0 < aw["overshoot"] < 0.8 * clip["overshoot"]
+    # default tracking time sqrt(Ti Td) (Astrom and Hagglund)
+    assert out["tracking_time"] == pytest.approx(np.sqrt(out["kp"] / out["ki"] * out["kd"] / out["kp"]), rel=1e-12)
+
+
 def loop_of(P, C):
     sj = control.summing_junction(inputs=["r", "-x"], output="e")
     return control.interconnect([P, control.ss(C, inputs="e", outputs="u"), sj], inplist=["r"], outlist=["x"])
