@@ -907,13 +907,28 @@ def analyze_table(table: ReversalTable, *, system: Oscillator) -> EnergyReport:
     Returns
     -------
     EnergyReport
+
+    Raises
+    ------
+    ValueError
+        Empty table, a non-finite entry, or times not strictly increasing.
+    TypeError
+        ``table`` is not a ReversalTable, or ``system`` not an Oscillator with a Dahl model.
     """
     friction, _ = _check_dahl(system)
     if not isinstance(table, ReversalTable):
         raise TypeError(f"table must be a prefriction.ReversalTable, got {table!r} of type {type(table).__name__}")
     if len(table) < 1:
         raise ValueError("table holds no reversal (length 0); need at least 1")
+    for name in ("t", "x", "F", "E_p", "E_d", "E_0"):
+        bad = ~np.isfinite(np.atleast_1d(np.asarray(getattr(table, name), dtype=float)))
+        if np.any(bad):
+            i = int(np.flatnonzero(bad)[0])
+            raise ValueError(f"table.{name} must be finite, got a non-finite entry at index {i} (reversal {i + 1})")
     t = np.asarray(table.t, dtype=float)
+    if np.any(np.diff(t) <= 0.0):
+        i = int(np.flatnonzero(np.diff(t) <= 0.0)[0])
+        raise ValueError(f"table.t must be strictly increasing, got t[{i + 1}] = {float(t[i + 1])!r} <= t[{i}] = {float(t[i])!r}")
     x = np.asarray(table.x, dtype=float)
     F = np.asarray(table.F, dtype=float)
     E_p = np.asarray(table.E_p, dtype=float)

@@ -481,5 +481,10 @@ def test_model_validation_messages():
         energy.analyze_samples(t, t, np.ones(4), np.zeros(4), system=Oscillator(d))
     with pytest.raises(ValueError, match="v is zero at every sample: nothing moves"):
         energy.total_energy(t, np.zeros(4), np.zeros(4), system=Oscillator(d))
+    one = dict(x=np.zeros(2), F=np.array([1.0, -0.5]), E_p=np.array([0.1, 0.05]), E_d=np.array([0.1, 0.05]), E_0=0.2)
+    with pytest.raises(ValueError, match=r"table.t must be finite, got a non-finite entry at index 1 \(reversal 2\)"):
+        energy.analyze_table(ReversalTable(t=np.array([1.0, np.inf]), **one), system=Oscillator(d))
+    with pytest.raises(ValueError, match=r"table.t must be strictly increasing, got t\[1\] = 1.0 <= t\[0\] = 1.0"):
+        energy.analyze_table(ReversalTable(t=np.array([1.0, 1.0]), **one), system=Oscillator(d))
     with pytest.raises(TypeError, match="table must be a prefriction.ReversalTable"):
         energy.analyze_table({"t": [1.0]}, system=Oscillator(d))
