@@ -15,7 +15,7 @@ Building blocks (model-free unless said otherwise):
 - :func:`dissipation` (2.10), :func:`series` (2.11), :func:`bound_check` (2.12);
 - :func:`analyze_samples`, :func:`analyze_table`: all of it at once, as an :class:`EnergyReport`.
 
-Conventions (see ``/work/plan.md``): reversal ``k`` ends half-cycle ``k - 1`` and starts
+Conventions (as in :class:`prefriction.ReversalTable`): reversal ``k`` ends half-cycle ``k - 1`` and starts
 half-cycle ``k``; ``E_p[k]`` is the potential energy at reversal ``k``, i.e. the energy the new
 branch returns as kinetic energy until its force zero crossing; ``E_d[k]`` (this module) is
 the energy dissipated in the half-cycle from reversal ``k`` to reversal ``k + 1``, which is the
@@ -285,6 +285,11 @@ def kinetic_energy(v: Any, *, mass: float) -> np.ndarray:
         Velocities [m/s].
     mass : float
         Moving mass [kg], ``0 < mass < inf``.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``E_k`` [J], same shape as ``v``.
     """
     m = check_positive("mass", mass)
     v = np.asarray(v, dtype=float)
@@ -477,6 +482,17 @@ def total_energy(t: Any, v: Any, F: Any, *, system: Oscillator) -> np.ndarray:
         Friction forces [N].
     system : Oscillator
         The oscillator (mass and Dahl friction model).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``E_k + E_branch`` at every sample [J]. For ``gamma >= 1`` it is infinite where a
+        sample has ``s F = Fc`` exactly (deep gross sliding rounds the force to ``Fc``).
+
+    Raises
+    ------
+    ValueError
+        Invalid arrays, ``|F| > Fc``, or ``v = 0`` at every sample (no direction).
     """
     friction, mass = _check_dahl(system)
     t, v, F = _samples(t=t, v=v, F=F)
