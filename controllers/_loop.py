@@ -65,6 +65,9 @@ class LoopResult:
     simulation : prefriction.simulate.SimulationResult or None
         The raw result of :func:`prefriction.simulate` (run statistics, work of the input);
         ``None`` for a saturated (``u_max``) loop, which calls the simulator once per sample.
+        A sampled loop that starts at rest with no net force (e.g. a delayed step) starts the
+        simulator at the first sample whose force moves the mass; the raw result's times are
+        then relative to that instant (the arrays above are not).
     """
 
     t: np.ndarray
@@ -347,10 +350,62 @@ def simulate_loop(
             dense = np.linspace(0.0, t_end, 2001)
         else:
             dense = np.asarray(t_out, dtype=float)
-    fb = LinearFeedback(A=C.A, B=C.B, C=C.C, D=C.D, Ts=Ts, reference=fb_reference, xc0=xc0)
-    sim = prefriction.simulate(system, v0, x0=x0, F0=F0, t_end=t_end, rtol=rtol, dense=dense, feedback=fb, jit=jit)
-    r = _evaluate(reference, sim.t)
+    rest = None
+    if Ts is not None and v0 == 0.0 and not system.forced:
+        rest = _rest_preroll(C, reference, x0=x0, F0=F0, xc0=xc0, Ts=Ts, t_end=t_end, Fc=system.friction.Fc)
+    if rest is None:
+        fb = LinearFeedback(A=C.A, B=C.B, C=C.C, D=C.D, Ts=Ts, reference=fb_reference, xc0=xc0)
+        sim = prefriction.simulate(system, v0, x0=x0, F0=F0, t_end=t_end, rtol=rtol, dense=dense, feedback=fb, jit=jit)
+        t, x, v, F, u, xc, table = sim.t, sim.x, sim.v, sim.F, sim.u, sim.xc, sim.reversals
+    else:  # the mass rests until sample k: start the simulator there (see _rest_preroll)
+        k, xc_k, xc_rest, u_rest = rest
+        tk = k * Ts
+        if isinstance(fb_reference, tuple):
+            fb_reference = (fb_reference[0] - tk, fb_reference[1])
+        fb = LinearFeedback(A=C.A, B=C.B, C=C.C, D=C.D, Ts=Ts, reference=fb_reference, xc0=xc_k)
+        sim = prefriction.simulate(system, 0.0, x0=x0, F0=F0, t_end=t_end - tk, rtol=rtol, feedback=fb, jit=jit)
+        t = np.concatenate((Ts * np.arange(k), sim.t + tk))
+        x = np.concatenate((np.full(k, float(x0)), sim.x))
+        v = np.concatenate((np.zeros(k), sim.v))
+        F = np.concatenate((np.full(k, float(F0)), sim.F))
+        u = np.concatenate((u_rest, sim.u))
+        xc = np.concatenate((xc_rest, sim.xc.reshape(len(sim.t), -1)))
+        R = sim.reversals
+        table = ReversalTable(t=R.t + tk, x=R.x, F=R.F, E_p=R.E_p, E_d=R.E_d, E_0=R.E_0)
+    r = _evaluate(reference, t)
     return LoopResult(
-        t=sim.t, reference=r, x=sim.x, v=sim.v, F=sim.F, u=sim.u, error=r - sim.x, xc=sim.xc,
-        reversals=sim.reversals, Ts=Ts, controller=C, system=system, kp=_dc_gain(C), simulation=sim,
+        t=t, reference=r, x=x, v=v, F=F, u=u, error=r - x, xc=xc,
+        reversals=table, Ts=Ts, controller=C, system=system, kp=_dc_gain(C), simulation=sim,
     )
+
+
+def _rest_preroll(
+    C: control.StateSpace, reference: Reference, *, x0: float, F0: float, xc0: Any, Ts: float, t_end: float, Fc: float
+) -> Optional[tuple[int, np.ndarray, np.ndarray, np.ndarray]]:
+    """Samples during which a sampled loop that starts at rest stays at rest.
+
+    With ``v0 = 0`` the mass does not move while the held force equals the friction force,
+    ``u[k] = F0`` (Dahl friction changes only with motion): the plant state is constant and the
+    controller runs on the constant position ``x0``. Returns ``(k, xc[k], xc[:k], u[:k])`` for
+    the first sample ``k >= 1`` whose force differs from ``F0``, or ``None`` if the mass moves
+    at once or never. The simulator then starts at ``t = k Ts`` from the same state; this keeps
+    a delayed step from rest exact whatever the simulator does with a mass at rest between
+    samples.
+    """
+    A, B, Cm, D = (np.asarray(M_, dtype=float) for M_ in (C.A, C.B, C.C, C.D))
+    n = A.shape[0]
+    xc = np.zeros(n) if xc0 is None else np.array(xc0, dtype=float).reshape(-1)
+    if xc.shape != (n,):
+        raise ValueError(f"xc0 must be a finite vector of length {n}, got {xc0!r}")
+    n_max = int(math.floor(t_end / Ts * (1 - 1e-12)))
+    r = _evaluate(reference, Ts * np.arange(n_max + 1))
+    xcs, us = [], []
+    for k in range(n_max + 1):
+        e = r[k] - x0
+        uk = float(Cm[0] @ xc + D[0, 0] * e)
+        if abs(uk - F0) > 1e-14 * Fc:
+            return None if k == 0 else (k, xc, np.array(xcs).reshape(k, n), np.array(us))
+        xcs.append(xc)
+        us.append(uk)
+        xc = A @ xc + B[:, 0] * e
+    return None

@@ -270,3 +270,27 @@ def test_anti_windup_reduces_overshoot_with_dahl_friction():
                                                               t_track=1e6), r0, 0.03, Ts=TS)
     assert np.max(np.abs(aw.u)) == 3.0 and np.max(np.abs(no_aw.u)) == 3.0
     assert np.max(aw.x) - r0 < 0.8 * (np.max(no_aw.x) - r0)
+
+
+def test_sampled_delayed_step_from_rest():
+    """The mass rests until the reference moves (r(0) = x0, no force), then follows the linear loop."""
+    system = linear_stage()
+    kp, ki, kd, tau = 1.1e6, 8e8, 2300.0, 1e-4
+    Cd = control.c2d(pid_tf(kp, ki, kd, tau), TS, "zoh")
+    samples = (np.array([0.0, 1.05e-3, 1.06e-3, 0.02]), np.array([0.0, 0.0, 1e-6, 1e-6]))  # first r > 0 at k = 11
+    res = controllers.simulate_loop(system, Cd, samples, 0.01)
+    Tz = control.feedback(control.c2d(plant_tf(), TS, "zoh") * Cd, 1)
+    r = np.interp(res.t, *samples)
+    assert r[0] == 0.0 and r[-1] == 1e-6
+    assert rel_err(res.x, control.forced_response(Tz, res.t, r).outputs) <= 1e-6
+    np.testing.assert_allclose(res.t, TS * np.arange(len(res.t)), rtol=0, atol=1e-15)
+    # nonlinear stage: the delayed step is the immediate step shifted by 11 samples
+    system = stage()
+    step = (np.array([0.0, 1.05e-3, 1.06e-3, 0.02]), np.array([0.0, 0.0, 1e-6, 1e-6]))
+    late = controllers.simulate_loop(system, Cd, step, 0.01)
+    now = controllers.simulate_loop(system, Cd, 1e-6, 0.0089)
+    assert np.all(late.x[:11] == 0.0) and late.x[12] > 0.0
+    n = min(len(now.t), len(late.t) - 11)
+    np.testing.assert_allclose(late.x[11:11 + n], now.x[:n], rtol=0, atol=1e-9 * 1e-6)
+    assert len(late.reversals) == len(now.reversals) >= 1
+    np.testing.assert_allclose(late.reversals.t, now.reversals.t + 11 * TS, rtol=1e-12)
