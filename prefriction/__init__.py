@@ -18,6 +18,7 @@ from .units import Scales
 from .simulate import SimulationResult, simulate
 from . import energy
 from . import dahl
+from .exact import exact_reversals
 
 __all__ = [
     "Dahl",
@@ -30,6 +31,7 @@ __all__ = [
     "SolverError",
     "dahl",
     "energy",
+    "exact_reversals",
     "simulate",
 ]
 __version__ = "0.1.0"
