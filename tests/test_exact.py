@@ -249,3 +249,33 @@ def test_system_errors():
         pf.exact_reversals(pf.Dahl(sigma=1e4, Fc=1.0), 0.1, 3)
     with pytest.raises(TypeError, match="unexpected keyword"):
         pf.exact_reversals(pf.Oscillator(pf.Dahl(1e4, 1.0)), 0.1, 3, F_0=0.1)
+
+
+def test_table_command_prints_the_default_case(capsys):
+    from prefriction.table import main
+
+    assert main([]) == 0
+    out = capsys.readouterr().out
+    # default: sigma = 1e4, Fc = 1, m = 1, v0 = 0.01 -> first excursion stores c = 0.5 Fc^2/sigma;
+    # first reversal force 1 - exp(-y), y = c + 1 + W0(-exp(-(1 + c))) (DESIGN.md section 2)
+    with mp.workdps(30):
+        y = mp.mpf("1.5") + mp.lambertw(-mp.exp(-mp.mpf("1.5")))
+        F1 = float(-mp.expm1(-y))
+    assert f"{F1:.7f}" in out
+    assert "t [s]" in out and "E_p [J]" in out
+    assert "Bound (2.12)" in out and "holds" in out
+    assert "0.5 Fc^2/sigma" in out
+    rows = [line for line in out.splitlines() if line.strip()[:2].strip().isdigit()]
+    assert len(rows) == 20
+
+
+def test_table_command_options_and_bad_input(capsys):
+    from prefriction.table import main
+
+    assert main(["--gamma", "0", "--v0", "0.05", "--n", "4", "--sigma", "1e6", "--Fc", "2"]) == 0
+    out = capsys.readouterr().out
+    assert "gamma = 0" in out and out.count(" -2 ") + out.count(" 2 ") >= 4
+    assert main(["--sigma", "-1"]) == 2
+    assert "sigma must be finite and > 0, got -1.0" in capsys.readouterr().out
+    assert main(["--v0", "0", "--F0", "0"]) == 2
+    assert "nothing moves" in capsys.readouterr().out
