@@ -136,6 +136,8 @@ def potential_ratio(f: np.ndarray, gamma: float) -> np.ndarray:
     low = f <= _F_SPLIT
     if gamma == 0.0:
         return np.full(f.shape, 0.5)
+    if gamma == 1.0:
+        return _ratio_gamma1(f)
     fl = f[low]
     if fl.size:
         t, wt = gauss_legendre_01(_nodes_for(gamma))
@@ -146,6 +148,22 @@ def potential_ratio(f: np.ndarray, gamma: float) -> np.ndarray:
         with np.errstate(over="ignore"):
             out[~low] = potential_of_log_gap(log_gap(fh), gamma) / (fh * fh)
     return out
+
+
+def _ratio_gamma1(f: np.ndarray) -> np.ndarray:
+    """``Q(f) = (-ln(1 - f) - f) / f^2 = sum_k f^k / (k + 2)`` (``gamma = 1``), series for ``|f| <= 1/2``.
+
+    Direct form above ``|f| = 1/2``, where the cancellation costs at most a factor 5.
+    """
+    small = np.abs(f) <= 0.5
+    fs = np.where(small, f, 0.0)
+    acc = np.zeros(f.shape)
+    for k in range(56, -1, -1):  # 0.5^57 / 59 < 1e-19
+        acc = acc * fs + 1.0 / (k + 2)
+    fl = np.where(small, 0.75, f)
+    with np.errstate(divide="ignore"):
+        direct = (-np.log1p(-fl) - fl) / (fl * fl)
+    return np.where(small, acc, direct)
 
 
 def branch_potential(f: np.ndarray, gamma: float) -> np.ndarray:
