@@ -19,6 +19,7 @@ import prefriction
 from prefriction._branch import force_after_distance
 from prefriction._feedback import LinearFeedback
 from prefriction._validation import check_finite, check_positive
+from prefriction.errors import SolverError
 from prefriction.models import Oscillator
 from prefriction.reversals import ReversalTable
 from prefriction.simulate import SimulationResult
@@ -357,6 +358,20 @@ def simulate_loop(
         fb = LinearFeedback(A=C.A, B=C.B, C=C.C, D=C.D, Ts=Ts, reference=fb_reference, xc0=xc0)
         sim = prefriction.simulate(system, v0, x0=x0, F0=F0, t_end=t_end, rtol=rtol, dense=dense, feedback=fb, jit=jit)
         t, x, v, F, u, xc, table = sim.t, sim.x, sim.v, sim.F, sim.u, sim.xc, sim.reversals
+        t_frozen = _frozen(sim, system.friction.Fc) if Ts is not None else None
+        if t_frozen is not None:
+            if system.forced:
+                raise SolverError(
+                    f"the sampled loop left the mass at rest under a net force at t = {t_frozen:.6g} s "
+                    "(a limitation of prefriction.simulate's sampled feedback); with an input force system.u "
+                    "controllers cannot re-run it per sample: use a continuous controller"
+                )
+            out = simulate_saturated(
+                system, C, np.zeros(C.nstates), math.inf, lambda tt: _evaluate(reference, tt), t_end, Ts,
+                x0=x0, v0=v0, F0=F0, xc0=xc0, rtol=rtol, jit=jit,
+            )
+            t, x, v, F, u, xc, table = (out[key] for key in ("t", "x", "v", "F", "u", "xc", "reversals"))
+            sim = None
     else:  # the mass rests until sample k: start the simulator there (see _rest_preroll)
         k, xc_k, xc_rest, u_rest = rest
         tk = k * Ts
@@ -377,6 +392,19 @@ def simulate_loop(
         t=t, reference=r, x=x, v=v, F=F, u=u, error=r - x, xc=xc,
         reversals=table, Ts=Ts, controller=C, system=system, kp=_dc_gain(C), simulation=sim,
     )
+
+
+def _frozen(sim: SimulationResult, Fc: float) -> Optional[float]:
+    """Time [s] of the first sample interval in which a resting mass stays put under a net force, or None.
+
+    Dahl friction has no stiction: a mass at rest with ``u != F`` moves at once. Samples with
+    ``v = 0`` at both ends, the same position, and ``|u - F| > 1e-9 Fc`` held in between mean
+    the simulator kept a stale rest state.
+    """
+    v, x, u, F = sim.v, sim.x, sim.u, sim.F
+    bad = (v[:-1] == 0.0) & (v[1:] == 0.0) & (x[1:] == x[:-1]) & (np.abs(u[:-1] - F[:-1]) > 1e-9 * Fc)
+    idx = np.nonzero(bad)[0]
+    return float(sim.t[idx[0]]) if idx.size else None
 
 
 def _rest_preroll(

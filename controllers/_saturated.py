@@ -12,7 +12,11 @@ and integrates the plant over ``[t_k, t_k + Ts]`` with :func:`prefriction.simula
 input force, every reversal inside the interval located). ``k_aw`` is
 :meth:`controllers.PID.back_calculation_gain`. The reversal table is assembled across the
 intervals; the work of the piecewise-constant force is exact (``u[k]`` times the displacement).
-One simulator call per sample costs about 1 ms, several times the linear path.
+A mass that rests at a sample instant and is pushed back the way it came makes a reversal at
+that instant, recorded as such. One simulator call per sample costs about 1 ms, several times
+the linear path. With ``u_max = inf`` and ``k_aw = 0`` this is the plain linear sampled loop,
+which :func:`controllers.simulate_loop` falls back to when the fast path leaves a resting mass
+frozen under a changed force (a limitation of the simulator's sampled feedback).
 """
 
 from __future__ import annotations
@@ -24,6 +28,7 @@ import control
 import numpy as np
 
 import prefriction
+from prefriction._branch import branch_potential
 from prefriction.models import Oscillator
 from prefriction.reversals import ReversalTable
 
@@ -65,6 +70,8 @@ def simulate_saturated(
     x, v, F = float(x0), float(v0), float(F0)
     W = 0.0  # work of the applied force since the last reversal [J]
     E_0 = None
+    s_prev = 0.0  # direction of the last motion (0: none yet)
+    gamma, E_unit = system.friction.gamma, Fc * Fc / system.friction.sigma
     for k in range(n_int):
         e = r[k] - x
         raw = float(Cc[0] @ xc + D[0, 0] * e)
@@ -78,6 +85,18 @@ def simulate_saturated(
         sim = prefriction.simulate(plant, v, x0=x, F0=F, t_end=h, rtol=rtol, dense=times[1:], jit=jit)
         if E_0 is None:
             E_0 = sim.reversals.E_0
+        # first direction of motion in this interval (0: the mass stays put)
+        x_first = sim.reversals.x[0] if len(sim.reversals) else float(sim.x[-1])
+        d = 0.0 if x_first == x else math.copysign(1.0, x_first - x)
+        if v == 0.0 and s_prev != 0.0 and d == -s_prev:
+            # the mass rested at t_k and leaves backwards: a reversal at t_k
+            rev_t.append(tk[k])
+            rev_x.append(x)
+            rev_F.append(F)
+            f_new = np.clip(d * F / Fc, -1.0, 1.0)
+            rev_Ep.append(float(branch_potential(np.array([f_new]), gamma)[0]) * E_unit)
+            rev_W.append(W)
+            W = 0.0
         x_prev = x
         for tr, xr, Fr, Ep in zip(sim.reversals.t, sim.reversals.x, sim.reversals.F, sim.reversals.E_p):
             W += u * (xr - x_prev)
@@ -89,6 +108,10 @@ def simulate_saturated(
             W, x_prev = 0.0, xr
         x, v, F = float(sim.x[-1]), float(sim.v[-1]), float(np.clip(sim.F[-1], -Fc, Fc))
         W += u * (x - x_prev)
+        if v != 0.0:
+            s_prev = math.copysign(1.0, v)
+        elif x != x_prev:  # came to rest: direction of the motion since the last reversal
+            s_prev = math.copysign(1.0, x - x_prev)
     E_p = np.array(rev_Ep)
     E_d = np.empty(len(E_p))
     if len(E_p):

@@ -294,3 +294,23 @@ def test_sampled_delayed_step_from_rest():
     np.testing.assert_allclose(late.x[11:11 + n], now.x[:n], rtol=0, atol=1e-9 * 1e-6)
     assert len(late.reversals) == len(now.reversals) >= 1
     np.testing.assert_allclose(late.reversals.t, now.reversals.t + 11 * TS, rtol=1e-12)
+
+
+def test_sampled_loop_moves_a_resting_mass_again():
+    """A PD loop comes to exact rest; a later reference change must move the mass again.
+
+    Reference: the same loop started afresh from the resting state (position, friction force and
+    controller state at that sample), which leaves rest at once.
+    """
+    system = stage()
+    Cd = controllers.design_pd(system, wn=2 * np.pi * 300, zeta=0.5).c2d(TS)
+    ref = lambda t: 1e-6 if t < 0.04 else 0.0  # noqa: E731
+    res = controllers.simulate_loop(system, Cd, ref, 0.06)
+    k = 400  # t = 40 ms
+    assert res.t[k] == pytest.approx(0.04) and res.v[k] == 0.0  # at rest when the reference moves
+    assert res.x[k] - res.x[k + 5] > 5e-7
+    fresh = controllers.simulate_loop(system, Cd, 0.0, 0.02, x0=res.x[k], F0=res.F[k], xc0=res.xc[k])
+    n = min(len(fresh.t), len(res.t) - k)
+    np.testing.assert_allclose(res.x[k:k + n], fresh.x[:n], rtol=0, atol=1e-9 * 1e-6)
+    later = res.reversals.t > 0.04
+    np.testing.assert_allclose(res.reversals.t[later], fresh.reversals.t + 0.04, rtol=1e-9)
