@@ -6,7 +6,9 @@
 - on the exact reference trajectory (prefriction.exact_reversals): E_p strictly decreasing
   (gamma > 0), (2.10) and (2.11) to rounding, (2.12) after the first reversal, gamma = 0
   conserving energy after saturation, E_p equal to (3.9) for gamma = 1 (mpmath), and the
-  energy analysis of prefriction.energy agreeing with the table.
+  energy analysis of prefriction.energy agreeing with the table;
+- samples from prefriction.simulate, analysed by prefriction.energy.analyze_samples, agree with
+  the exact table and with the simulator's own integrated power (2.8) and input work.
 """
 
 from __future__ import annotations
@@ -16,12 +18,13 @@ import math
 import mpmath as mp
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 from scipy.integrate import quad
 from scipy.optimize import brentq
 
 from prefriction import Dahl, Oscillator, energy
+from prefriction.exact import exact_reversals
 
 EPS = np.finfo(float).eps
 FAST = settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
@@ -78,12 +81,16 @@ def test_clockwise_dahl_loop_area(gamma, A, sigma, Fc):
 
     a = 1.0 if mismatch(1.0) >= 0.0 else brentq(mismatch, 0.0, 1.0, xtol=1e-15, rtol=4 * EPS)
     xi = 2 * A * np.linspace(0.0, 1.0, 4001) ** 2  # dense where the branch bends most
+    saturation = {0.0: 1.0 + a, 0.5: 2.0 * math.sqrt(1.0 + a)}.get(gamma, math.inf)
+    if saturation < 2 * A:  # put the kink of gamma < 1 on a sample
+        xi = np.unique(np.append(xi, saturation))
     up = 1.0 - _gap_after(1.0 + a, xi, gamma)
     x = np.concatenate((xi - A, (A - xi)[1:])) * Fc / sigma
     F = np.concatenate((up, -up[1:])) * Fc
     E = energy.loop_integral(x, F, closure_tol=1e-9)
     # loop = 2 int_{-A}^{A} f_+ dx (2.5) by symmetry, here by adaptive quadrature
-    branch = quad(lambda q: 1.0 - float(_gap_after(1.0 + a, np.array(q), gamma)), 0.0, 2 * A, limit=200)[0]
+    kinks = [saturation] if saturation < 2 * A else None
+    branch = quad(lambda q: 1.0 - float(_gap_after(1.0 + a, np.array(q), gamma)), 0.0, 2 * A, limit=200, points=kinks)[0]
     ref = 2 * branch * Fc**2 / sigma
     if gamma == 0.0 and A <= 1.0:
         assert abs(E) <= 1e-12 * Fc**2 / sigma * A  # elastic: the linear spring of (2.6)
@@ -109,7 +116,157 @@ def test_reversal_potential_never_exceeds_bound_2_12(gamma, a, sigma, Fc):
     bc = energy.bound_check(E, friction=d)
     assert bc.holds and bc.holds_sharp
     assert bc.ratio <= 1.0 + 1e-15
-    assert (bc.ratio < 1.0) or (gamma == 0.0 and a == 1.0)
+    # strict (2.12) except at full saturation when 1/2 - H_gamma(-1) ~ gamma/3 is below rounding
+    assert (bc.ratio < 1.0) or (a == 1.0 and gamma < 1e-14)
     # the sharp bound H_gamma(-1) = int_0^1 u (1 + u)^-gamma du, by quadrature
     H1 = quad(lambda u: u * (1 + u) ** -gamma, 0.0, 1.0, epsabs=0, epsrel=1e-13)[0]
     assert bc.bound_sharp == pytest.approx(H1 * Fc**2 / sigma, rel=1e-12)
+
+
+# --------------------------------------------------------------------------- exact reference trajectory
+
+
+@st.composite
+def unforced_cases(draw, gammas=None):
+    """A Dahl oscillator and initial state over the ranges of issue #2, in SI units."""
+    gamma = draw(gammas if gammas is not None else st.one_of(st.just(1.0), st.just(0.0), st.floats(0.0, 5.0)))
+    Fc = draw(log_uniform(1e-3, 1e3))
+    sigma = Fc * draw(log_uniform(1e-2, 1e10))
+    mass = draw(log_uniform(1e-6, 1e3))
+    f0 = draw(st.one_of(st.just(0.0), st.floats(-0.999, 0.999)))
+    c0 = draw(log_uniform(1e-20, 1e6))  # normalised initial kinetic energy sigma m v0^2 / (2 Fc^2)
+    sign = draw(st.sampled_from([-1.0, 1.0]))
+    v0 = sign * math.sqrt(2.0 * c0) * Fc / math.sqrt(mass * sigma)
+    return Oscillator(Dahl(sigma, Fc, gamma), mass=mass), v0, f0 * Fc
+
+
+N_REV = 8
+
+
+def _table(case):
+    system, v0, F0 = case
+    return system, exact_reversals(system, v0, N_REV, F0=F0)
+
+
+@FAST
+@given(case=unforced_cases())
+# start on the unloading side with a force far below Fc (|F0|/Fc < 1e-154: its square underflows)
+@example(case=(Oscillator(Dahl(1.0, 1.0, 1.0)), -1.4142135623730951, 1e-200))
+def test_exact_table_energy_invariants(case):
+    system, table = _table(case)
+    d = system.friction
+    unit = d.Fc**2 / d.sigma
+    E_p, E_d, E_0 = np.asarray(table.E_p), np.asarray(table.E_d), float(table.E_0)
+    assert len(table) == N_REV and np.all(np.isfinite(E_p)) and np.all(E_p >= 0.0)
+    for name in ("t", "x", "F", "E_d"):
+        assert np.all(np.isfinite(getattr(table, name))), f"table.{name} = {getattr(table, name)}"
+    a = np.abs(np.asarray(table.F)) / d.Fc
+    assert np.all(a <= 1.0)
+    # unforced: every reversal lies on the loading side, so the force alternates in sign
+    assert np.all(np.sign(table.F[1:]) == -np.sign(table.F[:-1]))
+    assert np.all(np.diff(table.t) > 0.0)
+    # (2.10): E_p(i) = E_d(i) + E_p(i+1), to rounding; and E_d[0] = E_0 - E_p[0]
+    np.testing.assert_array_less(np.abs(E_p[:-1] - E_d[1:] - E_p[1:]), 16 * EPS * E_p[:-1] + 1e-300)
+    assert abs(E_0 - E_d[0] - E_p[0]) <= 16 * EPS * E_0
+    assert np.all(E_d >= -16 * EPS * np.concatenate(([E_0], E_p[:-1])))
+    # E_p strictly decreasing where the decrement (about 2 gamma a E_p) is above rounding
+    drop = E_p[:-1] - E_p[1:]
+    resolvable = d.gamma * a[:-1] > 1e-12
+    assert np.all(drop[resolvable] > 0.0)
+    assert np.all(drop >= -16 * EPS * E_p[:-1])
+    # (2.11): the truncated series leaves exactly the last E_p, to rounding
+    S, R = energy.series(E_p, E_d[1:])
+    np.testing.assert_array_less(np.abs(R - E_p[-1]), 16 * N_REV * EPS * E_p + 1e-300)
+    # (2.12) at every reversal, including the first one after a gross-sliding start
+    assert np.all(E_p <= 0.5 * unit * (1 + 4 * EPS))
+    H1 = quad(lambda u: u * (1 + u) ** -d.gamma, 0.0, 1.0, epsabs=0, epsrel=1e-13)[0]
+    assert np.all(E_p <= H1 * unit * (1 + 1e-12))
+
+
+@FAST
+@given(case=unforced_cases())
+def test_energy_analysis_of_exact_table(case):
+    system, table = _table(case)
+    rep = energy.analyze_table(table, system=system)
+    d = system.friction
+    # independent recomputation of E_p from the tabulated forces (branch potential)
+    assert rep.E_p_check_max_rel_dev < 1e-12
+    assert rep.residual_2_10 < 32 * EPS
+    assert rep.bound.holds and rep.bound.holds_sharp
+    assert rep.bound.initial_ratio == pytest.approx(table.E_0 / (0.5 * d.Fc**2 / d.sigma), rel=1e-15)
+    if d.gamma > 0 and rep.bound.initial_ratio > 1.0:
+        # gross sliding start: reported, the first reversal is still bounded
+        assert rep.bound.max_E_p < rep.bound.E_0
+    np.testing.assert_array_equal(rep.direction, -np.sign(table.F))
+    assert len(rep.format().splitlines()) > N_REV
+
+
+@FAST
+@given(case=unforced_cases(gammas=st.just(1.0)))
+def test_exact_E_p_is_3_9_for_gamma1(case):
+    system, table = _table(case)
+    d = system.friction
+    with mp.workdps(40):
+        ref = [
+            float(d.Fc**2 / d.sigma * (mp.mpf(a) - mp.log1p(mp.mpf(a))))
+            for a in np.abs(np.asarray(table.F)) / d.Fc
+        ]
+    np.testing.assert_allclose(table.E_p, ref, rtol=1e-12, atol=0)
+
+
+@FAST
+@given(case=unforced_cases(gammas=st.just(0.0)))
+def test_prandtl_conserves_energy_after_saturation(case):
+    system, table = _table(case)
+    d = system.friction
+    unit = d.Fc**2 / d.sigma
+    E_0 = float(table.E_0)
+    # elastic below saturation, so every reversal keeps min(E_0, Fc^2 / (2 sigma)): the
+    # equality case of (2.12) once the first excursion saturates
+    expected = min(E_0, 0.5 * unit)
+    np.testing.assert_allclose(table.E_p, expected, rtol=1e-13, atol=0)
+    np.testing.assert_allclose(table.E_d[1:], 0.0, atol=1e-13 * expected)
+    if E_0 > 0.5 * unit * (1 + 1e-12):
+        np.testing.assert_allclose(np.abs(table.F), d.Fc, rtol=1e-14)
+        bc = energy.bound_check(table.E_p, friction=d, E_0=E_0)
+        assert bc.ratio == pytest.approx(1.0, rel=1e-13) and bc.holds
+
+
+# --------------------------------------------------------------------------- simulated samples
+
+
+def test_sampled_analysis_of_simulation_agrees_with_exact_table():
+    # prefriction.simulate (CasADi) samples, analysed model-free and with the Dahl potential,
+    # against the exact reversal table: (2.8)-(2.12) on a trajectory nobody tabulated.
+    from prefriction.simulate import simulate
+
+    system = Oscillator(Dahl(1e4, 2.0, 1.0), mass=0.5)
+    sim = simulate(system, 0.3, reversals=6, rtol=1e-10, dense=np.linspace(0.0, 0.2, 20001), jit=False)
+    table = exact_reversals(system, 0.3, 6)
+    rep = energy.analyze_samples(sim.t, sim.x, sim.v, sim.F, system=system)
+    n = len(rep)
+    assert n >= 5
+    np.testing.assert_allclose(rep.t, table.t[:n], rtol=1e-9)
+    np.testing.assert_allclose(rep.E_p, table.E_p[:n], rtol=1e-9)
+    np.testing.assert_allclose(rep.E_d, table.E_d[1:n], rtol=1e-8)
+    assert rep.E_0 == pytest.approx(table.E_0, rel=1e-14)
+    assert rep.E_p_check_max_rel_dev < 1e-8  # peak kinetic energy = E_p (note after (3.9))
+    assert rep.E_p_decreasing and rep.bound.holds and rep.bound.holds_sharp
+    # (2.8): the simulator's integrated power against ours
+    E_f = energy.integrated_power(sim.t, sim.v, sim.F, method="simpson")
+    np.testing.assert_allclose(E_f, sim.E_f, atol=1e-9 * float(np.max(np.abs(sim.E_f))))
+
+
+def test_sampled_analysis_of_forced_simulation_counts_input_work():
+    from prefriction.simulate import simulate
+
+    U = 0.6
+    system = Oscillator(Dahl(1e4, 2.0, 1.0), mass=0.5, u=lambda t: U + 0 * t)
+    sim = simulate(system, 0.3, reversals=6, t_end=0.2, rtol=1e-10, dense=np.linspace(0.0, 0.2, 20001), jit=False)
+    rep = energy.analyze_samples(sim.t, sim.x, sim.v, sim.F, system=system, method="simpson")
+    n = len(rep)
+    assert n >= 4
+    # the simulator's table: E_d[k] = E_p[k-1] + W_u[k] - E_p[k], with its own input work
+    np.testing.assert_allclose(rep.E_p, sim.reversals.E_p[:n], rtol=1e-9)
+    np.testing.assert_allclose(rep.E_d, sim.reversals.E_d[1:n], rtol=1e-6)
+    assert rep.E_p_check is None
