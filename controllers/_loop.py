@@ -295,7 +295,9 @@ def simulate_loop(
         A :class:`PID` with a force limit ``u_max`` in a continuous loop (the simulator's
         continuous feedback is linear; the force limit is simulated for sampled loops).
     prefriction.SolverError
-        If the integration fails.
+        If the integration fails, or a continuous loop leaves a resting mass frozen under a
+        force that jumps at a reference sample time (a limitation of the simulator; a sampled
+        loop in that situation is re-run per sample instead, exactly).
 
     Warns
     -----
@@ -358,7 +360,13 @@ def simulate_loop(
         fb = LinearFeedback(A=C.A, B=C.B, C=C.C, D=C.D, Ts=Ts, reference=fb_reference, xc0=xc0)
         sim = prefriction.simulate(system, v0, x0=x0, F0=F0, t_end=t_end, rtol=rtol, dense=dense, feedback=fb, jit=jit)
         t, x, v, F, u, xc, table = sim.t, sim.x, sim.v, sim.F, sim.u, sim.xc, sim.reversals
-        t_frozen = _frozen(sim, system.friction.Fc) if Ts is not None else None
+        t_frozen = _frozen(sim, system.friction.Fc, sampled=Ts is not None)
+        if t_frozen is not None and Ts is None:
+            raise SolverError(
+                f"the mass rests from t = {t_frozen:.6g} s on although the net force u - F is not zero: "
+                "prefriction.simulate does not end a rest when the force jumps at a reference sample "
+                "time. Use a reference without jumps (a smooth callable), or a sampled controller (Ts)"
+            )
         if t_frozen is not None:
             if system.forced:
                 raise SolverError(
@@ -394,15 +402,17 @@ def simulate_loop(
     )
 
 
-def _frozen(sim: SimulationResult, Fc: float) -> Optional[float]:
-    """Time [s] of the first sample interval in which a resting mass stays put under a net force, or None.
+def _frozen(sim: SimulationResult, Fc: float, *, sampled: bool) -> Optional[float]:
+    """Time [s] of the first output interval in which a resting mass stays put under a net force, or None.
 
     Dahl friction has no stiction: a mass at rest with ``u != F`` moves at once. Samples with
-    ``v = 0`` at both ends, the same position, and ``|u - F| > 1e-9 Fc`` held in between mean
-    the simulator kept a stale rest state.
+    ``v = 0`` at both ends, the same position, and ``|u - F| > 1e-9 Fc`` (the force held over a
+    sample interval, or the force at the interval's end in a continuous loop) mean the
+    simulator kept a stale rest state.
     """
     v, x, u, F = sim.v, sim.x, sim.u, sim.F
-    bad = (v[:-1] == 0.0) & (v[1:] == 0.0) & (x[1:] == x[:-1]) & (np.abs(u[:-1] - F[:-1]) > 1e-9 * Fc)
+    net = np.abs(u[:-1] - F[:-1]) if sampled else np.abs(u[1:] - F[1:])
+    bad = (v[:-1] == 0.0) & (v[1:] == 0.0) & (x[1:] == x[:-1]) & (net > 1e-9 * Fc)
     idx = np.nonzero(bad)[0]
     return float(sim.t[idx[0]]) if idx.size else None
 

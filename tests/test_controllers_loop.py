@@ -314,3 +314,16 @@ def test_sampled_loop_moves_a_resting_mass_again():
     np.testing.assert_allclose(res.x[k:k + n], fresh.x[:n], rtol=0, atol=1e-9 * 1e-6)
     later = res.reversals.t > 0.04
     np.testing.assert_allclose(res.reversals.t[later], fresh.reversals.t + 0.04, rtol=1e-9)
+
+
+def test_continuous_loop_never_returns_a_frozen_mass():
+    """A jump of a sampled reference while the mass rests: moved correctly, or a SolverError; never frozen."""
+    system = stage()
+    pd = controllers.design_pd(system, wn=2 * np.pi * 300, zeta=0.5)
+    ref = (np.array([0.0, 0.04, 0.04 + 1e-6, 1.0]), np.array([1e-6, 1e-6, 0.0, 0.0]))
+    try:
+        res = controllers.simulate_loop(system, pd, ref, 0.06, t_out=np.linspace(0.0, 0.06, 601))
+    except prefriction.SolverError as exc:
+        assert "rests from t = " in str(exc) and "smooth callable" in str(exc)
+    else:
+        assert res.x[400] - res.x[420] > 5e-7
