@@ -1,9 +1,18 @@
 """controllers: PD/PID positioning loops around the pre-sliding friction stage.
 
-Controllers are python-control LTI objects (or a :class:`PID` description that produces one);
-the loop is simulated by :func:`simulate_loop` with the reversal-aware plant of
-:func:`prefriction.simulate`. :func:`plant_iosys` gives the same plant as a
-``control.NonlinearIOSystem`` for python-control's own tools (less accurate, see its notes).
+- Controllers are python-control LTI objects from the error ``e = r - x`` [m] to the force
+  ``u`` [N]: :class:`PID` (with :func:`pd`, :func:`pid`) gives ``kp + ki/s + kd s/(tau s + 1)``
+  as ``.ss()``, ``.tf()`` or ``.c2d(Ts)``; :func:`design_pd` and :func:`design_pid` place the
+  poles on the pre-sliding linearisation ``1/(m s^2 + sigma)`` or the sliding one ``1/(m s^2)``;
+  :func:`margins` reports ``control.stability_margins``; :func:`closed_loop` is the linear loop
+  (warns with its poles if unstable).
+- :func:`simulate_loop` runs any SISO proper controller, continuous or sampled (ZOH), around
+  the reversal-aware plant of :func:`prefriction.simulate`; a :class:`PID` with a force limit
+  ``u_max`` adds back-calculation anti-windup (sampled loops). Returns a :class:`LoopResult`.
+- :func:`plant_iosys` is the same stage as a ``control.NonlinearIOSystem`` for
+  ``control.interconnect``; it does not locate reversals (see its notes and
+  ``python -m controllers.benchmark`` for the measured shortfall and run times).
+- :mod:`controllers.plotting` draws step responses (``examples/stage_*.py``).
 """
 
 from __future__ import annotations
