@@ -43,9 +43,10 @@ from .units import Scales
 
 __all__ = ["exact_reversals"]
 
-_N = 32  # Gauss-Legendre order of every rule below (outer and inner)
+_N = 32  # Gauss-Legendre order of the panel rules (first half-cycle)
+_N_REG = 24  # order of the vectorised half-cycle rules (integrands analytic on ellipses rho >= 3)
 _F_REGULAR = 0.75  # half-cycles ending below this force use the vectorised rule
-_CHUNK = 2048  # half-cycles per vectorised block (memory: _CHUNK * _N * _N doubles)
+_CHUNK = 2048  # half-cycles per vectorised block (memory: _CHUNK * _N_REG^2 doubles)
 
 
 def exact_reversals(system: Oscillator, v0: float, n: int, *, x0: float = 0.0, F0: float = 0.0) -> ReversalTable:
@@ -268,7 +269,13 @@ def _map_series(gamma: float, terms: int = 48) -> tuple[tuple[float, ...], float
 
 
 def _powg(w: np.ndarray, gamma: float) -> np.ndarray:
-    """``w^-gamma`` for ``w > 0``."""
+    """``w^-gamma`` for ``w > 0`` (cheap forms for gamma = 1/2, 1, 2)."""
+    if gamma == 1.0:
+        return 1.0 / w
+    if gamma == 2.0:
+        return 1.0 / (w * w)
+    if gamma == 0.5:
+        return 1.0 / np.sqrt(w)
     return np.exp(-gamma * np.log(w))
 
 
@@ -280,8 +287,8 @@ def _time_unloading_from_rest(a: np.ndarray, gamma: float) -> np.ndarray:
     ``T = int_0^1 2 du / ((1 + a (1 - u^2))^gamma sqrt(2 kappa(u^2)))``: smooth integrands,
     positive terms only (``pi / 2`` as ``a -> 0``).
     """
-    u, wu = gauss_legendre_01(_N)
-    tau, wt = gauss_legendre_01(_N)
+    u, wu = gauss_legendre_01(_N_REG)
+    tau, wt = gauss_legendre_01(_N_REG)
     s = u * u
     A = a[:, None, None]
     st = s[None, :, None] * tau[None, None, :]
@@ -297,8 +304,8 @@ def _time_loading_to_rest(b: np.ndarray, gamma: float) -> np.ndarray:
     ``kappa(s) = int_0^1 (1 - s tau)(1 - b + b s tau)^-gamma dtau`` and
     ``T = int_0^1 2 du / ((1 - b + b u^2)^gamma sqrt(2 kappa(u^2)))``.
     """
-    u, wu = gauss_legendre_01(_N)
-    tau, wt = gauss_legendre_01(_N)
+    u, wu = gauss_legendre_01(_N_REG)
+    tau, wt = gauss_legendre_01(_N_REG)
     s = u * u
     B = b[:, None, None]
     st = s[None, :, None] * tau[None, None, :]
