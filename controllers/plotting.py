@@ -78,7 +78,8 @@ def plot_steps(
         ax.semilogy(t_ms, np.where(err > 0, err, np.nan) * k, lw=1, label="|e| = |r - x|")
         level = res.error_bound if bound is None else bound
         if level is not None:
-            ax.axhline(level * k, color="C3", ls="--", label=f"Fc/kp = {level * k:.3g} {unit}")
+            note = "" if res.error_bound is not None else " (PD bound, for comparison)"
+            ax.axhline(level * k, color="C3", ls="--", label=f"Fc/kp = {level * k:.3g} {unit}{note}")
         ax.set(xlabel="time t [ms]", ylabel=f"|error| [{unit}]", title=f"{label}: error")
         ax.legend(loc="best")
         for a in row:
