@@ -122,6 +122,12 @@ def exact_reversals(system: Oscillator, v0: float, n: int, *, x0: float = 0.0, F
             "v0 = 0 and F0 = 0: the oscillator is at rest at its equilibrium and nothing moves "
             "(allowed: v0 != 0 or F0 != 0)"
         )
+    if gamma >= 1.0 and v0 != 0.0 and F0 == math.copysign(Fc, v0):
+        raise ValueError(
+            f"F0 = {F0!r} N equals Fc in the direction of v0 = {v0!r} m/s: for gamma = {gamma!r} >= 1 the "
+            "Dahl force reaches Fc only asymptotically, so this state stores infinite branch energy "
+            "(allowed: |F0| < Fc, or F0 opposing v0)"
+        )
     sc = Scales.of(system)
     if 0.5 * (v0 / sc.v) ** 2 + (F0 / Fc) ** 2 == 0.0:
         raise ValueError(
@@ -321,6 +327,8 @@ def _time_loading_to_rest(b: np.ndarray, gamma: float) -> np.ndarray:
 
 def _first_segment(f0: float, KE0: float, gamma: float) -> tuple[float, float, float]:
     """Duration, distance and end force of the half-cycle from force ``f0`` with kinetic energy ``KE0``."""
+    if f0 == 1.0:  # saturated (gamma < 1): Coulomb slide at unit deceleration
+        return math.sqrt(2.0 * KE0), KE0, 1.0
     t = 0.0
     d = 0.0
     if f0 < 0.0:
@@ -381,8 +389,10 @@ def _time_unloading(a: float, K_s: float, gamma: float) -> float:
     st = s[:, None] * tau[None, :]
     kappa = ((1.0 - st) * _powg(1.0 + a * (1.0 - st), gamma)) @ wt
     w = 1.0 + a * (1.0 - s)
-    # 2 a u / sqrt(2 (K_s + a^2 u^2 kappa)) = 2 u / sqrt(2 (K_s / a^2 + u^2 kappa))
-    return float(np.sum(wu * 2.0 * u * _powg(w, gamma) / np.sqrt(2.0 * (K_s / (a * a) + s * kappa))))
+    if K_s == 0.0:  # from rest: 2 a u / sqrt(2 a^2 u^2 kappa) = 2 / sqrt(2 kappa)
+        return float(np.sum(wu * 2.0 * _powg(w, gamma) / np.sqrt(2.0 * kappa)))
+    au = a * u
+    return float(np.sum(wu * 2.0 * au * _powg(w, gamma) / np.sqrt(2.0 * (K_s + au * au * kappa))))
 
 
 def _stored(L: np.ndarray, D: np.ndarray, gamma: float) -> np.ndarray:

@@ -14,6 +14,8 @@ import time
 import mpmath as mp
 import numpy as np
 import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
 
 import prefriction as pf
 from prefriction import Scales
@@ -182,6 +184,16 @@ def test_extreme_first_excursions(g, c):
     assert table.E_0 == pytest.approx(c * Fc**2 / sigma, rel=1e-15)
 
 
+@pytest.mark.parametrize("g", [0.0, 0.5])
+def test_start_in_coulomb_sliding_below_gamma_one(g):
+    # F0 = Fc along v0: saturated; the first half-cycle is a slide at deceleration Fc/m
+    system = pf.Oscillator(pf.Dahl(sigma=50.0, Fc=2.0, gamma=g), mass=3.0)
+    table = pf.exact_reversals(system, 0.4, 2, F0=2.0)
+    assert table.t[0] == pytest.approx(0.4 * 3.0 / 2.0, rel=1e-15)
+    assert table.x[0] == pytest.approx(0.5 * 3.0 * 0.4**2 / 2.0, rel=1e-15)
+    assert table.F[0] == 2.0
+
+
 def test_prandtl_stop_conserves_energy_after_saturation():
     system = pf.Oscillator(pf.Dahl(sigma=1e4, Fc=1.0, gamma=0.0), mass=1.0)
     table = pf.exact_reversals(system, 0.05, 1000)
@@ -229,6 +241,8 @@ def test_ten_thousand_reversals_fast(g):
         (dict(v0=0.1, F0=float("-inf")), ValueError, r"F0 must be finite, got -inf"),
         (dict(v0="fast"), TypeError, r"v0 must be a real number"),
         (dict(v0=0.1, n=2.0), TypeError, r"n must be an integer"),
+        (dict(v0=-0.1, F0=-1.0), ValueError, r"F0 = -1.0 N equals Fc in the direction of v0.*infinite"),
+        (dict(v0=0.0, F0=1e-320), ValueError, r"initial energy below the double-precision range"),
     ],
 )
 def test_argument_errors(kwargs, exc, match):
@@ -279,3 +293,31 @@ def test_table_command_options_and_bad_input(capsys):
     assert "sigma must be finite and > 0, got -1.0" in capsys.readouterr().out
     assert main(["--v0", "0", "--F0", "0"]) == 2
     assert "nothing moves" in capsys.readouterr().out
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    g=st.sampled_from([0.0, 0.3, 1.0, 2.0, 5.0]),
+    log_c=st.floats(min_value=-20, max_value=6),
+    f0=st.floats(min_value=-1.0, max_value=1.0),
+    log_sigma=st.floats(min_value=-2, max_value=10),
+    log_m=st.floats(min_value=-6, max_value=3),
+    Fc=st.floats(min_value=1e-3, max_value=1e3),
+)
+def test_normalised_table_is_independent_of_sigma_fc_and_mass(g, log_c, f0, log_sigma, log_m, Fc):
+    """(2.1) with (3.2) in the units x Fc/sigma, t sqrt(m/sigma) is parameter-free (DESIGN.md 2)."""
+    assume(not (g >= 1.0 and f0 == 1.0))  # infinite branch energy: rejected, tested above
+    unit = pf.Oscillator(pf.Dahl(sigma=1.0, Fc=1.0, gamma=g), mass=1.0)
+    other = pf.Oscillator(pf.Dahl(sigma=10.0**log_sigma, Fc=Fc, gamma=g), mass=10.0**log_m)
+    sc = Scales.of(other)
+    v = math.sqrt(2.0 * 10.0**log_c)
+    a = pf.exact_reversals(unit, v, 6, F0=f0)
+    b = pf.exact_reversals(other, v * sc.v, 6, F0=f0 * Fc)
+    assert np.allclose(b.t / sc.t, a.t, rtol=1e-14, atol=0)
+    assert np.allclose(b.x / sc.x, a.x, rtol=1e-14, atol=1e-14 * np.max(np.abs(a.x)))
+    assert np.allclose(b.F / Fc, a.F, rtol=1e-14, atol=0)
+    assert np.allclose(b.E_p / sc.E, a.E_p, rtol=1e-14, atol=0)
+    # reversal invariants: alternating forces within [-Fc, Fc], increasing times, E_p not increasing
+    assert np.all(np.abs(a.F) <= 1.0) and np.all(np.diff(a.t) > 0)
+    assert np.all(a.F[:-1] * a.F[1:] < 0)
+    assert np.all(np.diff(a.E_p) <= 0) and np.all(a.E_d >= 0)
