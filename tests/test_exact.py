@@ -82,21 +82,28 @@ def mp_half_cycle(f_s, K_s, g, L_guess):
             f_e = mp.mpf(1)
             slide = S
         else:
-            L_e = mp.findroot(lambda L: mp_H_of_L(L, g) - E, mp.mpf(L_guess))
+            hi = mp.mpf(L_guess) if L_guess > 0 else mp.mpf(1)
+            while mp_H_of_L(hi, g) < E:  # bracket the root independently of the guess
+                hi *= 2
+            lo = hi / 2
+            while mp_H_of_L(lo, g) > E:
+                lo, hi = lo / 2, lo
+            L_e = mp.findroot(lambda L: mp_H_of_L(L, g) - E, (lo, hi), solver="anderson")
             assert abs(mp_H_of_L(L_e, g) - E) <= mp.mpf(10) ** (-DPS - 5) * (1 + E)
             f_e = -mp.expm1(-L_e)
             slide = mp.mpf(0)
 
         if L_e == mp.inf:
 
-            # variable: the gap w = 1 - f, exact near saturation w = 0; dxi = w^-g dw
-            def load(w):
+            # variable: the distance z before saturation, w = ((1 - g) z)^(1/(1 - g)) (smooth in z)
+            def load(z):
                 with mp.workdps(DPS + GUARD):
-                    return w ** (-g) / mp.sqrt(2 * (E - mp_H_of_f(1 - w, g)))
+                    w = ((1 - g) * z) ** (1 / (1 - g))
+                    return 1 / mp.sqrt(2 * (E - mp_H_of_f(1 - w, g)))
 
-            w_a = mp.exp(-L_a)
+            z_a = mp.exp(-(1 - g) * L_a) / (1 - g)
             with mp.workdps(DPS):
-                t += mp.quad(load, [0, w_a / 2, w_a])
+                t += mp.quad(load, [0, z_a / 2, z_a])
         else:
             # variable: delta = L_e - L, exact near the singular end
             def load(delta):
