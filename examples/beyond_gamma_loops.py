@@ -61,7 +61,7 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
     axes[0, 0].plot([], [], "ko", ms=3, label="reversals")
     axes[0, 0].plot([], [], ":", color="0.6", label=r"$\pm F_c$")
     axes[0, 0].legend(loc="lower right", fontsize=8)
-    fig.suptitle(rf"Force-displacement loops of the oscillator (2.1), Dahl model (3.2), shape factor $\gamma$")
+    fig.suptitle(r"Force-displacement loops of the oscillator (2.1), Dahl model (3.2), shape factor $\gamma$")
     add_note(fig, f"m = {MASS:g} kg, sigma = {SIGMA:g} N/m, Fc = {FC:g} N, x(0) = 0, F(0) = 0, v(0) = {V0:g} m/s; "
                   f"{n_rev} reversals each (simulated).")
     png = save(fig, outdir, "beyond_gamma_loops.png")

@@ -116,7 +116,6 @@ def _captions(r: dict) -> dict[str, tuple[str, str]]:
         + (f"Maximum at a = 1: {f3['E_p_max'][1.0]:.6f} J for sigma/Fc = 1, i.e. "
            f"{f3['E_p_max'][1.0] * 1.0 / f3['Fc'] ** 2:.6f} Fc^2/sigma (paper: 0.3069)." if f3 else ""),
     )
-    f4 = get("fig4_omega")
     out["fig4_omega"] = (
         "Figure 4: Omega (3.10) and its linear approximation Omega* (3.11)",
         "Omega = exp(-sigma x/Fc) (black dashed) and Omega* = 1 - K x for F_i = -Fc x {0.2, ..., 1} "
