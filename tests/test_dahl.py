@@ -148,7 +148,8 @@ def test_paper_approximation_erratum_and_errors() -> None:
     assert err[3] == pytest.approx(5 / 6 - 1, abs=1e-5)
     # the corrected form is dimensionally consistent: scaling sigma, Fc scales x by Fc/sigma
     x1 = dahl.next_reversal_position_paper(-0.5 * 2.0, 300.0, 2.0)
-    assert x1 == pytest.approx(float(y_paper[0] * 0 + dahl.next_reversal_position_paper(-0.5, 1.0, 1.0)) * 2.0 / 300.0)
+    y_half = dahl.next_reversal_position_paper(-0.5, 1.0, 1.0)
+    assert x1 == pytest.approx(float(y_half) * 2.0 / 300.0, rel=1e-15)
     # printed (3.13) agrees with the corrected form only for sigma / Fc = 1
     assert dahl.next_reversal_position_paper(-0.5, 7.0, 7.0, printed=True) == pytest.approx(
         dahl.next_reversal_position_paper(-0.5, 7.0, 7.0), rel=1e-15
