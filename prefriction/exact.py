@@ -150,6 +150,9 @@ def exact_reversals(system: Oscillator, v0: float, n: int, *, x0: float = 0.0, F
     Ed = np.empty(n)
     Ed[0] = E0 - Ep[0]
     Ed[1:] = Ep[:-1] - Ep[1:]
+    if gamma == 0.0:
+        # the stop dissipates only while sliding: exactly v1^2 / 2 = E0 - 1/2 in the first half-cycle
+        Ed[0] = max(E0 - 0.5, 0.0)
     return ReversalTable(
         t=_cumsum(t) * sc.t, x=x, F=F, E_p=Ep * sc.E, E_d=Ed * sc.E, E_0=float(E0 * sc.E)
     )
