@@ -6,24 +6,28 @@ Time inside one call is ``tau`` in ``[0, n_out]``; the control ``dur`` of each o
 (one unit of ``tau``) is its duration in normalised time, so one compiled Function serves any
 output grid.
 
-State vector (indices in :class:`Layout`):
+State vector (indices in :class:`Layout`), kept short because the cost of a step grows with it:
 
 ``xh, vh, Fh``
-    ``x~ = xref + Ax xh``, ``v~ = Av vh``, ``F~ = AF Fh``;
-``tt``
-    normalised absolute time ``t~``;
-``s, n, frozen, sat, rest``
-    branch direction (+-1), reversals so far, stop flag (set when ``n`` reaches ``nstop``), the
-    saturation flag (``|F| = Fc``, ``F' = 0``; reached at finite distance when gamma < 1) and the
-    rest flag (``v = 0`` and ``u = F``; only with an input force);
-``Wh``
-    input work since the last reversal, ``W~ = AE Wh`` (forced systems only);
+    ``x~ = xref + Ax xh``, ``v~ = Av vh``, ``F~ = AF Fh`` (for gamma < 1 the force state is
+    ``p``, see :class:`PlantSpec`);
+``s, n``
+    branch direction (+-1) and reversals so far; the call stops (right-hand side zero) once
+    ``n`` reaches the parameter ``nstop``;
+``sat``
+    saturation flag (gamma < 1 only): ``|F| = Fc``, ``F' = 0`` until the next reversal;
+``rest, Wh``
+    (forced systems only) rest flag (``v = 0`` and ``u = F``) and the input work since the last
+    reversal, ``W~ = AE Wh``;
 ``Eh``
     work of the friction force since t = 0, ``E_f~ = Efref + AE Eh`` (dense output only), (2.8);
 ``xch``
     continuous controller states, ``xc = S * xch``;
 register
-    the newest ``K`` reversals, newest first: ``(t~, x~, F~, W~)`` each.
+    the newest ``K`` reversals, newest first: ``(t~, x~, F~[, W~])`` each.
+
+Normalised time is ``t~ = t0 + dur * tau`` with the integrator time ``tau`` and the controls
+``t0``, ``dur`` of the output interval.
 
 Events (the integrator fires when an indicator goes from positive to negative):
 
@@ -95,9 +99,11 @@ class Layout:
     """Index map of the state, parameter and control vectors for a :class:`PlantSpec`."""
 
     def __init__(self, spec: PlantSpec) -> None:
-        names = ["xh", "vh", "Fh", "tt", "s", "n", "frozen", "sat", "rest"]
+        names = ["xh", "vh", "Fh", "s", "n"]
+        if spec.pform:
+            names.append("sat")
         if spec.forced:
-            names.append("Wh")
+            names += ["rest", "Wh"]
         if spec.energy:
             names.append("Eh")
         self.state = {k: i for i, k in enumerate(names)}
@@ -117,7 +123,7 @@ class Layout:
         self.p_D = self.p_C + n
         self.p_S = self.p_D + (1 if spec.fb == "continuous" else 0)
         self.np = self.p_S + n
-        cnames = ["dur"]
+        cnames = ["dur", "t0"]
         if spec.u_kind == "samples" or spec.r_kind == "samples":
             cnames.append("tl")
         if spec.u_kind == "samples":
@@ -183,6 +189,7 @@ def build_integrator(spec: PlantSpec, tol: float, atol: float) -> ca.Function:
     X = ca.SX.sym("X", L.nx)
     P = ca.SX.sym("P", L.np)
     U = ca.SX.sym("U", L.nu)
+    tau = ca.SX.sym("tau")
     st = {k: X[i] for k, i in L.state.items()}
     p = {k: P[i] for k, i in L.param.items()}
     c = {k: U[i] for k, i in L.control.items()}
@@ -191,12 +198,15 @@ def build_integrator(spec: PlantSpec, tol: float, atol: float) -> ca.Function:
     v = p["Av"] * st["vh"]
     s = st["s"]
     g = spec.gamma
+    sat = st["sat"] if spec.pform else 0.0
+    rest = st["rest"] if spec.forced else 0.0
     if spec.pform:
         pp = p["AF"] * st["Fh"]
         F = -s * ca.expm1(ca.log1p(-ca.fmin(pp, 1.0 - 1e-16)) / (1.0 - g))  # finite derivatives at p = 1
     else:
         F = p["AF"] * st["Fh"]
-    t_si = st["tt"] * p["tunit"]
+    t_n = c["t0"] + c["dur"] * tau  # normalised time
+    t_si = t_n * p["tunit"]
     u = _signal(spec.u_kind, spec.u_fun, t_si, c, "u", p) / p["Fc"]
     xc = ca.SX(0, 1)
     if spec.fb != "none":
@@ -212,18 +222,13 @@ def build_integrator(spec: PlantSpec, tol: float, atol: float) -> ca.Function:
         else:
             u = u + c["uhold"] / p["Fc"]
     acc = u - F
-    run = 1.0 - st["frozen"]
-    run_m = run * (1.0 - st["rest"])
+    run = ca.if_else(st["n"] < p["nstop"], 1.0, 0.0)  # stop after the nstop-th reversal
+    run_m = run * (1.0 - rest) if spec.forced else run
     if spec.pform:
-        dF = (1.0 - g) * s * v * (1.0 - st["sat"])  # dp/dt
+        dF = (1.0 - g) * s * v * (1.0 - sat)  # dp/dt
     else:
         dF = v * _power(ca.fmax(1.0 - s * F, 0.0), g)
-    dot = {
-        "xh": run_m * v / p["Ax"],
-        "vh": run_m * acc / p["Av"],
-        "Fh": run_m * dF / p["AF"],
-        "tt": run,
-    }
+    dot = {"xh": run_m * v / p["Ax"], "vh": run_m * acc / p["Av"], "Fh": run_m * dF / p["AF"]}
     if spec.forced:
         dot["Wh"] = run_m * u * v / p["AE"]
     if spec.energy:
@@ -234,19 +239,18 @@ def build_integrator(spec: PlantSpec, tol: float, atol: float) -> ca.Function:
     if spec.fb == "continuous" and n:
         ode[L.xc] = run * (ca.mtimes(A, xc) + B * e) / S
     ode = c["dur"] * ode
-    zero = ca.vertcat(
-        ca.if_else(run_m > 0.5, s * st["vh"], 1.0),
-        ca.if_else(run_m * (1.0 - st["sat"]) > 0.5, 1.0 - pp, 1.0) if spec.pform else 1.0,
-        ca.if_else(run * st["rest"] > 0.5, EPS_REST - ca.fabs(acc), 1.0),
-    )
-    dae = {"x": X, "p": P, "u": U, "ode": ode, "zero": zero}
+    zero = [ca.if_else(run_m > 0.5, s * st["vh"], 1.0)]
+    if spec.pform:
+        zero.append(ca.if_else(run_m * (1.0 - sat) > 0.5, 1.0 - pp, 1.0))
+    if spec.forced:
+        zero.append(ca.if_else(run * rest > 0.5, EPS_REST - ca.fabs(acc), 1.0))
+    dae = {"x": X, "p": P, "u": U, "t": tau, "ode": ode, "zero": ca.vertcat(*zero)}
 
     # transition: the state just after an event
     idx = ca.SX.sym("index")
-    t_ev = ca.SX.sym("t")
     reg = X[L.reg:]
     W = p["AE"] * st["Wh"] if spec.forced else None
-    entry = [st["tt"], x, F] + ([W] if spec.forced else [])
+    entry = [t_n, x, F] + ([W] if spec.forced else [])
     shifted = ca.vertcat(*entry, reg[: -L.reg_width])
 
     def with_(changes: dict, base: ca.SX = X) -> ca.SX:
@@ -271,26 +275,30 @@ def build_integrator(spec: PlantSpec, tol: float, atol: float) -> ca.Function:
         return -ca.expm1((1.0 - g) * ca.log1p(-new_s * Fs)) / p["AF"]
 
     def reversal(new_s: Any, extra: dict) -> ca.SX:
-        n1 = st["n"] + 1
-        ch = {"reg": shifted, "n": n1, "s": new_s, "sat": 0.0, "Fh": force_state(new_s),
-              "frozen": ca.if_else(n1 >= p["nstop"], 1.0, 0.0)}
+        ch = {"reg": shifted, "n": st["n"] + 1, "s": new_s, "Fh": force_state(new_s)}
+        if spec.pform:
+            ch["sat"] = 0.0
         if spec.forced:
             ch["Wh"] = 0.0
         ch.update(extra)
         return with_(ch)
 
     sa = s * acc
-    on_zero_v = ca.if_else(
-        sa < -EPS_TOUCH,
-        reversal(-s, {}),
-        ca.if_else(sa > EPS_TOUCH, X, with_({"rest": 1.0, "vh": 0.0})),
-    )
-    on_saturation = with_({"sat": 1.0, "Fh": 1.0 / p["AF"]})
-    new_dir = ca.if_else(acc > 0, 1.0, -1.0)
-    on_move = ca.if_else(new_dir != s, reversal(new_dir, {"rest": 0.0}), with_({"rest": 0.0}))
-    post = ca.if_else(idx == 0, on_zero_v, ca.if_else(idx == 1, on_saturation, on_move))
+    if spec.forced:  # zero velocity: reversal, touch (velocity keeps its sign) or rest
+        posts = [ca.if_else(sa < -EPS_TOUCH, reversal(-s, {}),
+                            ca.if_else(sa > EPS_TOUCH, X, with_({"rest": 1.0, "vh": 0.0})))]
+    else:
+        posts = [reversal(-s, {})]
+    if spec.pform:
+        posts.append(with_({"sat": 1.0, "Fh": 1.0 / p["AF"]}))
+    if spec.forced:
+        new_dir = ca.if_else(acc > 0, 1.0, -1.0)
+        posts.append(ca.if_else(new_dir != s, reversal(new_dir, {"rest": 0.0}), with_({"rest": 0.0})))
+    post = posts[-1]
+    for k in range(len(posts) - 2, -1, -1):
+        post = ca.if_else(idx == k, posts[k], post)
     trans = ca.Function(
-        "transition", [idx, t_ev, X, ca.SX(0, 1), P, U], [post, ca.SX(0, 1)],
+        "transition", [idx, tau, X, ca.SX(0, 1), P, U], [post, ca.SX(0, 1)],
         ca.event_in(), ca.event_out(),
     )
     opts = {
