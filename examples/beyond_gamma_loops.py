@@ -42,7 +42,9 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
     runs: dict[float, dict] = {}
     for ax, color, gamma in zip(axes[0], COLORS, GAMMAS):
         system = Oscillator(Dahl(sigma=SIGMA, Fc=FC, gamma=gamma), mass=MASS)
-        res = simulate(system, V0, reversals=n_rev, dense=True)
+        t_rev = simulate(system, V0, reversals=n_rev).reversals.t
+        grid = np.union1d(np.linspace(0.0, t_rev[-1], 600 if quick else 3000), t_rev)
+        res = simulate(system, V0, reversals=n_rev, dense=grid)
         rev = res.reversals
         runs[gamma] = {
             "t": res.t, "x": res.x, "F": res.F, "v": res.v, "t_rev": np.asarray(rev.t),

@@ -54,8 +54,8 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
     """
     system = Oscillator(Dahl(sigma=SIGMA, Fc=FC), mass=MASS)
     rev = simulate(system, V0, reversals=N_REVERSALS).reversals
-    grid = np.linspace(0.0, rev.t[-1], 800 if quick else 4000)
-    res = simulate(system, V0, t_end=rev.t[-1], dense=grid)
+    grid = np.union1d(np.linspace(0.0, rev.t[-1], 800 if quick else 4000), rev.t)
+    res = simulate(system, V0, reversals=N_REVERSALS, dense=grid)
     t, x, F, E_f = res.t, res.x, res.F, res.E_f
     t_i, t_next = rev.t[0], rev.t[1]
     sel = (t >= t_i) & (t <= t_next)
@@ -80,7 +80,7 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
     xs = np.linspace(x.min(), x.max(), 200)
     ax.plot(xs, np.clip(SIGMA * (xs - x_0), -FC, FC), ":", color="0.45", lw=1.5,
             label=r"linear spring $\sigma(x - x_0)$, clipped at $\pm F_c$")
-    labels = ((rev.x[0], rev.F[0], "$x_i$", (8, -4)), (rev.x[1], rev.F[1], "$x_{i+1}$", (-34, 4)),
+    labels = ((rev.x[0], rev.F[0], "$x_i$", (8, -4)), (rev.x[1], rev.F[1], "$x_{i+1}$", (-24, -20)),
               (x_0, 0.0, "$x_0$", (6, -14)))
     for xx, ff, name, offset in labels:
         ax.plot(xx, ff, "ko", ms=5)
