@@ -44,6 +44,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, Callable
 
+import math
+
 import casadi as ca
 import numpy as np
 
@@ -59,16 +61,12 @@ EPS_REST = 1e-12
 class PlantSpec:
     """Structure of the integrated model (everything that changes the generated code).
 
-    ``pform``: for gamma < 1 the force state is ``p = 1 - (1 - s F~)^(1 - gamma)`` instead of
-    ``F~``: ``p`` grows linearly with the distance travelled (``p' = (1 - gamma) s v~``), so the
-    right-hand side stays smooth up to saturation (``p = 1``), which is an event with a
-    transversal crossing, and ``F~ = s (1 - (1 - p)^(1 / (1 - gamma)))`` keeps full relative
-    accuracy for small forces.
-
-    ``u_kind`` / ``r_kind``: ``"none"``, ``"callable"`` (traced into the model), ``"samples"``
-    (piecewise linear, one segment per output interval, passed as controls) or, for ``r_kind``,
-    ``"const"``. ``fb``: ``"none"``, ``"continuous"`` (``n_c`` controller states in the model)
-    or ``"sampled"`` (held force passed as a control).
+    The force state is the distance coordinate ``p`` of the branch, ``dp/dt = s v~``:
+    ``p = -ln(1 - f)`` for gamma = 1, ``p = (1 - (1 - f)^(1 - gamma)) / (1 - gamma)`` otherwise,
+    with ``f = s F~`` (:func:`force_of_p`). The right-hand side is then linear in the state
+    except for the smooth map ``f(p)``: no stiff decay of the gap ``1 - f`` in gross sliding,
+    full relative accuracy for small forces (``p ~ f``), and for gamma < 1 saturation is the
+    transversal crossing ``p = 1 / (1 - gamma)``.
     """
 
     u_kind: str = "none"
@@ -84,8 +82,8 @@ class PlantSpec:
     gamma: float = 1.0
 
     @property
-    def pform(self) -> bool:
-        """True if the force state is ``p`` (gamma < 1), see the class docstring."""
+    def saturates(self) -> bool:
+        """True if the branch reaches ``|F| = Fc`` at a finite distance (gamma < 1)."""
         return self.gamma < 1.0
 
 
@@ -100,7 +98,7 @@ class Layout:
 
     def __init__(self, spec: PlantSpec) -> None:
         names = ["xh", "vh", "Fh", "s", "n"]
-        if spec.pform:
+        if spec.saturates:
             names.append("sat")
         if spec.forced:
             names += ["rest", "Wh"]
@@ -147,14 +145,42 @@ def _signal(kind: str, fun: Callable[[Any], Any] | None, t_si: ca.SX, c: dict, p
     return 0.0
 
 
-def _power(w: ca.SX, g: float) -> ca.SX:
-    """``w ** g`` for ``w >= 0``: products for small integer ``g`` (fast, exact derivatives)."""
-    if float(g).is_integer() and 0 <= g <= 8:
-        out = ca.SX(1.0)
-        for _ in range(int(g)):
-            out = out * w
-        return out
-    return ca.fmax(w, 1e-300) ** g  # w > 0: the derivative of pow stays finite
+def force_of_p(p: Any, g: float) -> Any:
+    """Normalised branch force ``f = s F / Fc`` at the distance coordinate ``p`` (CasADi or float).
+
+    Inverse of :func:`p_of_force`. Symbolically, past saturation ``p = 1 / (1 - gamma)`` (before
+    the saturation event stops the force) ``f`` continues smoothly so that the step across it
+    stays accurate: analytically where ``1 / (1 - gamma)`` is an integer (gamma = 0, 1/2, 2/3,
+    ...), otherwise as ``f = 1`` (continuous in the derivatives of order < 1 / (1 - gamma)).
+    """
+    if g == 1.0:
+        return -ca.expm1(-p) if isinstance(p, ca.SX) else -math.expm1(-p)
+    if isinstance(p, ca.SX):
+        m = 1.0 / (1.0 - g)
+        if g > 1.0:
+            return -ca.expm1(ca.log1p(-(1.0 - g) * p) * m)
+        q = ca.fmin((1.0 - g) * p, 1.0 - 1e-16)
+        f = -ca.expm1(ca.log1p(-q) * m)  # accurate for small p
+        if m.is_integer():  # past saturation: the polynomial 1 - (1 - (1 - g) p)^m continues it
+            return ca.if_else((1.0 - g) * p < 1.0, f, 1.0 - (1.0 - (1.0 - g) * p) ** int(m))
+        return f
+    q = (1.0 - g) * p
+    if q >= 1.0:
+        return 1.0
+    return -math.expm1(math.log1p(-q) / (1.0 - g))
+
+
+def p_of_force(f: Any, g: float) -> Any:
+    """Distance coordinate ``p`` of the branch force ``f = s F / Fc`` (``-ln(1 - f)`` for gamma = 1)."""
+    if isinstance(f, ca.SX):
+        if g == 1.0:
+            return -ca.log1p(-f)
+        return -ca.expm1((1.0 - g) * ca.log1p(-f)) / (1.0 - g)
+    if f >= 1.0:
+        return 1.0 / (1.0 - g) if g < 1.0 else math.inf
+    if g == 1.0:
+        return -math.log1p(-f)
+    return -math.expm1((1.0 - g) * math.log1p(-f)) / (1.0 - g)
 
 
 def trace_signal(fun: Callable[[Any], Any], what: str) -> ca.SX:
@@ -198,13 +224,10 @@ def build_integrator(spec: PlantSpec, tol: float, atol: float) -> ca.Function:
     v = p["Av"] * st["vh"]
     s = st["s"]
     g = spec.gamma
-    sat = st["sat"] if spec.pform else 0.0
+    sat = st["sat"] if spec.saturates else 0.0
     rest = st["rest"] if spec.forced else 0.0
-    if spec.pform:
-        pp = p["AF"] * st["Fh"]
-        F = -s * ca.expm1(ca.log1p(-ca.fmin(pp, 1.0 - 1e-16)) / (1.0 - g))  # finite derivatives at p = 1
-    else:
-        F = p["AF"] * st["Fh"]
+    pp = p["AF"] * st["Fh"]
+    F = s * force_of_p(pp, g)
     t_n = c["t0"] + c["dur"] * tau  # normalised time
     t_si = t_n * p["tunit"]
     u = _signal(spec.u_kind, spec.u_fun, t_si, c, "u", p) / p["Fc"]
@@ -224,10 +247,7 @@ def build_integrator(spec: PlantSpec, tol: float, atol: float) -> ca.Function:
     acc = u - F
     run = ca.if_else(st["n"] < p["nstop"], 1.0, 0.0)  # stop after the nstop-th reversal
     run_m = run * (1.0 - rest) if spec.forced else run
-    if spec.pform:
-        dF = (1.0 - g) * s * v * (1.0 - sat)  # dp/dt
-    else:
-        dF = v * _power(ca.fmax(1.0 - s * F, 0.0), g)
+    dF = s * v * (1.0 - sat)  # dp/dt
     dot = {"xh": run_m * v / p["Ax"], "vh": run_m * acc / p["Av"], "Fh": run_m * dF / p["AF"]}
     if spec.forced:
         dot["Wh"] = run_m * u * v / p["AE"]
@@ -240,8 +260,8 @@ def build_integrator(spec: PlantSpec, tol: float, atol: float) -> ca.Function:
         ode[L.xc] = run * (ca.mtimes(A, xc) + B * e) / S
     ode = c["dur"] * ode
     zero = [ca.if_else(run_m > 0.5, s * st["vh"], 1.0)]
-    if spec.pform:
-        zero.append(ca.if_else(run_m * (1.0 - sat) > 0.5, 1.0 - pp, 1.0))
+    if spec.saturates:
+        zero.append(ca.if_else(run_m * (1.0 - sat) > 0.5, 1.0 - (1.0 - g) * pp, 1.0))
     if spec.forced:
         zero.append(ca.if_else(run * rest > 0.5, EPS_REST - ca.fabs(acc), 1.0))
     dae = {"x": X, "p": P, "u": U, "t": tau, "ode": ode, "zero": ca.vertcat(*zero)}
@@ -269,14 +289,12 @@ def build_integrator(spec: PlantSpec, tol: float, atol: float) -> ca.Function:
         saturation: the two events coincide to the tolerance (gamma = 0 reaches both at once
         in its undamped oscillation; resolving their order by round-off would bleed energy).
         """
-        if not spec.pform:
-            return st["Fh"]
-        Fs = ca.if_else(1.0 - pp < p["snap"], s, F)
-        return -ca.expm1((1.0 - g) * ca.log1p(-new_s * Fs)) / p["AF"]
+        Fs = ca.if_else(1.0 - (1.0 - g) * pp < p["snap"], s, F) if spec.saturates else F
+        return p_of_force(new_s * Fs, g) / p["AF"]
 
     def reversal(new_s: Any, extra: dict) -> ca.SX:
         ch = {"reg": shifted, "n": st["n"] + 1, "s": new_s, "Fh": force_state(new_s)}
-        if spec.pform:
+        if spec.saturates:
             ch["sat"] = 0.0
         if spec.forced:
             ch["Wh"] = 0.0
@@ -289,8 +307,8 @@ def build_integrator(spec: PlantSpec, tol: float, atol: float) -> ca.Function:
                             ca.if_else(sa > EPS_TOUCH, X, with_({"rest": 1.0, "vh": 0.0})))]
     else:
         posts = [reversal(-s, {})]
-    if spec.pform:
-        posts.append(with_({"sat": 1.0, "Fh": 1.0 / p["AF"]}))
+    if spec.saturates:
+        posts.append(with_({"sat": 1.0, "Fh": 1.0 / ((1.0 - g) * p["AF"])}))
     if spec.forced:
         new_dir = ca.if_else(acc > 0, 1.0, -1.0)
         posts.append(ca.if_else(new_dir != s, reversal(new_dir, {"rest": 0.0}), with_({"rest": 0.0})))
@@ -304,6 +322,9 @@ def build_integrator(spec: PlantSpec, tol: float, atol: float) -> ca.Function:
     opts = {
         "transition": trans,
         "max_events": spec.n_out * (4 * spec.K + 16),
+        # events to round-off (defaults 1e-6 and 3 are far too loose: tau spans a whole call)
+        "event_tol": 1e-15,
+        "max_event_iter": 40,
         "reltol": tol,
         "abstol": atol,
         "max_num_steps": 200000,

@@ -151,7 +151,7 @@ def _locate(t: np.ndarray, x: Callable, v: np.ndarray, F: Callable, vfun: Callab
         if vfun is None:
             tr = t[i] - v[i] * (t[i + 1] - t[i]) / (v[i + 1] - v[i])
         else:
-            tr = brentq(vfun, t[i], t[i + 1], xtol=1e-15, rtol=4e-16)
+            tr = brentq(vfun, t[i], t[i + 1], xtol=1e-15, rtol=1e-15)
         out.append((tr, x(tr), F(tr)))
     return np.array(out).reshape(-1, 3)
 

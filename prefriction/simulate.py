@@ -24,7 +24,7 @@ import numpy as np
 from ._branch import branch_potential
 from ._feedback import LinearFeedback
 from ._jit import compiled
-from ._plant import Layout, PlantSpec, build_integrator, trace_signal
+from ._plant import Layout, PlantSpec, build_integrator, force_of_p, p_of_force, trace_signal
 from ._validation import check_count, check_finite, check_positive
 from .errors import SolverError
 from .models import Dahl, Oscillator
@@ -264,7 +264,7 @@ class _Run:
         st, ix = self.st, L.state
         X = np.zeros(L.nx)
         X[ix["vh"]] = st["v"] / a["Av"]
-        X[ix["Fh"]] = self._force_state(st["F"], st["s"]) / a["AF"]
+        X[ix["Fh"]] = st["p"] / a["AF"]
         X[ix["s"]] = st["s"]
         X[ix["n"]] = len(self.rev)
         if "sat" in ix:
@@ -284,7 +284,8 @@ class _Run:
         out = {
             "x": a["xref"] + a["Ax"] * col[ix["xh"]],
             "v": a["Av"] * col[ix["vh"]],
-            "F": self._force(a["AF"] * col[ix["Fh"]], s),
+            "p": a["AF"] * col[ix["Fh"]],
+            "F": s * force_of_p(a["AF"] * col[ix["Fh"]], self.gamma),
             "s": s,
             "n": n,
             "frozen": n >= nstop,
@@ -304,18 +305,6 @@ class _Run:
         out["overflow"] = new > self.spec.K
         out["t"] = regs[-1][0] if out["frozen"] and regs else None
         return out
-
-    def _force_state(self, F: float, s: float) -> float:
-        """Force state (``F~``, or ``p`` for gamma < 1) on the branch ``s``."""
-        if not self.spec.pform:
-            return F
-        return -math.expm1((1.0 - self.gamma) * math.log1p(-min(s * F, 1.0)))
-
-    def _force(self, state: float, s: float) -> float:
-        """Normalised force ``F~`` from the force state."""
-        if not self.spec.pform:
-            return state
-        return -s * math.expm1(math.log1p(-min(state, 1.0)) / (1.0 - self.gamma))
 
     # --- one call -----------------------------------------------------------------------
     def _controls(self, t0: float, t1: float, j: int) -> list[float]:
@@ -378,7 +367,7 @@ class _Run:
     def _accept(self, out: dict, t: float) -> None:
         """Take the unpacked state ``out``, at normalised time ``t`` unless the call stopped early."""
         self.rev.extend(out["new"])
-        for k in ("x", "v", "F", "s", "sat", "rest", "W", "Ef", "xc"):
+        for k in ("x", "v", "F", "p", "s", "sat", "rest", "W", "Ef", "xc"):
             self.st[k] = out[k]
         self.st["t"] = t if out["t"] is None else out["t"]
 
@@ -603,8 +592,14 @@ def simulate(
         s0, rest = (-1.0 if F0 > 0 else 1.0), 1.0
         if not forced and t_end is None:
             raise ValueError("v0 = 0 and F0 = 0 without input: the mass rests, no reversal will come; give t_end")
-    run.st = {"x": x0 / sc.x, "v": v0 / sc.v, "F": F0 / sc.F, "t": 0.0, "s": s0,
-              "sat": 1.0 if s0 * F0 >= Fc and system.friction.gamma < 1 else 0.0, "rest": rest,
+    gamma = system.friction.gamma
+    if s0 * F0 >= Fc and gamma >= 1.0:
+        raise ValueError(
+            f"F0 = {F0!r} is the Coulomb force Fc in the direction of motion, which the Dahl branch "
+            f"reaches only asymptotically for gamma = {gamma!r} >= 1; use |F0| < Fc"
+        )
+    run.st = {"x": x0 / sc.x, "v": v0 / sc.v, "F": F0 / sc.F, "p": p_of_force(s0 * F0 / Fc, gamma),
+              "t": 0.0, "s": s0, "sat": 1.0 if s0 * F0 >= Fc else 0.0, "rest": rest,
               "W": 0.0, "Ef": 0.0, "xc": xc0, "uhold": 0.0}
     breaks = []
     if u_kind == "samples":
@@ -669,7 +664,6 @@ def simulate(
     rev = run.rev[: int(min(len(run.rev), n_target))]
     R = np.array(rev, dtype=float).reshape(-1, 4)
     t_r, x_r, F_r, W_r = R[:, 0] * sc.t, R[:, 1] * sc.x, R[:, 2] * sc.F, R[:, 3] * sc.E
-    gamma = system.friction.gamma
     s_after = s0 * (-1.0) ** (np.arange(1, len(R) + 1))
     E_p = branch_potential(np.clip(s_after * R[:, 2], -1.0, 1.0), gamma) * sc.E if len(R) else np.zeros(0)
     E0 = 0.5 * system.mass * v0 * v0 + float(branch_potential(np.array([s0 * F0 / Fc]), gamma)[0]) * sc.E
