@@ -52,9 +52,9 @@ import numpy as np
 __all__ = ["EPS_TOUCH", "EPS_REST", "Layout", "PlantSpec", "build_integrator"]
 
 EPS_TOUCH = 1e-14
-"""Normalised acceleration below which a zero velocity is rest, not a reversal or a touch."""
+"""Net force (relative to the call's amplitude scale) below which a zero velocity is rest."""
 EPS_REST = 1e-12
-"""Normalised net force above which a resting mass moves again."""
+"""Net force (relative to the call's amplitude scale) above which a resting mass moves again."""
 
 
 @dataclass(frozen=True)
@@ -197,6 +197,20 @@ def trace_signal(fun: Callable[[Any], Any], what: str) -> ca.SX:
         ) from None
     if val.numel() != 1:
         raise TypeError(f"{what} must return a scalar, got shape {val.shape}")
+    # math.sin(symbol) gives nan, float(symbol) branches silently: compare with numeric calls
+    f = ca.Function("signal", [t], [val])
+    for t0 in (0.0, 0.3183, 1.7):
+        traced = float(f(t0))
+        try:
+            direct = float(np.asarray(fun(t0), dtype=float))
+        except Exception as exc:  # user code failing on a float
+            raise TypeError(f"{what} failed on a float time t = {t0}: {type(exc).__name__}: {exc}") from None
+        if not (np.isfinite(traced) and abs(traced - direct) <= 1e-12 * max(1.0, abs(direct))):
+            raise TypeError(
+                f"{what} does not trace into CasADi: on a symbol it gives {traced!r} at t = {t0}, "
+                f"called directly {direct!r} (math.* functions and if/else on t do not trace; use numpy "
+                f"ufuncs such as np.sin, or casadi.if_else). Pass samples (t, values) instead."
+            )
     return val
 
 
@@ -263,7 +277,7 @@ def build_integrator(spec: PlantSpec, tol: float, atol: float) -> ca.Function:
     if spec.saturates:
         zero.append(ca.if_else(run_m * (1.0 - sat) > 0.5, 1.0 - (1.0 - g) * pp, 1.0))
     if spec.forced:
-        zero.append(ca.if_else(run * rest > 0.5, EPS_REST - ca.fabs(acc), 1.0))
+        zero.append(ca.if_else(run * rest > 0.5, EPS_REST * p["Av"] - ca.fabs(acc), 1.0))
     dae = {"x": X, "p": P, "u": U, "t": tau, "ode": ode, "zero": ca.vertcat(*zero)}
 
     # transition: the state just after an event
@@ -303,8 +317,9 @@ def build_integrator(spec: PlantSpec, tol: float, atol: float) -> ca.Function:
 
     sa = s * acc
     if spec.forced:  # zero velocity: reversal, touch (velocity keeps its sign) or rest
-        posts = [ca.if_else(sa < -EPS_TOUCH, reversal(-s, {}),
-                            ca.if_else(sa > EPS_TOUCH, X, with_({"rest": 1.0, "vh": 0.0})))]
+        eps = EPS_TOUCH * p["Av"]
+        posts = [ca.if_else(sa < -eps, reversal(-s, {}),
+                            ca.if_else(sa > eps, X, with_({"rest": 1.0, "vh": 0.0})))]
     else:
         posts = [reversal(-s, {})]
     if spec.saturates:
