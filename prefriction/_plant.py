@@ -205,7 +205,8 @@ def trace_signal(fun: Callable[[Any], Any], what: str) -> ca.SX:
             direct = float(np.asarray(fun(t0), dtype=float))
         except Exception as exc:  # user code failing on a float
             raise TypeError(f"{what} failed on a float time t = {t0}: {type(exc).__name__}: {exc}") from None
-        if not (np.isfinite(traced) and abs(traced - direct) <= 1e-12 * max(1.0, abs(direct))):
+        same = (np.isnan(traced) and np.isnan(direct)) or abs(traced - direct) <= 1e-12 * max(1.0, abs(direct))
+        if not same:
             raise TypeError(
                 f"{what} does not trace into CasADi: on a symbol it gives {traced!r} at t = {t0}, "
                 f"called directly {direct!r} (math.* functions and if/else on t do not trace; use numpy "

@@ -153,10 +153,12 @@ def _force_scale(system: Oscillator, u_kind: str, fb: Optional[LinearFeedback], 
     """Size [N] of the applied force: input samples, or 257 evaluations over [0, t_end], plus the
     feedback force ``|D| max |r - x0| + |C xc0|``; used for the error-control scale."""
     t = np.linspace(0.0, t_end, 257)
-    scale = float(np.max(np.abs(_eval_signal(system.u, u_kind, t)))) if system.forced else 0.0
-    if fb is not None:
-        r = _eval_signal(fb.reference, r_kind, t)
-        scale += abs(fb.D[0, 0]) * float(np.max(np.abs(r - x0))) + float(np.abs(fb.C[0] @ fb.xc0))
+    with np.errstate(invalid="ignore"):
+        scale = float(np.nanmax(np.abs(_eval_signal(system.u, u_kind, t)), initial=0.0)) if system.forced else 0.0
+        if fb is not None:
+            r = _eval_signal(fb.reference, r_kind, t)
+            scale += abs(fb.D[0, 0]) * float(np.nanmax(np.abs(r - x0), initial=0.0))
+            scale += float(np.abs(fb.C[0] @ fb.xc0))
     return scale
 
 

@@ -1,0 +1,129 @@
+"""simulate(): input validation, solver failures, JIT cache and the no-compiler fallback."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+
+import prefriction as pf
+from prefriction._feedback import LinearFeedback
+from prefriction._jit import compiled
+
+SYS = pf.Oscillator(pf.Dahl(1e4, 1.0))
+
+
+def test_unknown_keyword_raises_type_error() -> None:
+    with pytest.raises(TypeError):
+        pf.simulate(SYS, 1.0, reversals=3, tolerance=1e-6)  # type: ignore[call-arg]
+
+
+@pytest.mark.parametrize(
+    "kwargs, exc, match",
+    [
+        ({}, ValueError, "reversals .* t_end"),
+        ({"reversals": 0}, ValueError, "reversals must be an integer >= 1"),
+        ({"reversals": 2.5}, TypeError, "reversals must be an integer"),
+        ({"t_end": -1.0}, ValueError, "t_end must be finite and > 0"),
+        ({"reversals": 3, "rtol": 1e-1}, ValueError, r"rtol must lie in \[1e-13, 1e-2\]"),
+        ({"reversals": 3, "rtol": 0.0}, ValueError, "rtol must be finite and > 0"),
+        ({"reversals": 3, "atol": 1.0}, ValueError, "atol must lie in"),
+        ({"reversals": 3, "method": "cvodes"}, ValueError, "method must be one of"),
+        ({"reversals": 3, "F0": 1.5}, ValueError, r"F0 must lie in \[-Fc, Fc\]"),
+        ({"reversals": 3, "F0": 1.0}, ValueError, "reaches only asymptotically"),
+        ({"reversals": 3, "x0": float("nan")}, ValueError, "x0 must be finite"),
+        ({"reversals": 3, "feedback": "pid"}, TypeError, "feedback must be"),
+        ({"reversals": 3, "jit": 1}, TypeError, "jit must be True or False"),
+        ({"t_end": 1.0, "dense": [0.0, 2.0]}, ValueError, "dense sample times"),
+        ({"t_end": 1.0, "dense": [[0.0]]}, ValueError, "dense must be"),
+    ],
+)
+def test_invalid_arguments(kwargs: dict, exc: type, match: str) -> None:
+    with pytest.raises(exc, match=match):
+        pf.simulate(SYS, 1.0, **kwargs)
+
+
+def test_invalid_system_and_v0() -> None:
+    with pytest.raises(TypeError, match="Oscillator"):
+        pf.simulate(pf.Dahl(1.0, 1.0), 1.0, reversals=2)  # type: ignore[arg-type]
+    with pytest.raises(TypeError, match="v0 must be a real number"):
+        pf.simulate(SYS, "fast", reversals=2)  # type: ignore[arg-type]
+
+
+def test_forced_needs_t_end_and_rest_needs_t_end() -> None:
+    with pytest.raises(ValueError, match="t_end is required"):
+        pf.simulate(pf.Oscillator(pf.Dahl(1e4, 1.0), u=lambda t: 0.1 + 0 * t), 0.0, reversals=3)
+    with pytest.raises(ValueError, match="rests"):
+        pf.simulate(SYS, 0.0, reversals=3)
+    with pytest.raises(ValueError, match="sampled controller"):
+        pf.simulate(SYS, 0.0, t_end=1.0, dense=True, feedback=LinearFeedback(D=1.0, Ts=0.1))
+
+
+def test_feedback_validation() -> None:
+    with pytest.raises(ValueError, match=r"B must have shape \(1, 1\)"):
+        LinearFeedback(A=[[0.0]], B=[[1.0, 2.0]], C=[[1.0]], D=0.0)
+    with pytest.raises(ValueError, match="Ts must be finite and > 0"):
+        LinearFeedback(D=1.0, Ts=0.0)
+    with pytest.raises(ValueError, match="strictly increasing"):
+        LinearFeedback(D=1.0, reference=(np.array([0.0, 0.0]), np.array([1.0, 2.0])))
+
+
+def test_solver_failure_raises_solver_error_naming_time_and_state() -> None:
+    """An input that becomes NaN at t = 0.01 s makes the integrator fail: SolverError, no NaN result."""
+    sys_ = pf.Oscillator(pf.Dahl(1e4, 1.0), u=lambda t: 0.5 * np.sqrt(0.01 - t))
+    with pytest.raises(pf.SolverError) as info, np.errstate(invalid="ignore"):
+        pf.simulate(sys_, 0.1, t_end=0.05)
+    msg = str(info.value)
+    assert "t = " in msg and "x = " in msg and "v = " in msg and "F = " in msg and "Try" in msg
+
+
+def test_no_compiler_fallback_gives_the_same_table(monkeypatch: pytest.MonkeyPatch) -> None:
+    """PREFRICTION_NO_JIT=1: the interpreted integrator, same reversal table to round-off."""
+    ref = pf.simulate(SYS, 1.0, reversals=20, rtol=3e-9)
+    monkeypatch.setenv("PREFRICTION_NO_JIT", "1")
+    res = pf.simulate(SYS, 1.0, reversals=20, rtol=3.0000001e-9)  # new tolerance: not in memory
+    assert res.stats.jit == "interpreted" and res.stats.steps is not None and res.stats.steps > 0
+    np.testing.assert_allclose(res.reversals.F, ref.reversals.F, rtol=1e-7)
+    np.testing.assert_allclose(res.reversals.t, ref.reversals.t, rtol=1e-9)
+
+
+def test_missing_compiler_falls_back(monkeypatch: pytest.MonkeyPatch) -> None:
+    import casadi as ca
+
+    monkeypatch.setenv("CC", "/nonexistent/cc")
+    x = ca.SX.sym("x")
+    fun = ca.Function("f_nocc", [x], [2 * x])
+    out, info = compiled(fun)
+    assert out is fun and info.mode == "interpreted" and "compiler" in info.reason
+
+
+SCRIPT = textwrap.dedent(
+    """
+    import json, sys, time
+    import prefriction as pf
+    sys_ = pf.Oscillator(pf.Dahl(1e4, 1.0, 2.0))
+    r = pf.simulate(sys_, 1.0, reversals=5, rtol=2.5e-7)
+    print(json.dumps({"jit": r.stats.jit, "setup": r.stats.setup_time, "F": list(r.reversals.F)}))
+    """
+)
+
+
+def test_second_process_reuses_compiled_code(tmp_path) -> None:
+    """The compiled library is cached on disk: a second process loads it instead of compiling."""
+    env = {**os.environ, "PREFRICTION_CACHE": str(tmp_path)}
+    env.pop("PREFRICTION_NO_JIT", None)
+    runs = []
+    for _ in range(2):
+        out = subprocess.run([sys.executable, "-c", SCRIPT], env=env, capture_output=True, text=True,
+                             timeout=300, check=True)
+        runs.append(json.loads(out.stdout.strip().splitlines()[-1]))
+    assert runs[0]["jit"] == "compiled"
+    assert runs[1]["jit"] == "cached"
+    assert runs[1]["setup"] < runs[0]["setup"]
+    assert len(list(tmp_path.glob("*.so"))) == 1
+    assert runs[0]["F"] == runs[1]["F"]
