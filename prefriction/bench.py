@@ -371,8 +371,8 @@ def _plot(path: Path, rows: list[Row]) -> None:
 
     fig, ax = plt.subplots(figsize=(8, 5.5))
     for solver in dict.fromkeys(r.solver for r in rows):
-        pts = sorted((r.seconds, r.error) for r in rows
-                     if r.solver == solver and math.isfinite(r.error) and math.isfinite(r.seconds))
+        pts = [(r.seconds, r.error) for r in sorted(rows, key=lambda r: -r.tol)
+               if r.solver == solver and math.isfinite(r.error) and math.isfinite(r.seconds)]
         if pts:
             ax.loglog([p[0] for p in pts], [p[1] for p in pts], "o-" if "simulate" in solver else ".--",
                       label=solver, lw=2 if "simulate" in solver else 1)

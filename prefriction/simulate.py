@@ -41,6 +41,10 @@ _N_DENSE = 16  # output times per call of the dense-output integrator
 _CAL = 0.07  # calibration of the internal tolerance: global error over 50 reversals ~ 0.7 rtol
 _DENSE_STEP = 2.0 * math.pi / 64.0  # normalised spacing of dense=True samples (64 per small cycle)
 _CACHE: dict = {}
+_INTEGRATOR_FAILED = (
+    "the integrator stopped with an error before the end of its interval (a non-finite right-hand "
+    "side such as a NaN input, a step below its minimum, or more steps or events than allowed)"
+)
 
 
 @dataclass(frozen=True)
@@ -366,7 +370,7 @@ class _Run:
         except RuntimeError as exc:
             raise self._failure(str(exc).strip().splitlines()[-1]) from None
         if failed:
-            raise self._failure("the compiled integrator returned an error (step size or event limits)")
+            raise self._failure(_INTEGRATOR_FAILED)
         if self.steps is not None:
             try:  # statistics exist for the interpreted integrator only (memory 1: the buffer's)
                 self.steps += int(call.fun.stats(1)["n_steps"])
@@ -438,7 +442,7 @@ class _Run:
                 raise self._failure(str(exc).strip().splitlines()[-1]) from None
             c = out.tolist()
             if failed or not math.isfinite(math.fsum(c)):
-                raise self._failure("the integrator failed or returned non-finite values")
+                raise self._failure(_INTEGRATOR_FAILED)
             if self.steps is not None:
                 try:
                     self.steps += int(call.fun.stats(1)["n_steps"])
