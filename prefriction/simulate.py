@@ -24,7 +24,7 @@ import numpy as np
 from ._branch import branch_potential
 from ._feedback import LinearFeedback
 from ._jit import compiled
-from ._plant import Layout, PlantSpec, build_integrator, force_of_p, p_of_force, trace_signal
+from ._plant import EPS_REST, Layout, PlantSpec, build_integrator, force_of_p, p_of_force, trace_signal
 from ._validation import check_count, check_finite, check_positive
 from .errors import SolverError
 from .models import Dahl, Oscillator
@@ -353,8 +353,38 @@ class _Run:
             U[L.control["uhold"]] = self.st["uhold"]
         return U
 
+    def _net_force(self) -> float:
+        """Normalised net force ``u~ - F~`` on the mass in the current state."""
+        st, sc = self.st, self.sc
+        t_si = np.array([st["t"] * sc.t])
+        u = float(_eval_signal(self.system.u, self.u_kind, t_si)[0]) if self.system.forced else 0.0
+        if self.spec.fb == "continuous":
+            e = float(_eval_signal(self.fb.reference, self.r_kind, t_si)[0]) - st["x"] * sc.x
+            u += float(self.fb.C[0] @ st["xc"] + self.fb.D[0, 0] * e)
+        elif self.spec.fb == "sampled":
+            u += st["uhold"]
+        return u / sc.F - st["F"]
+
+    def _leave_rest(self) -> None:
+        """End a rest at the start of a call if the net force no longer vanishes (the input or the
+        held force jumped at a sample time; inside a call the rest-exit event does this)."""
+        acc = self._net_force()
+        if abs(acc) <= EPS_REST * self._scales()["Av"]:
+            return
+        st = self.st
+        new_s = 1.0 if acc > 0 else -1.0
+        if new_s != st["s"]:  # leaves backwards: a reversal at this instant
+            self.rev.append((st["t"], st["x"], st["F"], st["W"]))
+            st["W"] = 0.0
+            st["p"] = p_of_force(new_s * st["F"], self.gamma)
+            st["sat"] = 0.0
+            st["s"] = new_s
+        st["rest"] = 0.0
+
     def _call(self, call: "_Buffered", L: Layout, times: list[float], nstop: float) -> tuple[np.ndarray, dict]:
         """One integrator call over the output ``times`` (normalised), stopping at ``nstop`` reversals."""
+        if self.spec.forced and self.st["rest"] > 0.5:
+            self._leave_rest()
         a = self._scales()
         a["xref"], a["Efref"] = self.st["x"], self.st["Ef"]
         self._params(call, L, a, nstop)
@@ -672,6 +702,7 @@ def simulate(
     tol_abs = atol * _CAL * math.sqrt(L.n_active / L.nx)
     run = _Run(system, spec, feedback, tol, tol_abs, jit)
     run.snap = rtol
+    run.u_kind, run.r_kind = u_kind, r_kind
     run.P0 = run._constant_params(run.L)
     run.force_scale = _force_scale(system, u_kind, feedback, r_kind, x0, t_end_si) / Fc if forced else 0.0
 

@@ -138,3 +138,14 @@ def test_untraceable_input_raises_type_error() -> None:
     sys_ = spring_system(lambda s: math.sin(s))
     with pytest.raises(TypeError, match="trace"):
         pf.simulate(sys_, 0.0, t_end=1.0)
+
+
+def test_rest_ends_when_the_held_force_jumps() -> None:
+    """A mass at rest under a sampled controller moves once the held force changes (no stiction)."""
+    sys_ = pf.Oscillator(pf.Dahl(1e4, 1.0))
+    ref = (np.array([0.0, 0.0105, 0.0115, 1.0]), np.array([0.0, 0.0, 1e-4, 1e-4]))  # step at ~0.011 s
+    fb = LinearFeedback(D=2e3, Ts=1e-3, reference=ref)
+    res = pf.simulate(sys_, 0.0, t_end=0.05, feedback=fb, rtol=1e-9)
+    assert np.all(res.x[res.t <= 0.0105] == 0.0)
+    assert res.x[-1] > 1e-6  # the reference step moves the mass
+    assert np.max(np.abs(res.x)) < 2e-4
