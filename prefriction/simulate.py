@@ -166,25 +166,6 @@ def _force_scale(system: Oscillator, u_kind: str, fb: Optional[LinearFeedback], 
     return scale
 
 
-def _merge_touches(rev: list, threshold: float) -> list:
-    """Drop pairs of reversals closer than ``threshold`` (normalised distance): a velocity that
-    touches zero can dip below it by round-off or truncation error and come back, which is not a
-    reversal. The input work of a dropped pair is carried into the next half-cycle."""
-    out: list = []
-    carry = 0.0
-    i = 0
-    while i < len(rev):
-        if i + 1 < len(rev) and abs(rev[i + 1][1] - rev[i][1]) <= threshold:
-            carry += rev[i][3] + rev[i + 1][3]
-            i += 2
-            continue
-        t, x, F, W = rev[i]
-        out.append((t, x, F, W + carry))
-        carry = 0.0
-        i += 1
-    return out
-
-
 def _integrator(spec: PlantSpec, tol: float, atol: float, jit: bool) -> tuple["_Buffered", float, str]:
     """Build (or reuse) the integrator of ``spec``; returns it, the setup time and the JIT mode."""
     key = (spec, tol, atol, jit)
@@ -793,8 +774,6 @@ def simulate(
 
     # reversal table (SI)
     rev = run.rev[: int(min(len(run.rev), n_target))]
-    if forced:
-        rev = _merge_touches(rev, 10.0 * rtol * max(run.force_scale, getattr(run, "A_max", 0.0)))
     R = np.array(rev, dtype=float).reshape(-1, 4)
     t_r, x_r, F_r, W_r = R[:, 0] * sc.t, R[:, 1] * sc.x, R[:, 2] * sc.F, R[:, 3] * sc.E
     s_after = s0 * (-1.0) ** (np.arange(1, len(R) + 1))
