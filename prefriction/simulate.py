@@ -24,7 +24,7 @@ import math
 import time
 import warnings
 from dataclasses import dataclass
-from typing import Any, Callable, Optional, Union
+from typing import Any, Optional, Union
 
 import casadi as ca
 import numpy as np
@@ -229,7 +229,14 @@ class _Run:
         self.calls = 0
         self.steps: Optional[int] = 0
         self.rev: list[tuple] = []  # (t~, x~, F~, W~)
-        self.st: dict = {}
+        self.st: dict = {}  # current state, normalised (set by simulate)
+        self.snap = 0.0  # reversal-saturation coincidence tolerance (gamma < 1)
+        self.force_scale = 0.0  # size of the applied force / Fc
+        self.A_max = 0.0  # largest amplitude seen (forced)
+        self.breaks = np.zeros(0)  # sample times of sampled signals (normalised)
+        self.u_kind = self.r_kind = "none"
+        self.S = np.ones(spec.n_c)  # controller state scales
+        self.P0 = np.zeros(self.L.np)  # parameters fixed during the run
 
     # --- state conversion -------------------------------------------------------------
     def _scales(self) -> dict:
@@ -238,7 +245,7 @@ class _Run:
         v, F = self.st["v"], self.st["F"]
         A = math.hypot(v, F)
         if self.spec.forced:
-            self.A_max = max(getattr(self, "A_max", 0.0), A)
+            self.A_max = max(self.A_max, A)
             A = max(A, self.force_scale, 0.1 * self.A_max)
         A = max(A, 1e-300)
         Ax = max(A, 0.5 * A * A, min(abs(self.st["x"]), 1.0))  # positions: relative to |x| (<= 1)
