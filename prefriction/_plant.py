@@ -9,8 +9,8 @@ output grid.
 State vector (indices in :class:`Layout`), kept short because the cost of a step grows with it:
 
 ``xh, vh, Fh``
-    ``x~ = xref + Ax xh``, ``v~ = Av vh``, ``F~ = AF Fh`` (for gamma < 1 the force state is
-    ``p``, see :class:`PlantSpec`);
+    ``x~ = xref + Ax xh``, ``v~ = Av vh`` and the branch distance ``p = AF Fh`` with
+    ``F~ = s f(p)`` (see :class:`PlantSpec` and :func:`force_of_p`);
 ``s, n``
     branch direction (+-1) and reversals so far; the call stops (right-hand side zero) once
     ``n`` reaches the parameter ``nstop``;
@@ -31,12 +31,16 @@ Normalised time is ``t~ = t0 + dur * tau`` with the integrator time ``tau`` and 
 
 Events (the integrator fires when an indicator goes from positive to negative):
 
-0. reversal, indicator ``s v``: at the crossing the acceleration ``a~ = u~ - F~`` decides:
-   ``s a~ < -eps``: a reversal (register shift, ``s -> -s``); ``s a~ > eps``: the velocity
-   touches zero and keeps its sign (nothing changes); otherwise the mass is at rest.
-1. saturation, indicator ``1 - s F~``: ``F~ = s`` exactly and ``F' = 0`` until the next reversal.
-2. end of rest, indicator ``eps_rest - |a~|``: the mass moves again in direction ``sign(a~)``,
-   a reversal if that differs from ``s``.
+- reversal, indicator ``s v``. Unforced: always a reversal (register shift, ``s -> -s``).
+  Forced: the net force ``a~ = u~ - F~`` decides: ``s a~ < -eps``: a reversal;
+  ``s a~ > eps``: the velocity touches zero and keeps its sign (nothing changes); otherwise
+  the mass rests (``v = 0``, right-hand side zero).
+- saturation (gamma < 1 only), indicator ``1 - (1 - gamma) p``: ``F~ = s`` exactly, ``F' = 0``
+  until the next reversal; a reversal within ``snap`` of saturation is one at saturation.
+- end of rest (forced only), indicator ``eps_rest - |a~|``: the mass moves again in direction
+  ``sign(a~)``, a reversal if that differs from ``s``.
+
+``eps`` and ``eps_rest`` are :data:`EPS_TOUCH` and :data:`EPS_REST` times the amplitude scale.
 """
 
 from __future__ import annotations
