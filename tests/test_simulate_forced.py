@@ -149,3 +149,19 @@ def test_rest_ends_when_the_held_force_jumps() -> None:
     assert np.all(res.x[res.t <= 0.0105] == 0.0)
     assert res.x[-1] > 1e-6  # the reference step moves the mass
     assert np.max(np.abs(res.x)) < 2e-4
+
+
+def test_continuous_loop_with_sampled_reference_matches_python_control() -> None:
+    """u = kp (r - x) with r piecewise linear (samples): python-control's forced_response of the loop."""
+    kp = 5e4
+    tr = np.linspace(0.0, 0.1, 11)
+    rr = 1e-3 * np.minimum(tr / 0.03, 1.0) * (1.0 + 0.2 * np.sin(60.0 * tr))
+    fb = LinearFeedback(D=kp, reference=(tr, rr))
+    t = np.linspace(0.0, 0.1, 101)
+    res = pf.simulate(spring_system(), 0.0, t_end=0.1, dense=t, feedback=fb, rtol=1e-10)
+    loop = ct.ss([[0, 1], [-(K_SPRING + kp) / MASS, 0]], [[0], [kp / MASS]], [[1, 0]], [[0]])
+    tf = np.linspace(0.0, 0.1, 100_001)
+    ref = ct.forced_response(loop, T=tf, U=np.interp(tf, tr, rr))
+    x_ref = np.interp(t, tf, ref.outputs)
+    assert np.max(np.abs(res.x - x_ref)) <= 1e-6 * np.max(np.abs(x_ref))
+    np.testing.assert_allclose(res.u, kp * (np.interp(t, tr, rr) - res.x), rtol=0, atol=1e-9 * kp * 1e-3)
