@@ -115,3 +115,14 @@ def test_reversals_only_run_records_no_samples() -> None:
     assert res.t is None and res.x is None and res.E_f is None
     assert res.stats.calls >= 1 and res.stats.wall_time > 0
     assert math.isfinite(res.reversals.t[-1])
+
+
+def test_sparse_dense_samples_with_many_reversals_between() -> None:
+    """Many reversals between two samples (more than one call holds): none lost, energy balanced."""
+    case = CASES[0]
+    ref = exact_reversals(case.system, case.v0, 60)
+    t = np.linspace(0.0, ref.t[55], 7)
+    res = pf.simulate(case.system, case.v0, t_end=float(t[-1]), dense=t, rtol=1e-8)
+    assert len(res.reversals) == 56
+    assert reversal_error(case, res.reversals.t, res.reversals.x, res.reversals.F, ref) <= 1e-7
+    np.testing.assert_allclose(res.E_k + res.E_f, 0.5 * case.mass * case.v0**2, rtol=1e-10, atol=0)
