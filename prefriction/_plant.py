@@ -45,10 +45,13 @@ Events (the integrator fires when an indicator goes from positive to negative):
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Any, Callable
-
+import contextlib
 import math
+import os
+import sys
+import tempfile
+from dataclasses import dataclass
+from typing import Any, Callable, Iterator
 
 import casadi as ca
 import numpy as np
@@ -355,4 +358,31 @@ def build_integrator(spec: PlantSpec, tol: float, atol: float) -> ca.Function:
         # default estimate (about 13 % of all steps with K = 2).
         opts["step0"] = min(0.03, max(1e-4, 0.015 * (tol / 3.7e-10) ** 0.2))
     grid = [float(j) for j in range(1, spec.n_out + 1)]
-    return ca.integrator(f"dahl_{spec.method}_{spec.n_out}", spec.method, dae, 0.0, grid, opts)
+    with _without_event_notice():
+        return ca.integrator(f"dahl_{spec.method}_{spec.n_out}", spec.method, dae, 0.0, grid, opts)
+
+
+_EVENT_NOTICE = b'WARNING("Event support is experimental")'
+
+
+@contextlib.contextmanager
+def _without_event_notice() -> Iterator[None]:
+    """Drop CasADi's "Event support is experimental" line from stderr; pass every other line on.
+
+    CasADi writes the notice from C++ straight to file descriptor 2 each time an integrator
+    with events is built, which clutters progress output. The events are tested here
+    (tests/test_simulate*.py), so the notice carries no information for our users.
+    """
+    sys.stderr.flush()
+    saved = os.dup(2)
+    with tempfile.TemporaryFile() as capture:
+        os.dup2(capture.fileno(), 2)
+        try:
+            yield
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            capture.seek(0)
+            kept = [line for line in capture.read().splitlines(keepends=True) if _EVENT_NOTICE not in line]
+            if kept:
+                os.write(2, b"".join(kept))
