@@ -18,7 +18,7 @@ import numpy as np
 import prefriction
 from prefriction._branch import force_after_distance
 from prefriction._feedback import LinearFeedback
-from prefriction._validation import check_finite, check_positive
+from prefriction._validation import check_positive, check_signal
 from prefriction.errors import SolverError
 from prefriction.models import Oscillator
 from prefriction.reversals import ReversalTable
@@ -163,33 +163,6 @@ class LoopResult:
         return "\n".join(lines)
 
 
-def _check_reference(reference: Reference) -> Reference:
-    """Validate a reference and return it (samples as float arrays); errors name ``reference``."""
-    if callable(reference):
-        return reference
-    if isinstance(reference, tuple):
-        if len(reference) != 2:
-            raise ValueError(f"reference samples must be a pair (t, r), got a tuple of length {len(reference)}")
-        t = np.asarray(reference[0], dtype=float)
-        r = np.asarray(reference[1], dtype=float)
-        if t.ndim != 1 or r.ndim != 1 or t.shape != r.shape or t.size < 2:
-            raise ValueError(
-                "reference samples (t, r) must be 1-D arrays of equal length >= 2, "
-                f"got t with shape {t.shape} and r with shape {r.shape}"
-            )
-        if not (np.all(np.isfinite(t)) and np.all(np.isfinite(r))):
-            raise ValueError("reference samples (t, r) must be finite, got NaN or inf")
-        if np.any(np.diff(t) <= 0):
-            raise ValueError("reference sample times t must be strictly increasing")
-        return (t, r)
-    if isinstance(reference, (list, np.ndarray)):
-        raise TypeError(
-            "reference must be a number [m], a callable r(t) or a pair (t, r) of sample arrays; "
-            f"got a bare {type(reference).__name__}: pass (t, r) with the sample times"
-        )
-    return check_finite("reference", reference)
-
-
 def _evaluate(reference: Reference, t: np.ndarray) -> np.ndarray:
     """Numeric reference at times ``t`` [s] (samples: linear, held constant outside their range)."""
     if isinstance(reference, tuple):
@@ -307,7 +280,7 @@ def simulate_loop(
     """
     _check_system(system)
     t_end = check_positive("t_end", t_end)
-    reference = _check_reference(reference)
+    reference = check_signal("reference", reference, "m", "r")
     if Ts is not None:
         Ts = check_positive("Ts", Ts)
     if discretization not in DISCRETIZATIONS:

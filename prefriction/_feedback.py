@@ -27,7 +27,7 @@ from typing import Any, Callable, Optional, Union
 
 import numpy as np
 
-from ._validation import check_finite, check_positive
+from ._validation import check_positive, check_signal
 
 Reference = Union[float, Callable[[Any], Any], tuple]
 
@@ -43,30 +43,6 @@ def _as_matrix(name: str, value: Any, shape: tuple[int, int]) -> np.ndarray:
         raise ValueError(f"{name} must be finite (every entry), got {arr.tolist()!r}")
     arr.setflags(write=False)
     return arr
-
-
-def _check_reference(r: Reference) -> Reference:
-    """Validate a reference: a finite constant [m], a callable ``r(t)`` [m], or samples ``(t, r)``."""
-    if callable(r):
-        return r
-    if isinstance(r, tuple):
-        if len(r) != 2:
-            raise ValueError(f"reference samples must be a pair (t, r), got a tuple of length {len(r)}")
-        t = np.asarray(r[0], dtype=float)
-        val = np.asarray(r[1], dtype=float)
-        if t.ndim != 1 or val.shape != t.shape or t.size < 2:
-            raise ValueError(
-                "reference samples must be a pair (t, r) of 1-D arrays of equal length >= 2, "
-                f"got shapes {t.shape} and {val.shape}"
-            )
-        if not (np.all(np.isfinite(t)) and np.all(np.isfinite(val))):
-            raise ValueError("reference samples must be finite (t and r), got NaN or inf")
-        if np.any(np.diff(t) <= 0):
-            raise ValueError("reference sample times t must be strictly increasing")
-        t.setflags(write=False)
-        val.setflags(write=False)
-        return (t, val)
-    return check_finite("reference", r)
 
 
 @dataclass(frozen=True, eq=False)
@@ -114,7 +90,7 @@ class LinearFeedback:
         object.__setattr__(self, "D", _as_matrix("D", self.D, (1, 1)))
         if self.Ts is not None:
             object.__setattr__(self, "Ts", check_positive("Ts", self.Ts))
-        object.__setattr__(self, "reference", _check_reference(self.reference))
+        object.__setattr__(self, "reference", check_signal("reference", self.reference, "m", "r"))
         xc0 = np.zeros(n) if self.xc0 is None else np.array(self.xc0, dtype=float).reshape(-1)
         if xc0.shape != (n,) or not np.all(np.isfinite(xc0)):
             raise ValueError(f"xc0 must be a finite vector of length {n}, got {self.xc0!r}")

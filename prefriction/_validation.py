@@ -65,3 +65,55 @@ def check_array_interval(name: str, values: Any, lo: float, hi: float) -> np.nda
         first = arr[bad].flat[0]
         raise ValueError(f"{name} must lie in [{lo!r}, {hi!r}] (every entry), got {first!r}")
     return arr
+
+
+def check_signal(name: str, value: Any, unit: str, letter: str) -> Any:
+    """Validate a time signal: a finite number, a callable of time, or samples ``(t, values)``.
+
+    Parameters
+    ----------
+    name : str
+        Argument name used in error messages (e.g. ``"u"`` or ``"reference"``).
+    value : number, callable or tuple
+        The signal. Samples are a pair of 1-D arrays of equal length >= 2, finite, with
+        strictly increasing times [s]; they are returned as read-only float arrays.
+    unit : str
+        Unit of the signal's values, for messages (e.g. ``"N"`` or ``"m"``).
+    letter : str
+        Symbol of the signal in messages, as in ``(t, r)``.
+
+    Returns
+    -------
+    float, callable or (numpy.ndarray, numpy.ndarray)
+    """
+    if callable(value):
+        return value
+    if isinstance(value, tuple):
+        if len(value) != 2:
+            raise ValueError(f"{name} samples must be a pair (t, {letter}), got a tuple of length {len(value)}")
+        t = np.array(value[0], dtype=float)
+        val = np.array(value[1], dtype=float)
+        if t.ndim != 1 or val.shape != t.shape or t.size < 2:
+            raise ValueError(
+                f"{name} samples must be a pair (t, {letter}) of 1-D arrays of equal length >= 2, "
+                f"got shapes {t.shape} and {val.shape}"
+            )
+        if not (np.all(np.isfinite(t)) and np.all(np.isfinite(val))):
+            raise ValueError(f"{name} samples must be finite (t and {letter}), got NaN or inf")
+        if np.any(np.diff(t) <= 0):
+            raise ValueError(f"{name} sample times t must be strictly increasing")
+        t.setflags(write=False)
+        val.setflags(write=False)
+        return (t, val)
+    if isinstance(value, (list, np.ndarray)):
+        raise TypeError(
+            f"{name} must be a number [{unit}], a callable {letter}(t) or a pair (t, {letter}) of sample "
+            f"arrays; got a bare {type(value).__name__}: pass (t, {letter}) with the sample times"
+        )
+    try:
+        return check_finite(name, value)
+    except TypeError:
+        raise TypeError(
+            f"{name} must be a number [{unit}], a callable {letter}(t) of time t [s] or a pair (t, {letter}) "
+            f"of sample arrays, got {value!r} of type {type(value).__name__}"
+        ) from None

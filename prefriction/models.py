@@ -12,11 +12,10 @@ from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
 from typing import Any, Callable, Union
 
-import numpy as np
 
-from ._validation import check_nonnegative, check_positive
+from ._validation import check_nonnegative, check_positive, check_signal
 
-InputForce = Union[None, Callable[[Any], Any], tuple]
+InputForce = Union[None, float, Callable[[Any], Any], tuple]
 
 
 class FrictionModel(ABC):
@@ -78,31 +77,6 @@ class Dahl(FrictionModel):
         return (1.0 - f) ** self.gamma
 
 
-def _check_input_force(u: InputForce) -> InputForce:
-    """Validate an input force: ``None``, a callable of time, or samples ``(t, u)``."""
-    if u is None or callable(u):
-        return u
-    if isinstance(u, tuple) and len(u) == 2:
-        t = np.asarray(u[0], dtype=float)
-        val = np.asarray(u[1], dtype=float)
-        if t.ndim != 1 or val.shape != t.shape or t.size < 2:
-            raise ValueError(
-                "u samples must be a pair (t, u) of 1-D arrays of equal length >= 2, "
-                f"got shapes {t.shape} and {val.shape}"
-            )
-        if not (np.all(np.isfinite(t)) and np.all(np.isfinite(val))):
-            raise ValueError("u samples must be finite (t and u), got NaN or inf")
-        if np.any(np.diff(t) <= 0):
-            raise ValueError("u sample times t must be strictly increasing")
-        t.setflags(write=False)
-        val.setflags(write=False)
-        return (t, val)
-    raise TypeError(
-        "u must be None, a callable u(t) [N] of time t [s], or a pair (t, u) of sample arrays, "
-        f"got {u!r} of type {type(u).__name__}"
-    )
-
-
 @dataclass(frozen=True, eq=False)
 class Oscillator:
     """Pre-sliding hysteresis oscillator (2.1): ``m x'' + F = u(t)``.
@@ -113,10 +87,11 @@ class Oscillator:
         The hysteretic restoring (friction) force ``f[x]``, e.g. :class:`Dahl`.
     mass : float, default 1.0
         Moving mass ``m`` [kg], ``0 < mass < inf``.
-    u : None, callable or (t, u) samples, default None
-        External force [N]. ``None`` is the unforced system (2.1) of the paper. A callable
-        ``u(t)`` takes time in seconds; samples ``(t, u)`` are two 1-D arrays with strictly
-        increasing times [s].
+    u : None, float, callable or (t, u) samples, default None
+        External force [N]. ``None`` is the unforced system (2.1) of the paper. A float is a
+        constant force; a callable ``u(t)`` takes time in seconds (and must accept a CasADi
+        symbol, see :func:`prefriction.simulate`); samples ``(t, u)`` are two 1-D arrays with
+        strictly increasing times [s], linear in between.
     """
 
     friction: FrictionModel
@@ -129,7 +104,8 @@ class Oscillator:
                 f"friction must be a FrictionModel such as prefriction.Dahl, got {self.friction!r}"
             )
         object.__setattr__(self, "mass", check_positive("mass", self.mass))
-        object.__setattr__(self, "u", _check_input_force(self.u))
+        if self.u is not None:
+            object.__setattr__(self, "u", check_signal("u", self.u, "N", "u"))
 
     @property
     def forced(self) -> bool:

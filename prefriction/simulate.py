@@ -766,7 +766,6 @@ def simulate(
     elif want_dense:
         if times_si is None:
             stop_t = t_end_n
-            times = []
             stopped = False
             t0 = 0.0
             while not stopped and t0 <= stop_t:

@@ -170,8 +170,8 @@ def test_summary_is_readable():
 def test_argument_errors():
     system = stage()
     pd = controllers.pd(2e6, 2000.0)
-    with pytest.raises(ValueError, match=r"reference samples \(t, r\) must be 1-D arrays of equal length >= 2, "
-                                         r"got t with shape \(3,\) and r with shape \(2,\)"):
+    with pytest.raises(ValueError, match=r"reference samples must be a pair \(t, r\) of 1-D arrays of equal length >= 2, "
+                                         r"got shapes \(3,\) and \(2,\)"):
         controllers.simulate_loop(system, pd, (np.array([0.0, 1.0, 2.0]), np.array([0.0, 1e-6])), 0.01)
     with pytest.raises(ValueError, match="strictly increasing"):
         controllers.simulate_loop(system, pd, (np.array([0.0, 0.0]), np.array([0.0, 1e-6])), 0.01)

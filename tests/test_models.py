@@ -51,12 +51,13 @@ def test_dahl_slope_is_rest_stiffness_at_zero_force(gamma):
 def test_oscillator_validation():
     d = Dahl(1e4, 1.0)
     assert Oscillator(d).mass == 1.0 and not Oscillator(d).forced
+    assert Oscillator(d, u=2).u == 2.0 and Oscillator(d, u=2).forced
     with pytest.raises(ValueError, match=r"mass must be finite and > 0, got -1.0"):
         Oscillator(d, mass=-1.0)
     with pytest.raises(TypeError, match="friction must be a FrictionModel"):
         Oscillator(1.0)  # type: ignore[arg-type]
-    with pytest.raises(TypeError, match="u must be None, a callable"):
-        Oscillator(d, u=3.0)  # type: ignore[arg-type]
+    with pytest.raises(TypeError, match=r"u must be a number \[N\], a callable u\(t\)"):
+        Oscillator(d, u="3")  # type: ignore[arg-type]
     with pytest.raises(ValueError, match="strictly increasing"):
         Oscillator(d, u=([0.0, 0.0], [1.0, 2.0]))
     with pytest.raises(ValueError, match="equal length"):
