@@ -1,0 +1,218 @@
+"""Energy balance at the reversals: the Dahl branch potential (3.9), the dissipation per
+half-cycle (2.10), the dissipation series (2.11) and the bound (2.12)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Optional
+
+import numpy as np
+
+from ._branch import branch_potential
+from ._energy_checks import ROUNDING, check_dahl
+from .models import Dahl
+
+
+def branch_energy(F: Any, direction: Any, *, friction: Dahl) -> np.ndarray:
+    """Energy stored on a Dahl branch relative to its force zero crossing [J].
+
+    ``E = (Fc^2 / sigma) H_gamma(s F / Fc)`` with ``H_gamma(f) = int_0^f phi (1 - phi)^-gamma dphi``
+    and ``s`` the direction of motion on the branch. At a reversal, with ``s`` the *new*
+    direction, this is the potential energy ``E_p`` of the paper, (3.9) for ``gamma = 1``:
+    ``(Fc^2/sigma) (a - ln(1 + a))`` with ``a = |F_i| / Fc``.
+
+    Parameters
+    ----------
+    F : array_like
+        Friction forces [N], ``|F| <= Fc``.
+    direction : array_like
+        Direction of motion on the branch, +1 or -1 (broadcast against ``F``).
+    friction : Dahl
+        The friction model (``sigma`` [N/m], ``Fc`` [N], ``gamma``).
+
+    Returns
+    -------
+    numpy.ndarray
+        Stored energy [J], >= 0.
+    """
+    friction = check_dahl(friction)
+    F = np.asarray(F, dtype=float)
+    s = np.asarray(direction, dtype=float)
+    if not np.all(np.abs(s) == 1.0):
+        bad = s[np.abs(s) != 1.0].flat[0]
+        raise ValueError(f"direction must be +1 or -1 (every entry), got {float(bad)!r}")
+    Fc = friction.Fc
+    if np.any(~(np.abs(F) <= Fc * (1.0 + ROUNDING))):
+        bad = F[~(np.abs(F) <= Fc * (1.0 + ROUNDING))].flat[0]
+        raise ValueError(f"F must lie in [-Fc, Fc] = [{-Fc!r}, {Fc!r}] (every entry), got {float(bad)!r}")
+    f = np.clip(s * F / Fc, -1.0, 1.0)
+    return (Fc * Fc / friction.sigma) * np.asarray(branch_potential(f, friction.gamma), dtype=float)
+
+
+def dissipation(E_p: Any, *, input_work: Any = None) -> np.ndarray:
+    """Energy dissipated in each half-cycle between reversals [J] (2.10).
+
+    ``E_d[k] = E_p[k] - E_p[k + 1]`` (+ ``input_work[k]``, the work of an external force over
+    the half-cycle, for forced motion).
+
+    Parameters
+    ----------
+    E_p : array_like
+        Potential energy at consecutive reversals [J], length n >= 1.
+    input_work : array_like, optional
+        Work of the external force in each half-cycle [J], length n - 1.
+
+    Returns
+    -------
+    numpy.ndarray
+        Length n - 1.
+    """
+    E_p = np.asarray(E_p, dtype=float)
+    if E_p.ndim != 1:
+        raise ValueError(f"E_p must be a 1-D array, got shape {E_p.shape}")
+    E_d = E_p[:-1] - E_p[1:]
+    if input_work is not None:
+        w = np.asarray(input_work, dtype=float)
+        if w.shape != E_d.shape:
+            raise ValueError(f"input_work has shape {w.shape}, expected {E_d.shape} (one value per half-cycle)")
+        E_d = E_d + w
+    return E_d
+
+
+def series(E_p: Any, E_d: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Partial sums of the dissipation series (2.11), ``E_p(i) = sum_{n >= i} E_d(n)``.
+
+    With n reversals the data hold ``E_d(i)`` for ``i < n - 1`` only, so the series is
+    truncated: ``S[i] = sum_{j=i}^{n-2} E_d[j]`` and the remainder ``R[i] = E_p[i] - S[i]``
+    is the part of the series not yet dissipated. If (2.10) holds, ``R[i] = E_p[n-1]`` for
+    every ``i`` (to rounding), and (2.11) states ``R -> 0`` as more reversals are added.
+
+    Parameters
+    ----------
+    E_p : array_like
+        Potential energy at the reversals [J], length n.
+    E_d : array_like
+        Dissipation per half-cycle [J], length n - 1 (``E_d[k]`` from reversal k to k + 1).
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray)
+        Partial sums ``S`` and remainders ``R``, each of length n [J].
+    """
+    E_p = np.asarray(E_p, dtype=float)
+    E_d = np.asarray(E_d, dtype=float)
+    if E_d.shape != (E_p.size - 1,) or E_p.ndim != 1:
+        raise ValueError(f"E_d must have length len(E_p) - 1 = {E_p.size - 1}, got shape {E_d.shape}")
+    S = np.concatenate((np.cumsum(E_d[::-1])[::-1], [0.0]))
+    return S, E_p - S
+
+
+@dataclass(frozen=True)
+class BoundCheck:
+    """How far the potential energy at the reversals stays below the bound (2.12).
+
+    Attributes
+    ----------
+    bound : float
+        The paper's bound ``Fc^2 / (2 k_min)`` [J] with ``k_min = sigma``, the least tangent
+        stiffness of the Dahl model on an unloading branch (any ``gamma >= 0``).
+    bound_sharp : float
+        The least upper bound for this ``gamma``, ``(Fc^2/sigma) H_gamma(-1)`` [J]
+        (``(1 - ln 2) Fc^2/sigma`` for ``gamma = 1``; equal to ``bound`` for ``gamma = 0``).
+    max_E_p : float
+        Largest potential energy at a reversal [J].
+    index : int
+        Reversal at which it occurs.
+    ratio : float
+        ``max_E_p / bound`` (<= 1 when (2.12) holds).
+    margin : float
+        ``bound - max_E_p`` [J] (>= 0 when (2.12) holds).
+    ratio_sharp : float
+        ``max_E_p / bound_sharp``.
+    holds : bool
+        ``max_E_p <= bound`` up to rounding. (2.12) is stated strictly; equality is reached
+        by ``gamma = 0`` after saturation, see ``strict``.
+    strict : bool
+        ``max_E_p < bound``.
+    holds_sharp : bool
+        ``max_E_p <= bound_sharp`` up to rounding.
+    E_0 : float or None
+        Energy of the initial state [J], if known. The first excursion from the initial
+        velocity is not bounded by (2.12) (gross sliding), so it is reported, not checked.
+    initial_ratio : float or None
+        ``E_0 / bound``; > 1 means the first excursion starts in gross sliding.
+    """
+
+    bound: float
+    bound_sharp: float
+    max_E_p: float
+    index: int
+    ratio: float
+    margin: float
+    ratio_sharp: float
+    holds: bool
+    strict: bool
+    holds_sharp: bool
+    E_0: Optional[float]
+    initial_ratio: Optional[float]
+
+    def format(self) -> str:
+        """Readable summary of the check, one line per bound."""
+        lines = [
+            f"(2.12) E_p <= Fc^2/(2 sigma) = {self.bound:.6e} J: "
+            f"{'holds' if self.holds else 'VIOLATED'}{'' if self.strict or not self.holds else ' (with equality)'}, "
+            f"max E_p = {self.max_E_p:.6e} J at reversal {self.index + 1}, ratio {self.ratio:.6f}, margin {self.margin:.3e} J",
+            f"sharp bound (Fc^2/sigma) H_gamma(-1) = {self.bound_sharp:.6e} J: "
+            f"{'holds' if self.holds_sharp else 'VIOLATED'}, ratio {self.ratio_sharp:.6f}",
+        ]
+        if self.E_0 is not None:
+            note = "gross sliding in the first excursion, not covered by (2.12)" if self.initial_ratio > 1 else "within the bound"
+            lines.append(f"initial energy E_0 = {self.E_0:.6e} J = {self.initial_ratio:.4g} x bound ({note})")
+        return "\n".join(lines)
+
+
+def bound_check(E_p: Any, *, friction: Dahl, E_0: Optional[float] = None) -> BoundCheck:
+    """Check the bound (2.12) ``E_p(i) < Fc^2 / (2 k_min)`` and report by how much it holds.
+
+    For the Dahl model (3.2) with ``gamma >= 0`` the tangent stiffness on an unloading branch
+    (``s F <= 0``) is ``sigma (1 - f)^gamma >= sigma``, so ``k_min = sigma``. The sharp bound
+    is the potential energy of a reversal at full saturation, ``(Fc^2/sigma) H_gamma(-1)``,
+    ``(1 - ln 2) Fc^2/sigma = 0.306853 Fc^2/sigma`` for ``gamma = 1`` (paper, after (3.9)).
+
+    Parameters
+    ----------
+    E_p : float or array_like
+        Potential energy at the reversals [J], length >= 1.
+    friction : Dahl
+        The friction model.
+    E_0 : float, optional
+        Energy of the initial state [J]; reported (ratio to the bound), never checked.
+
+    Returns
+    -------
+    BoundCheck
+    """
+    friction = check_dahl(friction)
+    E_p = np.atleast_1d(np.asarray(E_p, dtype=float))
+    if E_p.ndim != 1 or E_p.size < 1:
+        raise ValueError(f"E_p must be a number or a non-empty 1-D array, got shape {E_p.shape}")
+    scale = friction.Fc**2 / friction.sigma
+    bound = 0.5 * scale
+    sharp = scale * float(branch_potential(-1.0, friction.gamma))
+    i = int(np.argmax(E_p))
+    top = float(E_p[i])
+    e0 = None if E_0 is None else float(E_0)
+    return BoundCheck(
+        bound=bound,
+        bound_sharp=sharp,
+        max_E_p=top,
+        index=i,
+        ratio=top / bound,
+        margin=bound - top,
+        ratio_sharp=top / sharp,
+        holds=top <= bound * (1.0 + ROUNDING),
+        strict=top < bound,
+        holds_sharp=top <= sharp * (1.0 + ROUNDING),
+        E_0=e0,
+        initial_ratio=None if e0 is None else e0 / bound,
+    )
