@@ -32,6 +32,7 @@ from typing import Callable, Optional
 
 import numpy as np
 
+from .dahl import next_amplitude
 from .models import Dahl, Oscillator
 from .reversals import ReversalTable
 from .simulate import METHODS, simulate
@@ -249,6 +250,7 @@ def headline(ladder: list[float], repeats: int, peers: bool, budget: float) -> l
     case = HEADLINE
     ref = _exact(case, N_REV)
     # simulate runs take milliseconds: more repeats for the same confidence in the minimum
+    _progress(f"headline: simulate over {len(ladder)} tolerances")
     rows = [_simulate_point(case, tol, m, ref, 4 * repeats) for m in METHODS for tol in ladder]
     if not peers:
         return rows
@@ -259,6 +261,7 @@ def headline(ladder: list[float], repeats: int, peers: bool, budget: float) -> l
         solvers.append((f"scipy {m} |v| form", lambda tol, m=m: _scipy_noevents(case, tol, m)))
     solvers.append(("python-control |v| form", lambda tol: _control(case, tol)))
     for name, fn in solvers:
+        _progress(f"headline: {name}")
         for tol in ladder:
             try:
                 with warnings.catch_warnings():
@@ -295,7 +298,9 @@ class StabilityRow:
 def stability(ladder: list[float], n_long: int, tol_long: float) -> tuple[list[StabilityRow], list[Row]]:
     """Every stiff/extreme case over the ladder (50 reversals) and one run of ``n_long`` reversals."""
     out, rows = [], []
-    for case in stability_cases():
+    cases = stability_cases()
+    for k, case in enumerate(cases, 1):
+        _progress(f"stability [{k}/{len(cases)}]: {case.name}")
         ref = _exact(case, max(n_long, N_REV))
         worst, worst_tol = 0.0, ladder[0]
         for tol in ladder:
@@ -312,6 +317,27 @@ def stability(ladder: list[float], n_long: int, tol_long: float) -> tuple[list[S
         out.append(StabilityRow(case.name, worst, worst_tol, e50, eall, len(tab), tol_long,
                                 r.stats.wall_time, drift, ok))
     return out, rows
+
+
+def _progress(message: str) -> None:
+    """One progress line on stderr (the tables go to stdout)."""
+    print(f"  ... {message}", file=sys.stderr, flush=True)
+
+
+def analytics_timing(repeats: int, n_amp: int = 1_000_000, n_rev: int = 10_000) -> list[str]:
+    """Lines timing the exact analytics: :func:`prefriction.dahl.next_amplitude` on ``n_amp``
+    amplitudes against ``numpy.exp`` on the same array, and :func:`exact_reversals` for ``n_rev``
+    reversals of the headline case (minimum of ``repeats`` warm runs)."""
+    a = np.logspace(-12, 0, n_amp)
+    _, t_map = _timed(lambda: (next_amplitude(a),), repeats)
+    _, t_exp = _timed(lambda: (np.exp(a),), repeats)
+    _, t_ref = _timed(lambda: (_exact(HEADLINE, n_rev),), max(1, repeats // 2))
+    return [
+        f"next_amplitude on {n_amp:.0e} amplitudes in [1e-12, 1]: {t_map * 1e3:.1f} ms "
+        f"= {t_map / t_exp:.0f} x numpy.exp on the same array ({t_exp * 1e3:.2f} ms)",
+        f"exact_reversals, {n_rev} reversals of the headline case: {t_ref * 1e3:.0f} ms "
+        f"({t_ref / n_rev * 1e6:.1f} us per reversal)",
+    ]
 
 
 def linear_cost(tol: float, n_long: int, repeats: int) -> tuple[float, float]:
@@ -453,6 +479,9 @@ def main(argv: Optional[list[str]] = None) -> int:
           f"linearly with the number of cycles)\n")
     print(format_stability(stab))
     t50, tlong = linear_cost(1e-8, n_long, repeats)
+    print("\nExact analytics (the reference itself):")
+    for line in analytics_timing(repeats, n_amp=100_000 if args.quick else 1_000_000):
+        print("  " + line)
     comp = sum(r.compile_seconds for r in rows + stab_rows if r.note == "compiled")
     print(f"\nOne-time JIT compile (gcc, cached on disk): {comp:.1f} s in this run "
           f"(0 when every integrator was already in the cache)")
