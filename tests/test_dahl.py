@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-import time
 
 import mpmath as mp
 import numpy as np
@@ -63,9 +62,7 @@ def test_next_amplitude_monotone_and_contracting(a: float, b: float) -> None:
 
 def test_amplitude_sequence_1e5_steps_against_mpmath() -> None:
     n = 100_000
-    t0 = time.perf_counter()
     seq = dahl.amplitude_sequence(1.0, n)
-    assert time.perf_counter() - t0 < 5.0
     # reference: the recursion in mpmath (120-bit binary floats, raw libmp calls for speed),
     # each step the root of H(b) = H(-a) (energy balance (3.9) = (3.7)) refined by one Newton
     # step from the double value; the Newton correction is checked to be small, so the refined

@@ -9,7 +9,6 @@ potential H evaluated with 40 guard digits, mp.findroot for the reversal force a
 from __future__ import annotations
 
 import math
-import time
 
 import mpmath as mp
 import numpy as np
@@ -228,11 +227,9 @@ def test_gamma1_amplitudes_follow_the_map_and_energy_bookkeeping():
 
 
 @pytest.mark.parametrize("g", [0.5, 1.0, 5.0])
-def test_ten_thousand_reversals_fast(g):
+def test_ten_thousand_reversals_tend_to_the_linear_period(g):
     system = pf.Oscillator(pf.Dahl(sigma=1e4, Fc=1.0, gamma=g), mass=1.0)
-    t0 = time.perf_counter()
-    table = pf.exact_reversals(system, 0.01, 10_000)
-    assert time.perf_counter() - t0 < 3.0  # about 0.3 s on an idle core
+    table = pf.exact_reversals(system, 0.01, 10_000)  # timed in `prefriction bench`, not here
     # late half-cycles tend to the linear period pi sqrt(m / sigma)
     assert (table.t[-1] - table.t[-2]) == pytest.approx(math.pi * 1e-2, rel=1e-5)
 
