@@ -23,7 +23,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
-from typing import Optional, Union
+from typing import Any, Optional, Union
 
 import numpy as np
 
@@ -221,14 +221,7 @@ def simulate(
         n_c = feedback.n_states if fb_kind == "continuous" else 0
         r_kind = checked_signal_kind(feedback.reference, "feedback.reference")
     want_dense = not (dense is False or dense is None)
-    if want_dense and not isinstance(dense, bool):
-        times_si = np.asarray(dense, dtype=float)
-        if times_si.ndim != 1 or times_si.size < 1 or not np.all(np.isfinite(times_si)):
-            raise ValueError("dense must be True, False or a 1-D array of finite sample times [s]")
-        if np.any(np.diff(times_si) <= 0) or times_si[0] < 0 or times_si[-1] > t_end_si:
-            raise ValueError(f"dense sample times must increase and lie in [0, t_end] = [0, {t_end_si!r}] s")
-    elif want_dense:
-        times_si = None
+    times_si = _dense_times(dense, t_end_si) if want_dense and not isinstance(dense, bool) else None
     if want_dense and fb_kind == "sampled":
         raise ValueError("dense samples are not available with a sampled controller: its samples are at k Ts")
     spec = PlantSpec(
@@ -249,32 +242,8 @@ def simulate(
     run.P0 = run._constant_params(run.L)
     run.force_scale = applied_force_scale(system, u_kind, feedback, r_kind, x0, t_end_si) / Fc if forced else 0.0
 
-    # initial state (normalised)
-    u0 = eval_signal(system.u, u_kind, np.array([0.0]))[0] if system.forced else 0.0
     xc0 = np.array(feedback.xc0, dtype=float) if feedback is not None else np.zeros(0)
-    if feedback is not None:
-        r0 = eval_signal(feedback.reference, r_kind, np.array([0.0]))[0]
-        e0 = r0 - x0
-        u0 += float(feedback.C[0] @ xc0 + feedback.D[0, 0] * e0)
-    acc0 = (u0 - F0) / Fc
-    rest = 0.0
-    if v0 != 0.0:
-        s0 = 1.0 if v0 > 0 else -1.0
-    elif abs(acc0) > 1e-14:
-        s0 = 1.0 if acc0 > 0 else -1.0
-    else:
-        s0, rest = (-1.0 if F0 > 0 else 1.0), 1.0
-        if not forced and t_end is None:
-            raise ValueError("v0 = 0 and F0 = 0 without input: the mass rests, no reversal will come; give t_end")
-    gamma = system.friction.gamma
-    if s0 * F0 >= Fc and gamma >= 1.0:
-        raise ValueError(
-            f"F0 = {F0!r} is the Coulomb force Fc in the direction of motion, which the Dahl branch "
-            f"reaches only asymptotically for gamma = {gamma!r} >= 1; use |F0| < Fc"
-        )
-    run.st = {"x": x0 / sc.x, "v": v0 / sc.v, "F": F0 / sc.F, "p": p_of_force(s0 * F0 / Fc, gamma),
-              "t": 0.0, "s": s0, "sat": 1.0 if s0 * F0 >= Fc else 0.0, "rest": rest,
-              "W": 0.0, "Ef": 0.0, "xc": xc0, "uhold": 0.0}
+    run.st, s0 = _initial_state(run, x0, v0, F0, xc0, stops=forced or t_end is not None)
     breaks = []
     if u_kind == "samples":
         breaks.append(np.asarray(system.u[0]) / sc.t)
@@ -285,56 +254,121 @@ def simulate(
     t_end_n = t_end_si / sc.t
 
     start = time.perf_counter()
-    samples: list = []
     u_hist: list = []
     if fb_kind == "sampled":
-        Ts = feedback.Ts / sc.t
-        xc = xc0.copy()
-        k = 0
-        while True:
-            tk = min(k * Ts, t_end_n)
-            t_si = tk * sc.t
-            e = eval_signal(feedback.reference, r_kind, np.array([t_si]))[0] - run.st["x"] * sc.x
-            uk = float(feedback.C[0] @ xc + feedback.D[0, 0] * e)
-            run.st["uhold"] = uk
-            run.st["xc"] = xc.copy()
-            samples.append(run.sample())
-            u_hist.append(uk + eval_signal(system.u, u_kind, np.array([t_si]))[0])
-            if tk >= t_end_n * (1 - 1e-12):
-                break
-            xc = feedback.A @ xc + feedback.B[:, 0] * e
-            if run.advance(min((k + 1) * Ts, t_end_n), n_target):
-                break
-            k += 1
-        status = "reversals" if len(run.rev) >= n_target else "t_end"
+        samples, u_hist = _sampled_loop(run, xc0, t_end_n, n_target)
     elif want_dense:
-        if times_si is None:
-            stop_t = t_end_n
-            stopped = False
-            t0 = 0.0
-            while not stopped and t0 <= stop_t:
-                block = t0 + _DENSE_STEP * np.arange(0, 256)
-                block = block[block <= stop_t]
-                if block.size == 0:
-                    break
-                got, stopped = run.dense(block, stop_t, n_target)
-                samples.extend(got)
-                t0 = block[-1] + _DENSE_STEP
-        else:
-            got, stopped = run.dense(times_si / sc.t, t_end_n, n_target)
-            samples.extend(got)
-            if not stopped and t_end is not None:
-                stopped = run.advance(t_end_n, n_target)
-            elif not stopped:
-                stopped = run.advance(math.inf, n_target)
-        status = "reversals" if len(run.rev) >= n_target else "t_end"
+        samples = _dense_loop(run, None if times_si is None else times_si / sc.t, t_end_n, n_target)
     else:
-        stopped = run.advance(t_end_n, n_target)
-        status = "reversals" if stopped else "t_end"
+        samples = []
+        run.advance(t_end_n, n_target)
+    status = "reversals" if len(run.rev) >= n_target else "t_end"
     wall = time.perf_counter() - start
 
-    # reversal table (SI)
-    rev = run.rev[: int(min(len(run.rev), n_target))]
+    table, W_r = _reversal_table(run.rev[: int(min(len(run.rev), n_target))], system, s0, v0, F0)
+    stats = RunStats(wall_time=wall, setup_time=run.setup_time, calls=run.calls, steps=run.steps, jit=run.mode)
+    extra = _samples_si(run, samples, u_hist, times_si) if samples else {}
+    return SimulationResult(reversals=table, status=status, stats=stats, work_input=W_r, **extra)
+
+
+def _dense_times(dense: Any, t_end: float) -> np.ndarray:
+    """The requested sample times [s] as an array; ``ValueError`` unless increasing within [0, t_end]."""
+    times = np.asarray(dense, dtype=float)
+    if times.ndim != 1 or times.size < 1 or not np.all(np.isfinite(times)):
+        raise ValueError("dense must be True, False or a 1-D array of finite sample times [s]")
+    if np.any(np.diff(times) <= 0) or times[0] < 0 or times[-1] > t_end:
+        raise ValueError(f"dense sample times must increase and lie in [0, t_end] = [0, {t_end!r}] s")
+    return times
+
+
+def _initial_state(run: Run, x0: float, v0: float, F0: float, xc0: np.ndarray, *, stops: bool) -> tuple[dict, float]:
+    """Normalised initial state of ``run`` and the initial branch direction ``s0``.
+
+    If ``v0 = 0`` the motion starts in the direction of the net force; with no net force the mass
+    rests (``ValueError`` unless the run ``stops`` at a time: no reversal would ever come).
+    """
+    system, feedback, sc = run.system, run.fb, run.sc
+    Fc, gamma = system.friction.Fc, system.friction.gamma
+    u0 = eval_signal(system.u, run.u_kind, np.array([0.0]))[0] if system.forced else 0.0
+    if feedback is not None:
+        e0 = eval_signal(feedback.reference, run.r_kind, np.array([0.0]))[0] - x0
+        u0 += float(feedback.C[0] @ xc0 + feedback.D[0, 0] * e0)
+    acc0 = (u0 - F0) / Fc
+    rest = 0.0
+    if v0 != 0.0:
+        s0 = 1.0 if v0 > 0 else -1.0
+    elif abs(acc0) > 1e-14:
+        s0 = 1.0 if acc0 > 0 else -1.0
+    else:
+        s0, rest = (-1.0 if F0 > 0 else 1.0), 1.0
+        if not stops:
+            raise ValueError("v0 = 0 and F0 = 0 without input: the mass rests, no reversal will come; give t_end")
+    if s0 * F0 >= Fc and gamma >= 1.0:
+        raise ValueError(
+            f"F0 = {F0!r} is the Coulomb force Fc in the direction of motion, which the Dahl branch "
+            f"reaches only asymptotically for gamma = {gamma!r} >= 1; use |F0| < Fc"
+        )
+    st = {"x": x0 / sc.x, "v": v0 / sc.v, "F": F0 / sc.F, "p": p_of_force(s0 * F0 / Fc, gamma),
+          "t": 0.0, "s": s0, "sat": 1.0 if s0 * F0 >= Fc else 0.0, "rest": rest,
+          "W": 0.0, "Ef": 0.0, "xc": xc0, "uhold": 0.0}
+    return st, s0
+
+
+def _sampled_loop(run: Run, xc0: np.ndarray, t_end: float, n_target: float) -> tuple[list, list]:
+    """Closed loop with a sampled controller: hold its output over each period ``Ts`` up to the
+    normalised time ``t_end`` or ``n_target`` reversals; returns the samples at ``k Ts`` and the
+    total applied force there [N]."""
+    system, feedback, sc = run.system, run.fb, run.sc
+    samples: list = []
+    u_hist: list = []
+    Ts = feedback.Ts / sc.t
+    xc = xc0.copy()
+    k = 0
+    while True:
+        tk = min(k * Ts, t_end)
+        t_si = tk * sc.t
+        e = eval_signal(feedback.reference, run.r_kind, np.array([t_si]))[0] - run.st["x"] * sc.x
+        uk = float(feedback.C[0] @ xc + feedback.D[0, 0] * e)
+        run.st["uhold"] = uk
+        run.st["xc"] = xc.copy()
+        samples.append(run.sample())
+        u_hist.append(uk + eval_signal(system.u, run.u_kind, np.array([t_si]))[0])
+        if tk >= t_end * (1 - 1e-12):
+            break
+        xc = feedback.A @ xc + feedback.B[:, 0] * e
+        if run.advance(min((k + 1) * Ts, t_end), n_target):
+            break
+        k += 1
+    return samples, u_hist
+
+
+def _dense_loop(run: Run, times: Optional[np.ndarray], t_end: float, n_target: float) -> list:
+    """Samples at the normalised ``times`` (every ``_DENSE_STEP`` if None), integrating up to the
+    normalised time ``t_end`` or ``n_target`` reversals."""
+    if times is not None:
+        samples, stopped = run.dense(times, t_end, n_target)
+        if not stopped:
+            run.advance(t_end, n_target)
+        return samples
+    samples: list = []
+    stopped = False
+    t0 = 0.0
+    while not stopped and t0 <= t_end:
+        block = t0 + _DENSE_STEP * np.arange(0, 256)
+        block = block[block <= t_end]
+        if block.size == 0:
+            break
+        got, stopped = run.dense(block, t_end, n_target)
+        samples.extend(got)
+        t0 = block[-1] + _DENSE_STEP
+    return samples
+
+
+def _reversal_table(rev: list, system: Oscillator, s0: float, v0: float, F0: float) -> tuple[ReversalTable, np.ndarray]:
+    """The reversals ``(t~, x~, F~, W~)`` as a :class:`ReversalTable` in SI, and the input's work
+    over each half-cycle [J]; ``E_p`` is the branch potential (3.9), ``E_d`` the balance (2.10)."""
+    sc = Scales.of(system)
+    Fc, gamma = system.friction.Fc, system.friction.gamma
     R = np.array(rev, dtype=float).reshape(-1, 4)
     t_r, x_r, F_r, W_r = R[:, 0] * sc.t, R[:, 1] * sc.x, R[:, 2] * sc.F, R[:, 3] * sc.E
     s_after = s0 * (-1.0) ** (np.arange(1, len(R) + 1))
@@ -344,30 +378,33 @@ def simulate(
     if len(R):
         E_d[0] = E0 - E_p[0] + W_r[0]
         E_d[1:] = E_p[:-1] + W_r[1:] - E_p[1:]
-    table = ReversalTable(t=t_r, x=x_r, F=F_r, E_p=E_p, E_d=E_d, E_0=E0)
-    stats = RunStats(wall_time=wall, setup_time=run.setup_time, calls=run.calls, steps=run.steps, jit=run.mode)
-    extra: dict = {}
-    if samples:
-        S = list(zip(*samples))
-        ts = np.array(S[0]) * sc.t
-        if want_dense and times_si is not None:
-            ts = times_si[: len(ts)].copy()  # the requested times exactly (no unit round trip)
-        extra = {
-            "t": ts, "x": np.array(S[1]) * sc.x, "v": np.array(S[2]) * sc.v, "F": np.array(S[3]) * sc.F,
-        }
-        extra["E_k"] = 0.5 * system.mass * extra["v"] ** 2
-        if want_dense:
-            extra["E_f"] = np.array(S[4]) * sc.E
-        if forced:
-            if fb_kind == "sampled":
-                extra["u"] = np.array(u_hist)
-            else:
-                uu = eval_signal(system.u, u_kind, ts)
-                if feedback is not None:
-                    xcs = np.array(S[5]).reshape(len(ts), -1)
-                    e = eval_signal(feedback.reference, r_kind, ts) - extra["x"]
-                    uu = uu + (xcs @ feedback.C[0] if n_c else 0.0) + feedback.D[0, 0] * e
-                extra["u"] = uu
-        if feedback is not None:
-            extra["xc"] = np.array(S[5]).reshape(len(ts), -1)
-    return SimulationResult(reversals=table, status=status, stats=stats, work_input=W_r, **extra)
+    return ReversalTable(t=t_r, x=x_r, F=F_r, E_p=E_p, E_d=E_d, E_0=E0), W_r
+
+
+def _samples_si(run: Run, samples: list, u_hist: list, times_si: Optional[np.ndarray]) -> dict:
+    """The samples ``(t~, x~, v~, F~, E_f~, xc)`` of ``run`` as the SI fields of :class:`SimulationResult`;
+    ``times_si`` are the requested sample times [s] (None: every ``_DENSE_STEP``)."""
+    system, feedback, sc = run.system, run.fb, run.sc
+    S = list(zip(*samples))
+    ts = np.array(S[0]) * sc.t
+    if run.spec.energy and times_si is not None:
+        ts = times_si[: len(ts)].copy()  # the requested times exactly (no unit round trip)
+    extra = {
+        "t": ts, "x": np.array(S[1]) * sc.x, "v": np.array(S[2]) * sc.v, "F": np.array(S[3]) * sc.F,
+    }
+    extra["E_k"] = 0.5 * system.mass * extra["v"] ** 2
+    if run.spec.energy:
+        extra["E_f"] = np.array(S[4]) * sc.E
+    if system.forced or feedback is not None:
+        if run.spec.fb == "sampled":
+            extra["u"] = np.array(u_hist)
+        else:
+            uu = eval_signal(system.u, run.u_kind, ts)
+            if feedback is not None:
+                xcs = np.array(S[5]).reshape(len(ts), -1)
+                e = eval_signal(feedback.reference, run.r_kind, ts) - extra["x"]
+                uu = uu + (xcs @ feedback.C[0] if run.spec.n_c else 0.0) + feedback.D[0, 0] * e
+            extra["u"] = uu
+    if feedback is not None:
+        extra["xc"] = np.array(S[5]).reshape(len(ts), -1)
+    return extra
