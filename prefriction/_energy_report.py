@@ -11,6 +11,7 @@ from ._energy_balance import BoundCheck, bound_check, branch_energy, dissipation
 from ._energy_checks import ROUNDING, check_dahl_system, check_method, check_samples
 from ._sampled_energy import cumulative, kinetic_energy
 from ._sampled_reversals import SampledReversals, find_reversals
+from ._signals import eval_signal, signal_kind
 from .models import Oscillator
 from .reversals import ReversalTable
 
@@ -119,18 +120,15 @@ class EnergyReport:
 
 
 def _rel_residual(values: np.ndarray, scale: float) -> float:
+    """``max |values|`` relative to ``scale`` (absolute if ``scale`` is 0); 0 for no values."""
     if values.size == 0:
         return 0.0
     return float(np.max(np.abs(values)) / scale) if scale > 0 else float(np.max(np.abs(values)))
 
 
 def _input_power(system: Oscillator, t: np.ndarray, v: np.ndarray) -> np.ndarray:
-    u = system.u
-    if callable(u):
-        values = np.array([float(u(ti)) for ti in t])
-    else:
-        values = np.interp(t, u[0], u[1])
-    return values * v
+    """Power ``u v`` [W] of the input force at the samples."""
+    return eval_signal(system.u, signal_kind(system.u), t) * v
 
 
 def _work_to_reversals(t: np.ndarray, p: np.ndarray, rev: SampledReversals, method: str) -> np.ndarray:

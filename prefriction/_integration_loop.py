@@ -346,7 +346,9 @@ class Run:
     def dense(self, times: np.ndarray, t_end: float, n_target: float) -> tuple[list, bool]:
         """Integrate through the sorted normalised ``times``; returns the samples and the stop flag."""
         samples = []
-        grid = np.union1d(times, self.breaks[(self.breaks > self.st["t"]) & (self.breaks < t_end)])
+        # breaks up to the last requested time only: the caller continues from there
+        last = min(t_end, float(times[-1]))
+        grid = np.union1d(times, self.breaks[(self.breaks > self.st["t"]) & (self.breaks < last)])
         is_sample = np.isin(grid, times)
         i = 0
         if grid.size and grid[0] <= self.st["t"]:

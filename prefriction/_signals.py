@@ -7,6 +7,7 @@ A signal is ``None``, a constant, a callable of time [s] (traced with a CasADi s
 from __future__ import annotations
 
 import warnings
+from dataclasses import dataclass
 from typing import Any, Optional
 
 import casadi as ca
@@ -15,6 +16,17 @@ import numpy as np
 from ._feedback import LinearFeedback
 from ._plant import trace_signal
 from .models import Oscillator
+
+
+@dataclass(frozen=True)
+class ConstantSignal:
+    """A constant signal [SI] as a callable of time, equal (and hashed) by value, so that a plant
+    with a constant input force is built once per value."""
+
+    value: float
+
+    def __call__(self, t: Any) -> float:
+        return self.value
 
 
 def signal_kind(value: Any) -> str:

@@ -31,7 +31,7 @@ from ._branch import branch_potential
 from ._feedback import LinearFeedback
 from ._integration_loop import N_DENSE, Run
 from ._plant import Layout, PlantSpec, p_of_force
-from ._signals import applied_force_scale, checked_signal_kind, eval_signal
+from ._signals import ConstantSignal, applied_force_scale, checked_signal_kind, eval_signal
 from ._validation import check_count, check_finite, check_positive
 from .models import Dahl, Oscillator
 from .reversals import ReversalTable
@@ -226,7 +226,7 @@ def simulate(
         raise ValueError("dense samples are not available with a sampled controller: its samples are at k Ts")
     spec = PlantSpec(
         u_kind=u_kind if u_kind != "const" else "callable",
-        u_fun=(system.u if u_kind == "callable" else None),
+        u_fun=(system.u if u_kind == "callable" else ConstantSignal(float(system.u)) if u_kind == "const" else None),
         fb=fb_kind, n_c=n_c,
         r_kind=r_kind if fb_kind == "continuous" else "none",
         r_fun=(feedback.reference if r_kind == "callable" and fb_kind == "continuous" else None),
