@@ -66,9 +66,6 @@ class LoopResult:
     simulation : prefriction.simulate.SimulationResult or None
         The raw result of :func:`prefriction.simulate` (run statistics, work of the input);
         ``None`` for a saturated (``u_max``) loop, which calls the simulator once per sample.
-        A sampled loop that starts at rest with no net force (e.g. a delayed step) starts the
-        simulator at the first sample whose force moves the mass; the raw result's times are
-        then relative to that instant (the arrays above are not).
     """
 
     t: np.ndarray
@@ -268,9 +265,9 @@ def simulate_loop(
         A :class:`PID` with a force limit ``u_max`` in a continuous loop (the simulator's
         continuous feedback is linear; the force limit is simulated for sampled loops).
     prefriction.SolverError
-        If the integration fails, or a continuous loop leaves a resting mass frozen under a
-        force that jumps at a reference sample time (a limitation of the simulator; a sampled
-        loop in that situation is re-run per sample instead, exactly).
+        If the integration fails, or if the samples of a continuous loop leave the Dahl branches
+        (the simulator missed a reversal: a resting mass pushed back by a force that jumps at a
+        reference sample time; use a smooth callable reference or a sampled controller).
 
     Warns
     -----
@@ -326,97 +323,49 @@ def simulate_loop(
             dense = np.linspace(0.0, t_end, 2001)
         else:
             dense = np.asarray(t_out, dtype=float)
-    rest = None
-    if Ts is not None and v0 == 0.0 and not system.forced:
-        rest = _rest_preroll(C, reference, x0=x0, F0=F0, xc0=xc0, Ts=Ts, t_end=t_end, Fc=system.friction.Fc)
-    if rest is None:
-        fb = LinearFeedback(A=C.A, B=C.B, C=C.C, D=C.D, Ts=Ts, reference=fb_reference, xc0=xc0)
-        sim = prefriction.simulate(system, v0, x0=x0, F0=F0, t_end=t_end, rtol=rtol, dense=dense, feedback=fb, jit=jit)
-        t, x, v, F, u, xc, table = sim.t, sim.x, sim.v, sim.F, sim.u, sim.xc, sim.reversals
-        t_frozen = _frozen(sim, system.friction.Fc, sampled=Ts is not None)
-        if t_frozen is not None and Ts is None:
-            raise SolverError(
-                f"the mass rests from t = {t_frozen:.6g} s on although the net force u - F is not zero: "
-                "prefriction.simulate does not end a rest when the force jumps at a reference sample "
-                "time. Use a reference without jumps (a smooth callable), or a sampled controller (Ts)"
-            )
-        if t_frozen is not None:
-            if system.forced:
-                raise SolverError(
-                    f"the sampled loop left the mass at rest under a net force at t = {t_frozen:.6g} s "
-                    "(a limitation of prefriction.simulate's sampled feedback); with an input force system.u "
-                    "controllers cannot re-run it per sample: use a continuous controller"
-                )
-            out = simulate_saturated(
-                system, C, np.zeros(C.nstates), math.inf, lambda tt: _evaluate(reference, tt), t_end, Ts,
-                x0=x0, v0=v0, F0=F0, xc0=xc0, rtol=rtol, jit=jit,
-            )
-            t, x, v, F, u, xc, table = (out[key] for key in ("t", "x", "v", "F", "u", "xc", "reversals"))
-            sim = None
-    else:  # the mass rests until sample k: start the simulator there (see _rest_preroll)
-        k, xc_k, xc_rest, u_rest = rest
-        tk = k * Ts
-        if isinstance(fb_reference, tuple):
-            fb_reference = (fb_reference[0] - tk, fb_reference[1])
-        fb = LinearFeedback(A=C.A, B=C.B, C=C.C, D=C.D, Ts=Ts, reference=fb_reference, xc0=xc_k)
-        sim = prefriction.simulate(system, 0.0, x0=x0, F0=F0, t_end=t_end - tk, rtol=rtol, feedback=fb, jit=jit)
-        t = np.concatenate((Ts * np.arange(k), sim.t + tk))
-        x = np.concatenate((np.full(k, float(x0)), sim.x))
-        v = np.concatenate((np.zeros(k), sim.v))
-        F = np.concatenate((np.full(k, float(F0)), sim.F))
-        u = np.concatenate((u_rest, sim.u))
-        xc = np.concatenate((xc_rest, sim.xc.reshape(len(sim.t), -1)))
-        R = sim.reversals
-        table = ReversalTable(t=R.t + tk, x=R.x, F=R.F, E_p=R.E_p, E_d=R.E_d, E_0=R.E_0)
+    fb = LinearFeedback(A=C.A, B=C.B, C=C.C, D=C.D, Ts=Ts, reference=fb_reference, xc0=xc0)
+    sim = prefriction.simulate(system, v0, x0=x0, F0=F0, t_end=t_end, rtol=rtol, dense=dense, feedback=fb, jit=jit)
+    if Ts is None:
+        _check_branches(sim, system, x0, F0)
+    t = sim.t
     r = _evaluate(reference, t)
     return LoopResult(
-        t=t, reference=r, x=x, v=v, F=F, u=u, error=r - x, xc=xc,
-        reversals=table, Ts=Ts, controller=C, system=system, kp=_dc_gain(C), simulation=sim,
+        t=t, reference=r, x=sim.x, v=sim.v, F=sim.F, u=sim.u, error=r - sim.x, xc=sim.xc,
+        reversals=sim.reversals, Ts=Ts, controller=C, system=system, kp=_dc_gain(C), simulation=sim,
     )
 
 
-def _frozen(sim: SimulationResult, Fc: float, *, sampled: bool) -> Optional[float]:
-    """Time [s] of the first output interval in which a resting mass stays put under a net force, or None.
+def _check_branches(sim: SimulationResult, system: Oscillator, x0: float, F0: float) -> None:
+    """Raise :class:`prefriction.SolverError` if a continuous loop's samples leave the Dahl branches.
 
-    Dahl friction has no stiction: a mass at rest with ``u != F`` moves at once. Samples with
-    ``v = 0`` at both ends, the same position, and ``|u - F| > 1e-9 Fc`` (the force held over a
-    sample interval, or the force at the interval's end in a continuous loop) mean the
-    simulator kept a stale rest state.
+    Dahl friction is rate-independent: between two velocity reversals the position is monotone
+    and ``F`` is the branch (3.4)/(3.5) through the previous reversal (or the initial state) as
+    a function of ``x`` alone. ``prefriction.simulate`` can miss a reversal in a continuous loop
+    when a resting mass is pushed back by a force that jumps at a reference sample time (the
+    velocity starts at exactly zero and the net force changes sign before the first step ends);
+    the mass then moves backwards on the old branch. This check finds that (a position step
+    against the branch direction by more than ``1e-6 Fc/sigma``, or ``F`` off the branch by
+    more than ``1e-6 Fc``) instead of returning a wrong trajectory.
     """
-    v, x, u, F = sim.v, sim.x, sim.u, sim.F
-    net = np.abs(u[:-1] - F[:-1]) if sampled else np.abs(u[1:] - F[1:])
-    bad = (v[:-1] == 0.0) & (v[1:] == 0.0) & (x[1:] == x[:-1]) & (net > 1e-9 * Fc)
-    idx = np.nonzero(bad)[0]
-    return float(sim.t[idx[0]]) if idx.size else None
-
-
-def _rest_preroll(
-    C: control.StateSpace, reference: Reference, *, x0: float, F0: float, xc0: Any, Ts: float, t_end: float, Fc: float
-) -> Optional[tuple[int, np.ndarray, np.ndarray, np.ndarray]]:
-    """Samples during which a sampled loop that starts at rest stays at rest.
-
-    With ``v0 = 0`` the mass does not move while the held force equals the friction force,
-    ``u[k] = F0`` (Dahl friction changes only with motion): the plant state is constant and the
-    controller runs on the constant position ``x0``. Returns ``(k, xc[k], xc[:k], u[:k])`` for
-    the first sample ``k >= 1`` whose force differs from ``F0``, or ``None`` if the mass moves
-    at once or never. The simulator then starts at ``t = k Ts`` from the same state; this keeps
-    a delayed step from rest exact whatever the simulator does with a mass at rest between
-    samples.
-    """
-    A, B, Cm, D = (np.asarray(M_, dtype=float) for M_ in (C.A, C.B, C.C, C.D))
-    n = A.shape[0]
-    xc = np.zeros(n) if xc0 is None else np.array(xc0, dtype=float).reshape(-1)
-    if xc.shape != (n,):
-        raise ValueError(f"xc0 must be a finite vector of length {n}, got {xc0!r}")
-    n_max = int(math.floor(t_end / Ts * (1 - 1e-12)))
-    r = _evaluate(reference, Ts * np.arange(n_max + 1))
-    xcs, us = [], []
-    for k in range(n_max + 1):
-        e = r[k] - x0
-        uk = float(Cm[0] @ xc + D[0, 0] * e)
-        if abs(uk - F0) > 1e-14 * Fc:
-            return None if k == 0 else (k, xc, np.array(xcs).reshape(k, n), np.array(us))
-        xcs.append(xc)
-        us.append(uk)
-        xc = A @ xc + B[:, 0] * e
-    return None
+    fr = system.friction
+    Fc, sigma = fr.Fc, fr.sigma
+    R = sim.reversals
+    at, ax, aF = (np.concatenate(([a0], a)) for a0, a in ((0.0, R.t), (x0, R.x), (F0, R.F)))
+    seg = np.searchsorted(at, sim.t, side="right") - 1  # anchor (start of the branch) of each sample
+    d = sim.x - ax[seg]
+    s = np.where(d >= 0.0, 1.0, -1.0)
+    f = force_after_distance(np.clip(s * aF[seg] / Fc, -1.0, 1.0), np.abs(d) * sigma / Fc, fr.gamma)
+    off = np.abs(s * Fc * f - sim.F) > 1e-6 * Fc
+    direction = np.sign(np.concatenate((R.x, [sim.x[-1]])) - ax)  # of each branch
+    first = np.concatenate(([True], seg[1:] != seg[:-1]))
+    prev = np.where(first, ax[seg], np.concatenate(([x0], sim.x[:-1])))
+    off |= direction[seg] * (sim.x - prev) < -1e-6 * Fc / sigma
+    bad = np.nonzero(off)[0]
+    if bad.size:
+        k = bad[0]
+        raise SolverError(
+            f"simulate left the Dahl branch through the reversal at t = {at[seg[k]]:.6g} s before t = {sim.t[k]:.6g} s "
+            f"(state there: x = {sim.x[k]:.6g} m, v = {sim.v[k]:.6g} m/s, F = {sim.F[k]:.6g} N): a velocity reversal "
+            "was missed, as happens when a resting mass is pushed back by a force that jumps at a reference sample "
+            "time. Use a smooth callable reference, or a sampled controller (Ts)"
+        )
