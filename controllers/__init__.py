@@ -12,7 +12,8 @@
 - :func:`plant_iosys` is the same stage as a ``control.NonlinearIOSystem`` for
   ``control.interconnect``; it does not locate reversals (see its notes and
   ``python -m controllers.benchmark`` for the measured shortfall and run times).
-- :mod:`controllers.plotting` draws step responses (``examples/stage_*.py``).
+- :mod:`controllers.plotting` draws step responses; :mod:`controllers.example_stage` holds the
+  stage of ``examples/stage_*.py`` and of the benchmark and runs their step responses.
 """
 
 from __future__ import annotations

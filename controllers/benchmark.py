@@ -23,18 +23,12 @@ from typing import Any, Optional
 import control
 import numpy as np
 
-import prefriction
-
 from ._iosys import plant_iosys
 from ._linear import design_pd
 from ._loop import simulate_loop
+from .example_stage import stage
 
 STEP = 1e-6  # reference step [m]
-
-
-def stage() -> prefriction.Oscillator:
-    """The example stage: m = 1 kg, sigma = 1e6 N/m, Fc = 1 N (see examples/stage_common.py)."""
-    return prefriction.Oscillator(prefriction.Dahl(sigma=1e6, Fc=1.0), mass=1.0)
 
 
 def _loop(P: control.NonlinearIOSystem, C: control.StateSpace) -> control.InterconnectedSystem:

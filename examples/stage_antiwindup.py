@@ -1,7 +1,7 @@
 """PID with a force limit: back-calculation anti-windup on the friction stage (controllers issue).
 
-Stage as in ``stage_pd.py`` (m = 1 kg, sigma = 1e6 N/m, Fc = 1 N, Dahl gamma = 1; round numbers
-of the order of small ball-screw / linear-guide stages, pre-sliding range Fc/sigma = 1 um).
+Stage as in ``stage_pd.py`` (see :mod:`controllers.example_stage`: m = 1 kg, sigma = 1e6 N/m,
+Fc = 1 N, Dahl gamma = 1; pre-sliding range Fc/sigma = 1 um).
 PID as in ``stage_pid.py`` (pre-sliding pole placement at 150 Hz, zeta = 0.7, 10 kHz ZOH), now
 with an actuator limit u_max = 3 N and a 5 um step, five pre-sliding ranges: the stage slides
 and the force saturates. With back-calculation (tracking time sqrt(Ti Td), Astrom and
@@ -19,11 +19,9 @@ from pathlib import Path
 import numpy as np
 
 import controllers
-import prefriction
+from controllers.example_stage import FC, TS, stage, title
 from controllers.plotting import plot_steps
 
-M, SIGMA, FC = 1.0, 1e6, 1.0  # kg, N/m, N
-TS = 1e-4  # s (10 kHz)
 T_END = 0.03  # s
 STEP = 5e-6  # m
 U_MAX = 3.0  # N
@@ -31,7 +29,7 @@ U_MAX = 3.0  # N
 
 def main(outdir: "str | Path" = ".") -> dict:
     """Simulate the saturated loop with and without anti-windup; write the PNG, return the numbers."""
-    system = prefriction.Oscillator(prefriction.Dahl(sigma=SIGMA, Fc=FC), mass=M)
+    system = stage()
     pid = controllers.design_pid(system, wn=2 * np.pi * 150.0, zeta=0.7, u_max=U_MAX)
     clip_only = controllers.PID(kp=pid.kp, ki=pid.ki, kd=pid.kd, tau=pid.tau, u_max=U_MAX, t_track=1e6)
     results = {
@@ -40,7 +38,7 @@ def main(outdir: "str | Path" = ".") -> dict:
     }
     path = plot_steps(
         results, Path(outdir) / "stage_antiwindup.png", bound=FC / pid.kp,
-        title=f"{pid}, Ts = {TS:g} s, 5 um step; stage m = {M:g} kg, sigma = {SIGMA:g} N/m, Fc = {FC:g} N (Dahl)",
+        title=title(pid, ", 5 um step"),
     )
     cases = {}
     for label, res in zip(("anti-windup", "clipping only"), results.values()):

@@ -18,6 +18,7 @@ import pytest
 import controllers
 import prefriction
 from controllers import benchmark
+from controllers.example_stage import report
 
 matplotlib.use("Agg")
 
@@ -56,6 +57,8 @@ def test_stage_pd_example(tmp_path):
     s = out["steps"]["10 nm"]
     assert np.max(np.abs(s["F"])) < 0.02 * FC
     assert s["residual_error"] == pytest.approx(1e-8 * SIGMA / (SIGMA + out["kp"]), rel=0.03)
+    text = report(out)
+    assert f"kp = {out['kp']:.4g} N/m" in text and "step 10 nm: residual error" in text
 
 
 def test_stage_pid_example(tmp_path):
@@ -68,6 +71,7 @@ def test_stage_pid_example(tmp_path):
         # final value theorem: integral action, zero static error; far below the PD bound Fc/kp
         assert abs(s["residual_error"]) <= 1e-5 * s["step"]
         assert s["reversals"] >= 1 and len(s["reversal_x"]) == s["reversals"]
+    assert "ki = " in report(out)
 
 
 def test_stage_antiwindup_example(tmp_path):

@@ -106,17 +106,24 @@ def test_linear_regime_references_callable_and_samples():
     assert rel_err(res_c.x, control.forced_response(Tz, res_c.t, r).outputs) <= 1e-6
 
 
-@settings(max_examples=4, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
-@given(wn_ratio=st.floats(1.3, 2.5), zeta=st.floats(0.5, 0.9), step=st.floats(2e-7, 3e-6))
-def test_pd_settles_within_fc_over_kp(wn_ratio, zeta, step):
-    system = stage()
+def _stable_sampled_loop(design, step, t_end):
+    """The design sampled at TS on the Dahl stage; an UnstableLoopWarning fails the test.
+
+    A loop that settles: well damped once sampled (a nearly unstable sampled loop, e.g.
+    wn = 3 sqrt(sigma/m) with zeta = 1 at 10 kHz, 0.2 deg margin, rings for long).
+    """
     with warnings.catch_warnings():
         warnings.simplefilter("error", controllers.UnstableLoopWarning)
-        pd = controllers.design_pd(system, wn=wn_ratio * np.sqrt(SIGMA / M), zeta=zeta)
-        # a loop that settles: well damped once sampled (a nearly unstable sampled loop, e.g.
-        # wn = 3 sqrt(sigma/m) with zeta = 1 at 10 kHz, 0.2 deg margin, rings for long)
-        assert controllers.margins(system, pd.c2d(TS)).phase_margin > 25.0
-        res = controllers.simulate_loop(system, pd.c2d(TS), step, 0.04)
+        c = design(stage())
+        assert controllers.margins(stage(), c.c2d(TS)).phase_margin > 25.0
+        return c, controllers.simulate_loop(stage(), c.c2d(TS), step, t_end)
+
+
+@settings(max_examples=4, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+@given(wn_ratio=st.floats(1.3, 2.2), zeta=st.floats(0.5, 0.9), step=st.floats(2e-7, 3e-6))
+def test_pd_settles_within_fc_over_kp(wn_ratio, zeta, step):
+    pd, res = _stable_sampled_loop(lambda s: controllers.design_pd(s, wn=wn_ratio * np.sqrt(SIGMA / M), zeta=zeta),
+                                   step, 0.04)
     bound = 1.0 / pd.kp  # Fc / kp
     tail = res.t >= 0.03
     assert np.all(np.abs(res.error[tail]) <= bound)
@@ -130,11 +137,7 @@ def test_pd_settles_within_fc_over_kp(wn_ratio, zeta, step):
 @settings(max_examples=3, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
 @given(wn_hz=st.floats(110.0, 200.0), zeta=st.floats(0.6, 0.9), step=st.floats(2e-7, 3e-6))
 def test_pid_drives_error_to_zero(wn_hz, zeta, step):
-    system = stage()
-    with warnings.catch_warnings():
-        warnings.simplefilter("error", controllers.UnstableLoopWarning)
-        c = controllers.design_pid(system, wn=2 * np.pi * wn_hz, zeta=zeta)
-        res = controllers.simulate_loop(system, c.c2d(TS), step, 0.08)
+    _, res = _stable_sampled_loop(lambda s: controllers.design_pid(s, wn=2 * np.pi * wn_hz, zeta=zeta), step, 0.08)
     assert abs(res.residual_error) <= 1e-6 * step
     assert res.kp is None and res.error_bound is None  # integrator: no finite static gain
 
