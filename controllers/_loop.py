@@ -356,10 +356,13 @@ def _check_branches(sim: SimulationResult, system: Oscillator, x0: float, F0: fl
     s = np.where(d >= 0.0, 1.0, -1.0)
     f = force_after_distance(np.clip(s * aF[seg] / Fc, -1.0, 1.0), np.abs(d) * sigma / Fc, fr.gamma)
     off = np.abs(s * Fc * f - sim.F) > 1e-6 * Fc
-    direction = np.sign(np.concatenate((R.x, [sim.x[-1]])) - ax)  # of each branch
     first = np.concatenate(([True], seg[1:] != seg[:-1]))
-    prev = np.where(first, ax[seg], np.concatenate(([x0], sim.x[:-1])))
-    off |= direction[seg] * (sim.x - prev) < -1e-6 * Fc / sigma
+    move = sim.x - np.where(first, ax[seg], np.concatenate(([x0], sim.x[:-1])))  # since the previous sample
+    moved = np.abs(move) > 1e-6 * Fc / sigma
+    direction = np.zeros(len(at))  # of each branch: its first move
+    segs, idx = np.unique(seg[moved], return_index=True)
+    direction[segs] = np.sign(move[moved][idx])
+    off |= moved & (np.sign(move) != direction[seg])
     bad = np.nonzero(off)[0]
     if bad.size:
         k = bad[0]
