@@ -21,6 +21,11 @@ branch returns as kinetic energy until its force zero crossing; ``E_d[k]`` (this
 the energy dissipated in the half-cycle from reversal ``k`` to reversal ``k + 1``, which is the
 paper's ``E_d(i)`` in (2.10). :class:`prefriction.ReversalTable` indexes ``E_d`` by the
 half-cycle that *ends* at a reversal instead: ``table.E_d[k + 1]`` is ``E_d[k]`` here.
+
+The functions live in private modules: reversals in samples :mod:`prefriction._sampled_reversals`,
+energies along samples :mod:`prefriction._sampled_energy`, energies at reversals
+:mod:`prefriction._energy_balance`, the report :mod:`prefriction._energy_report`, argument checks
+:mod:`prefriction._energy_checks`.
 """
 
 from __future__ import annotations

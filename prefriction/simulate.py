@@ -16,6 +16,10 @@ amplitude, so the relative accuracy does not depend on ``sigma``, ``Fc``, the ma
 The internal tolerance is ``rtol`` times a calibration factor such that the error of reversal
 times, positions and forces over 50 reversals stays below ``rtol`` (``prefriction bench``);
 global errors grow linearly with the number of cycles, as for any one-step method.
+
+This module validates the arguments and assembles the result; the integration loop is
+:mod:`prefriction._integration_loop`, the compiled integrator and its buffers
+:mod:`prefriction._buffered_integrator`, the input and reference signals :mod:`prefriction._signals`.
 """
 
 from __future__ import annotations
