@@ -31,7 +31,7 @@ Normalised time is ``t~ = t0 + dur * tau`` with the integrator time ``tau`` and 
 
 Events (the integrator fires when an indicator goes from positive to negative):
 
-- reversal, indicator ``s v``. Unforced: always a reversal (register shift, ``s -> -s``).
+- reversal, indicator ``s v`` (forced: ``s v / Av + EPS_START``). Unforced: always a reversal (register shift, ``s -> -s``).
   Forced: the net force ``a~ = u~ - F~`` decides: ``s a~ < -eps``: a reversal;
   ``s a~ > eps``: the velocity touches zero and keeps its sign (nothing changes); otherwise
   the mass rests (``v = 0``, right-hand side zero).
@@ -62,6 +62,10 @@ EPS_TOUCH = 1e-14
 """Net force (relative to the call's amplitude scale) below which a zero velocity is rest."""
 EPS_REST = 1e-12
 """Net force (relative to the call's amplitude scale) above which a resting mass moves again."""
+EPS_START = 1e-13
+"""Offset of the forced reversal indicator ``s v / Av + EPS_START``: a branch that starts at
+``v = 0`` starts with a positive indicator, so a velocity that turns against ``s`` before it
+has grown (the net force reverses within the first step) still fires the reversal event."""
 
 
 @dataclass(frozen=True)
@@ -281,7 +285,8 @@ def build_integrator(spec: PlantSpec, tol: float, atol: float) -> ca.Function:
     if spec.fb == "continuous" and n:
         ode[L.xc] = run * (ca.mtimes(A, xc) + B * e) / S
     ode = c["dur"] * ode
-    zero = [ca.if_else(run_m > 0.5, s * st["vh"], 1.0)]
+    # forced: offset so that a branch starting at v = 0 has a positive indicator (EPS_START)
+    zero = [ca.if_else(run_m > 0.5, s * st["vh"] + (EPS_START if spec.forced else 0.0), 1.0)]
     if spec.saturates:
         zero.append(ca.if_else(run_m * (1.0 - sat) > 0.5, 1.0 - (1.0 - g) * pp, 1.0))
     if spec.forced:

@@ -320,7 +320,8 @@ def test_sampled_loop_moves_a_resting_mass_again():
     ref = lambda t: 1e-6 if t < 0.04 - 1e-12 else 0.0  # noqa: E731
     res = controllers.simulate_loop(stage(), Cd, ref, 0.06)
     k = 400  # t = 40 ms
-    assert res.t[k] == pytest.approx(0.04) and res.v[k] == 0.0 and res.v[k - 1] == 0.0  # at rest
+    # at rest (|v| at round-off of the mm/s peak speed)
+    assert res.t[k] == pytest.approx(0.04) and abs(res.v[k]) <= 1e-15 and abs(res.v[k - 1]) <= 1e-15
     assert res.x[k] - res.x[k + 5] > 5e-7
     assert np.any(res.reversals.t > 0.04)
     assert rel_err(res.x, _lsoda_sampled(Cd, ref, len(res.t))) <= 1e-8
@@ -349,21 +350,18 @@ def test_continuous_loop_moves_a_resting_mass_with_a_smooth_reference():
     assert rel_err(res.x[k:], _lsoda_continuous(res.controller, ref, y0, t[k:])) <= 1e-8
 
 
-def test_continuous_loop_never_returns_a_wrong_branch():
-    """A jump of a sampled reference while the mass rests: the LSODA trajectory, or a SolverError."""
+def test_continuous_loop_follows_a_reference_jump_from_rest():
+    """A jump of a sampled reference while the mass rests: the LSODA trajectory from 39 ms on."""
     system = stage()
     pd = controllers.design_pd(system, wn=2 * np.pi * 300, zeta=0.5)
     samples = (np.array([0.0, 0.04, 0.04 + 1e-6, 1.0]), np.array([1e-6, 1e-6, 0.0, 0.0]))
     t = np.linspace(0.0, 0.046, 461)
-    try:
-        res = controllers.simulate_loop(system, pd, samples, 0.046, t_out=t)
-    except prefriction.SolverError as exc:
-        assert "left the Dahl branch" in str(exc) and "smooth callable" in str(exc)
-    else:
-        k = 390
-        y0 = np.concatenate(([res.x[k], res.v[k], res.F[k]], res.xc[k]))
-        ref = lambda tt: np.interp(tt, *samples)  # noqa: E731
-        assert rel_err(res.x[k:], _lsoda_continuous(res.controller, ref, y0, t[k:])) <= 1e-8
+    res = controllers.simulate_loop(system, pd, samples, 0.046, t_out=t)
+    k = 390
+    assert np.any(res.reversals.t > 0.04)
+    y0 = np.concatenate(([res.x[k], res.v[k], res.F[k]], res.xc[k]))
+    ref = lambda tt: np.interp(tt, *samples)  # noqa: E731
+    assert rel_err(res.x[k:], _lsoda_continuous(res.controller, ref, y0, t[k:])) <= 1e-8
 
 
 def test_saturated_loop_delayed_step_from_rest():

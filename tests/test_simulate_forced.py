@@ -165,3 +165,23 @@ def test_continuous_loop_with_sampled_reference_matches_python_control() -> None
     x_ref = np.interp(t, tf, ref.outputs)
     assert np.max(np.abs(res.x - x_ref)) <= 1e-6 * np.max(np.abs(x_ref))
     np.testing.assert_allclose(res.u, kp * (np.interp(t, tr, rr) - res.x), rtol=0, atol=1e-9 * kp * 1e-3)
+
+
+def test_net_force_reversing_within_the_first_step_is_a_reversal() -> None:
+    """Start at v = 0 pushed forward by 1 mN, then pulled back by 30 N within 1 us: the velocity turns
+    negative before it has grown, so the branch must flip (scipy LSODA on the |v| form as reference)."""
+    from scipy.integrate import solve_ivp
+
+    ts, us = np.array([0.0, 1e-6, 1.0]), np.array([0.301, -30.0, -30.0])
+    system = pf.Oscillator(pf.Dahl(1.0, 1.0), mass=1.0, u=(ts, us))
+    times = np.array([1e-5, 5e-5, 1e-4])
+    res = pf.simulate(system, 0.0, F0=0.3, t_end=1e-4, dense=times)
+
+    def rhs(t, y):
+        return [y[1], np.interp(t, ts, us) - y[2], y[1] - abs(y[1]) * y[2]]
+
+    ref = solve_ivp(rhs, [0.0, 1e-4], [0.0, 0.0, 0.3], method="LSODA", rtol=1e-12, atol=1e-18,
+                    t_eval=times, max_step=1e-7)
+    assert len(res.reversals) == 1 and res.reversals.t[0] < 1e-6
+    # F moves by about 2e-7 N: on the wrong branch (slope 1 - F instead of 1 + F) it is 46 % off
+    np.testing.assert_allclose(0.3 - res.F, 0.3 - ref.y[2], rtol=1e-5)
