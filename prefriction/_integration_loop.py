@@ -63,7 +63,7 @@ class Run:
         if self.spec.forced:
             self.A_max = max(self.A_max, A)
             A = max(A, self.force_scale, 0.1 * self.A_max)
-        A = max(A, 1e-300)
+        A = max(A, 1e-150)  # AE = A^2 stays a normal double
         Ax = max(A, 0.5 * A * A, min(abs(self.st["x"]), 1.0))  # positions: relative to |x| (<= 1)
         return {"Ax": Ax, "Av": A, "AF": min(A, 1.0), "AE": A * A}
 

@@ -185,3 +185,10 @@ def test_net_force_reversing_within_the_first_step_is_a_reversal() -> None:
     assert len(res.reversals) == 1 and res.reversals.t[0] < 1e-6
     # F moves by about 2e-7 N: on the wrong branch (slope 1 - F instead of 1 + F) it is 46 % off
     np.testing.assert_allclose(0.3 - res.F, 0.3 - ref.y[2], rtol=1e-5)
+
+
+def test_no_force_on_a_mass_at_rest_keeps_it_at_rest() -> None:
+    """u = 0, v0 = 0, F0 = 0: the equilibrium; the mass stays at x = 0 (was: ZeroDivisionError)."""
+    res = pf.simulate(pf.Oscillator(pf.Dahl(1e6, 1.0), u=0.0), 0.0, t_end=1e-3, dense=True)
+    assert res.status == "t_end" and len(res.reversals) == 0 and res.reversals.E_0 == 0.0
+    assert np.all(res.x == 0.0) and np.all(res.v == 0.0) and np.all(res.F == 0.0)
