@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from .models import Dahl, Oscillator
+from .models import Dahl, check_dahl_oscillator
 
 QUADRATURES = ("trapezoid", "simpson")
 """Quadrature rules of the power integrals: cumulative trapezoid or Simpson (scipy)."""
@@ -64,14 +64,7 @@ def check_method(method: Any) -> str:
 
 def check_dahl_system(system: Any) -> tuple[Dahl, float]:
     """Return the Dahl friction model and the mass of ``system``; ``TypeError`` otherwise."""
-    if not isinstance(system, Oscillator):
-        raise TypeError(f"system must be a prefriction.Oscillator, got {system!r} of type {type(system).__name__}")
-    if not isinstance(system.friction, Dahl):
-        raise TypeError(
-            "system.friction must be a prefriction.Dahl model (the branch potential is known for Dahl only), "
-            f"got {system.friction!r}"
-        )
-    return system.friction, system.mass
+    return check_dahl_oscillator(system, "the energy analysis (branch potential)"), system.mass
 
 
 def check_dahl(friction: Any) -> Dahl:

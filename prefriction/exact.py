@@ -37,7 +37,7 @@ from ._branch import (
     potential_of_log_gap,
 )
 from ._validation import check_count, check_finite
-from .models import Dahl, Oscillator
+from .models import Oscillator, check_dahl_oscillator
 from .reversals import ReversalTable
 from .units import Scales
 
@@ -97,13 +97,7 @@ def exact_reversals(system: Oscillator, v0: float, n: int, *, x0: float = 0.0, F
     >>> [round(float(F), 7) for F in table.F]  # the map 1 -> 0.5936243 -> ...
     [0.5936243, -0.4239535, 0.3300787]
     """
-    if not isinstance(system, Oscillator):
-        raise TypeError(f"system must be a prefriction.Oscillator, got {system!r} of type {type(system).__name__}")
-    if not isinstance(system.friction, Dahl):
-        raise TypeError(
-            "exact_reversals needs prefriction.Dahl friction, got "
-            f"{system.friction!r} of type {type(system.friction).__name__}"
-        )
+    check_dahl_oscillator(system, "exact_reversals")
     if system.u is not None:
         raise ValueError(
             "exact_reversals covers the unforced system (2.1) only, got an oscillator with an input force u "

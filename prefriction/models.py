@@ -111,3 +111,23 @@ class Oscillator:
     def forced(self) -> bool:
         """True if an external force ``u`` acts on the mass."""
         return self.u is not None
+
+
+def check_dahl_oscillator(system: Any, purpose: str) -> Dahl:
+    """Return the Dahl model of ``system``, or raise ``TypeError`` naming what was passed.
+
+    Parameters
+    ----------
+    system : Any
+        Must be an :class:`Oscillator` whose friction is a :class:`Dahl` model.
+    purpose : str
+        What needs the Dahl model, for the message (e.g. ``"exact_reversals"``).
+    """
+    if not isinstance(system, Oscillator):
+        raise TypeError(f"system must be a prefriction.Oscillator, got {system!r} of type {type(system).__name__}")
+    if not isinstance(system.friction, Dahl):
+        raise TypeError(
+            f"{purpose} needs system.friction to be a prefriction.Dahl model, got "
+            f"{system.friction!r} of type {type(system.friction).__name__}"
+        )
+    return system.friction

@@ -37,7 +37,7 @@ from ._integration_loop import N_DENSE, Run
 from ._plant import Layout, PlantSpec, p_of_force
 from ._signals import ConstantSignal, applied_force_scale, checked_signal_kind, eval_signal
 from ._validation import check_count, check_finite, check_positive
-from .models import Dahl, Oscillator
+from .models import Oscillator, check_dahl_oscillator
 from .reversals import ReversalTable
 from .units import Scales
 
@@ -187,10 +187,7 @@ def simulate(
     SolverError
         If the integrator fails; the message names the time, the state and what to try.
     """
-    if not isinstance(system, Oscillator):
-        raise TypeError(f"system must be a prefriction.Oscillator, got {system!r}")
-    if not isinstance(system.friction, Dahl):
-        raise TypeError(f"simulate supports the Dahl friction model, got {type(system.friction).__name__}")
+    check_dahl_oscillator(system, "simulate")
     v0 = check_finite("v0", v0)
     x0 = check_finite("x0", x0)
     F0 = check_finite("F0", F0)

@@ -7,7 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from prefriction import Dahl, Oscillator, Scales
+import prefriction as pf
+from prefriction import Dahl, FrictionModel, Oscillator, Scales
 
 
 def test_dahl_stores_floats_and_is_immutable():
@@ -78,3 +79,27 @@ def test_scales_are_consistent_units(sigma, Fc, m):
     assert s.E == pytest.approx(s.F * s.x)  # energy unit = force x length
     assert m * s.v**2 == pytest.approx(s.E)  # kinetic energy m v^2 in energy units
     assert sigma * s.t**2 / m == pytest.approx(1.0)  # natural period of the rest-stiffness spring
+
+
+class _Linear(FrictionModel):
+    """A friction model that is not Dahl: a linear spring (for the type checks)."""
+
+    sigma, Fc = 1.0, 1.0
+
+    def slope(self, f):
+        return 1.0 + 0.0 * f
+
+
+@pytest.mark.parametrize(
+    ("call", "purpose"),
+    [
+        (lambda s: pf.exact_reversals(s, 0.1, 3), "exact_reversals"),
+        (lambda s: pf.simulate(s, 0.1, reversals=3), "simulate"),
+        (lambda s: pf.energy.total_energy([0.0, 1.0], [0.1, 0.1], [0.0, 0.0], system=s), "the energy analysis"),
+    ],
+)
+def test_dahl_only_functions_name_what_needs_dahl(call, purpose):
+    with pytest.raises(TypeError, match=rf"{purpose}.* needs system.friction to be a prefriction.Dahl model"):
+        call(Oscillator(_Linear()))
+    with pytest.raises(TypeError, match="system must be a prefriction.Oscillator, got 3"):
+        call(3)
