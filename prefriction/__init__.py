@@ -5,7 +5,7 @@ Public API, re-exported from private modules:
 - models: :class:`Dahl`, :class:`Oscillator`, :class:`FrictionModel`
 - analytics: :mod:`prefriction.dahl` (exact and approximate reversal maps, energies)
 - exact reference: :func:`exact_reversals`
-- simulation: :func:`simulate`
+- simulation: :func:`simulate` (closed linear loops: :class:`LinearFeedback`)
 - energy analysis: :mod:`prefriction.energy`
 """
 
@@ -16,6 +16,7 @@ from .models import Dahl, FrictionModel, Oscillator
 from .reversals import ReversalTable
 from .units import Scales
 from .simulate import SimulationResult, simulate
+from ._feedback import LinearFeedback
 from . import energy
 from . import dahl
 from .exact import exact_reversals
@@ -23,6 +24,7 @@ from .exact import exact_reversals
 __all__ = [
     "Dahl",
     "FrictionModel",
+    "LinearFeedback",
     "Oscillator",
     "PrefrictionError",
     "ReversalTable",
