@@ -123,6 +123,22 @@ def closed_loop(
     ``T = P C / (1 + P C)`` built with ``control.feedback``. A discrete controller (``dt > 0``)
     is closed around the ZOH-discretised plant, exact at the sample instants. If the loop is
     not asymptotically stable a :class:`UnstableLoopWarning` lists its poles (``warn=True``).
+
+    Parameters
+    ----------
+    system : prefriction.Oscillator
+        The stage: mass [kg] and Dahl friction (rest stiffness sigma [N/m]).
+    controller : PID or control.LTI
+        Controller from the error ``e = r - x`` [m] to the force ``u`` [N], continuous or discrete.
+    regime : {"presliding", "sliding"}, default "presliding"
+        Linearisation of the plant: ``1/(m s^2 + sigma)`` or ``1/(m s^2)``.
+    warn : bool, default True
+        Warn with the poles if the closed loop is unstable.
+
+    Returns
+    -------
+    control.StateSpace
+        The closed loop ``r -> x`` (discrete with the controller's ``dt`` if it is discrete).
     """
     C = as_lti(controller)
     Ts = _sample_time(C)
@@ -206,6 +222,21 @@ def margins(system: Oscillator, controller: "PID | control.LTI", *, regime: str 
     """Gain, phase and stability margins of ``L = C P`` (``control.stability_margins``).
 
     A discrete controller is evaluated with the ZOH-discretised plant.
+
+    Parameters
+    ----------
+    system : prefriction.Oscillator
+        The stage: mass [kg] and Dahl friction (rest stiffness sigma [N/m]).
+    controller : PID or control.LTI
+        Controller from the error ``e = r - x`` [m] to the force ``u`` [N].
+    regime : {"presliding", "sliding"}, default "presliding"
+        Linearisation of the plant: ``1/(m s^2 + sigma)`` or ``1/(m s^2)``.
+
+    Returns
+    -------
+    Margins
+        Gain margin [-], phase margin [deg], stability margin [-] and the phase and gain
+        crossover frequencies [rad/s], as ``control.stability_margins`` reports them.
     """
     C = as_lti(controller)
     P = linear_plant(system, regime, _sample_time(C))

@@ -172,7 +172,23 @@ class PID:
 
 
 def pd(kp: float, kd: float, *, tau: Optional[float] = None, N: float = 10.0) -> PID:
-    """PD controller ``kp + kd s / (tau s + 1)`` (see :class:`PID` for the arguments and units)."""
+    """PD controller ``kp + kd s / (tau s + 1)`` from the error [m] to the force [N].
+
+    Parameters
+    ----------
+    kp : float
+        Proportional gain [N/m], >= 0.
+    kd : float
+        Derivative gain [N s/m], >= 0.
+    tau : float, optional
+        Derivative filter time constant [s], > 0; default ``kd / (N kp)``.
+    N : float, default 10
+        Derivative filter ratio used when ``tau`` is not given, > 0.
+
+    Returns
+    -------
+    PID
+    """
     return PID(kp=kp, kd=kd, tau=tau, N=N)
 
 
@@ -186,5 +202,27 @@ def pid(
     u_max: Optional[float] = None,
     t_track: Optional[float] = None,
 ) -> PID:
-    """PID controller ``kp + ki/s + kd s / (tau s + 1)`` (see :class:`PID` for arguments and units)."""
+    """PID controller ``kp + ki/s + kd s / (tau s + 1)`` from the error [m] to the force [N].
+
+    Parameters
+    ----------
+    kp : float
+        Proportional gain [N/m], >= 0.
+    ki : float
+        Integral gain [N/(m s)], >= 0.
+    kd : float
+        Derivative gain [N s/m], >= 0.
+    tau : float, optional
+        Derivative filter time constant [s], > 0; default ``kd / (N kp)``.
+    N : float, default 10
+        Derivative filter ratio used when ``tau`` is not given, > 0.
+    u_max : float, optional
+        Force limit [N], > 0, with back-calculation anti-windup (sampled loops).
+    t_track : float, optional
+        Tracking time constant [s] of the anti-windup (see :class:`PID`).
+
+    Returns
+    -------
+    PID
+    """
     return PID(kp=kp, ki=ki, kd=kd, tau=tau, N=N, u_max=u_max, t_track=t_track)
