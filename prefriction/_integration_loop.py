@@ -71,6 +71,8 @@ class Run:
         """Parameter vector with the entries that stay fixed during the run."""
         sc, fb = self.sc, self.fb
         P = np.zeros(L.np)
+        if self.spec.stops_at_reversal:  # every parameter changes per call
+            return P
         P[L.param["snap"]] = self.snap
         P[L.param["tunit"]] = sc.t
         P[L.param["xunit"]] = sc.x
@@ -245,16 +247,14 @@ class Run:
         self.st["t"] = t if out["t"] is None else out["t"]
 
     # --- loops --------------------------------------------------------------------------
-    def _advance_unforced(self, t_target: float, n_target: float) -> bool:
-        """:meth:`advance` for the unforced oscillator without dense output: the same steps with
-        local variables instead of dictionaries (the Python work per call is ~5 us, not ~13 us)."""
-        call, L, K, g = self.f1, self.L, self.spec.K, self.gamma
+    def _advance_compact(self, t_target: float, n_target: float) -> bool:
+        """:meth:`advance` for the compact unforced model (``spec.stops_at_reversal``): each call
+        runs to the next reversal (or ``t_target``); the new branch starts here, in Python."""
+        call, L, g = self.f1, self.L, self.gamma
         X0, P, U, out = call.X0, call.P, call.U, call.out
-        np.copyto(P, self.P0)
-        ip = L.param
-        iAx, iAv, iAF, iAE, ixr, ins = ip["Ax"], ip["Av"], ip["AF"], ip["AE"], ip["xref"], ip["nstop"]
-        isat = L.state.get("sat")
-        r0, w = L.reg, L.reg_width
+        ix = L.state
+        isat, ite = ix.get("sat"), ix["te"]
+        saturates, snap = isat is not None, self.snap
         st, rev = self.st, self.rev
         x, v, p, s, t, sat = st["x"], st["v"], st["p"], st["s"], st["t"], st["sat"]
         grow = 1.0
@@ -266,43 +266,50 @@ class Run:
                 break
             if t >= t_target * (1 - 1e-15) and t_target < math.inf:
                 break
-            if n >= 2:
-                chunk = (K + 0.6) * (rev[-1][0] - rev[-2][0]) * 1.25 * grow
-            else:  # F rises over a distance ~1 (time ~1/|v|): the first step must not skip it
+            if n >= 2:  # the next half-cycle about as long as the last one, with a margin
+                chunk = 2.0 * (rev[-1][0] - rev[-2][0]) * grow
+            else:  # F rises over a distance ~1 (time ~1/|v|): the first step must not skip it;
+                # doubled while no reversal comes (a gross slide: the scales follow the speed)
                 chunk = 2.0 * math.pi / max(1.0, abs(v)) * grow
             t1 = min(t_target, t + chunk)
-            nstop = min(n + (K if n else 1), n_target)
             F = s * force_of_p(p, g)
             A = max(math.hypot(v, F), 1e-300)
             Ax = max(A, 0.5 * A * A, min(abs(x), 1.0))
             AF = min(A, 1.0)
-            P[iAx], P[iAv], P[iAF], P[iAE], P[ixr], P[ins] = Ax, A, AF, A * A, x, nstop
-            X0[0], X0[1], X0[2], X0[3], X0[4] = 0.0, v / A, p / AF, s, n
-            if isat is not None:
+            P[0], P[1], P[2], P[3] = Ax, A, AF, s
+            X0[0], X0[1], X0[2], X0[ite] = 0.0, v / A, p / AF, -1.0
+            if saturates:
                 X0[isat] = sat
             U[0, 0], U[0, 1] = t1 - t, t
             self._trigger(call)
             c = out.tolist()
             if not math.isfinite(math.fsum(c)):
                 raise self._failure(INTEGRATOR_FAILED)
-            n1 = int(c[4] + 0.5)
-            for j in range(min(n1 - n, K) - 1, -1, -1):
-                k = r0 + j * w
-                rev.append((c[k], c[k + 1], c[k + 2], 0.0))
-            x, v, p, s = x + Ax * c[0], A * c[1], AF * c[2], c[3]
-            if isat is not None:
+            x, v, p = x + Ax * c[0], A * c[1], AF * c[2]
+            if saturates:
                 sat = c[isat]
-            frozen = n1 >= nstop
-            t = rev[-1][0] if frozen and n1 > n else t1
-            grow = 1.0 if frozen or n1 > n else 2.0 * grow
+            te = c[ite]
+            if te > -0.5:  # a reversal at te: record it, start the branch of direction -s
+                F = s * force_of_p(p, g)
+                rev.append((te, x, F, 0.0))
+                # a reversal within snap of saturation is one at saturation (see _plant)
+                Fs = s if saturates and 1.0 - (1.0 - g) * p < snap else F
+                s = -s
+                p = p_of_force(s * Fs, g)
+                sat = 0.0
+                t = te
+                grow = 1.0
+            else:
+                t = t1
+                grow *= 2.0
             # state for error messages and the caller
             st.update(x=x, v=v, p=p, s=s, t=t, sat=sat, F=s * force_of_p(p, g))
         return done
 
     def advance(self, t_target: float, n_target: float) -> bool:
         """Integrate to normalised time ``t_target`` or ``n_target`` reversals; True if the latter."""
-        if not self.spec.forced and not self.spec.energy:
-            return self._advance_unforced(t_target, n_target)
+        if self.spec.stops_at_reversal:
+            return self._advance_compact(t_target, n_target)
         grow = 1.0
         while True:
             if len(self.rev) >= n_target:

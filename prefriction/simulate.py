@@ -5,9 +5,11 @@ Between two velocity reversals the branch direction ``s`` is fixed and the Dahl 
 Runge-Kutta 5(4), compiled with gcc and cached on disk by :mod:`prefriction._jit`) locates every
 zero of ``s v`` on its dense output (to round-off) and restarts on the new branch through an
 event transition; saturation (gamma < 1), touches and rest of a forced mass are events too
-(see :mod:`prefriction._plant`). One call covers up to ``K = 2`` reversals and is made through a
-persistent argument buffer, so the cost per reversal is the integration itself (about 50 steps
-at ``rtol = 1e-8``), the same for 50 or 1e4 reversals.
+(see :mod:`prefriction._plant`). Unforced runs without dense output use a compact model (4
+states: one call per reversal, the next branch started in Python); forced or dense runs record up
+to ``K = 2`` reversals per call in a register. Calls go through a persistent argument buffer, so
+the cost per reversal is the integration itself (about 54 steps at ``rtol = 1e-8``), the same
+for 50 or 1e4 reversals.
 
 The model is integrated in normalised units (:mod:`prefriction.units`), with the branch distance
 ``p`` (``p' = s v``) as the force state and every state scaled per call by the current
@@ -46,7 +48,7 @@ __all__ = ["METHODS", "RunStats", "SimulationResult", "simulate"]
 METHODS = ("erk",)
 """Integrator plugins exposed by :func:`simulate` (each tested on the whole case set)."""
 
-_K = 2  # reversals recorded per integrator call (register length)
+_K = 2  # reversals recorded per integrator call (register length; forced or dense runs)
 _CAL = 0.07  # calibration of the internal tolerance: global error over 50 reversals ~ 0.7 rtol
 _DENSE_STEP = 2.0 * math.pi / 64.0  # normalised spacing of dense=True samples (64 per small cycle)
 
@@ -232,7 +234,7 @@ def simulate(
         r_kind=r_kind if fb_kind == "continuous" else "none",
         r_fun=(feedback.reference if r_kind == "callable" and fb_kind == "continuous" else None),
         energy=want_dense, K=_K, n_out=N_DENSE if want_dense else 1, method=method,
-        gamma=system.friction.gamma,
+        gamma=system.friction.gamma, compact=True,
     )
     L = Layout(spec)
     tol = rtol * _CAL * math.sqrt(L.n_active / L.nx)
