@@ -224,10 +224,7 @@ class Run:
         if failed:
             raise self._failure(INTEGRATOR_FAILED)
         if self.steps is not None:
-            try:  # statistics exist for the interpreted integrator only (memory 1: the buffer's)
-                self.steps += int(call.fun.stats(1)["n_steps"])
-            except (RuntimeError, KeyError):
-                self.steps = None
+            self._count_steps(call)
 
     def _failure(self, why: str) -> SolverError:
         """The SolverError of a failed call: time, state, reversals so far and what to try."""
@@ -249,30 +246,33 @@ class Run:
     # --- loops --------------------------------------------------------------------------
     def _advance_compact(self, t_target: float, n_target: float) -> bool:
         """:meth:`advance` for the compact unforced model (``spec.stops_at_reversal``): each call
-        runs to the next reversal (or ``t_target``); the new branch starts here, in Python."""
+        runs to the next reversal (or ``t_target``); the new branch starts here, in Python.
+        Local variables only (``self.st`` is written at the end or before an error)."""
         call, L, g = self.f1, self.L, self.gamma
-        X0, P, U, out = call.X0, call.P, call.U, call.out
+        X0, P, U, out, trigger, buf = call.X0, call.P, call.U, call.out, call.trigger, call.buf
         ix = L.state
         isat, ite = ix.get("sat"), ix["te"]
         saturates, snap = isat is not None, self.snap
+        if g == 1.0:
+            def f_of(p: float) -> float:
+                return -math.expm1(-p)
+        else:
+            def f_of(p: float) -> float:
+                return force_of_p(p, g)
         st, rev = self.st, self.rev
         x, v, p, s, t, sat = st["x"], st["v"], st["p"], st["s"], st["t"], st["sat"]
         grow = 1.0
-        done = False
-        while True:
-            n = len(rev)
-            if n >= n_target:
-                done = True
-                break
-            if t >= t_target * (1 - 1e-15) and t_target < math.inf:
-                break
+        calls = 0
+        t_stop = t_target * (1 - 1e-15) if t_target < math.inf else math.inf
+        n = len(rev)
+        while n < n_target and t < t_stop:
+            F = s * f_of(p)
             if n >= 2:  # the next half-cycle about as long as the last one, with a margin
                 chunk = 2.0 * (rev[-1][0] - rev[-2][0]) * grow
             else:  # F rises over a distance ~1 (time ~1/|v|): the first step must not skip it;
                 # doubled while no reversal comes (a gross slide: the scales follow the speed)
                 chunk = 2.0 * math.pi / max(1.0, abs(v)) * grow
             t1 = min(t_target, t + chunk)
-            F = s * force_of_p(p, g)
             A = max(math.hypot(v, F), 1e-300)
             Ax = max(A, 0.5 * A * A, min(abs(x), 1.0))
             AF = min(A, 1.0)
@@ -281,17 +281,28 @@ class Run:
             if saturates:
                 X0[isat] = sat
             U[0, 0], U[0, 1] = t1 - t, t
-            self._trigger(call)
+            calls += 1
+            why = INTEGRATOR_FAILED
+            try:
+                trigger()
+                ok = buf.ret() == 0
+            except RuntimeError as exc:
+                ok, why = False, str(exc).strip().splitlines()[-1]
             c = out.tolist()
-            if not math.isfinite(math.fsum(c)):
-                raise self._failure(INTEGRATOR_FAILED)
+            if not (ok and math.isfinite(math.fsum(c))):
+                self.calls += calls
+                st.update(x=x, v=v, p=p, s=s, t=t, sat=sat, F=F)
+                raise self._failure(why)
+            if self.steps is not None:
+                self._count_steps(call)
             x, v, p = x + Ax * c[0], A * c[1], AF * c[2]
             if saturates:
                 sat = c[isat]
             te = c[ite]
             if te > -0.5:  # a reversal at te: record it, start the branch of direction -s
-                F = s * force_of_p(p, g)
+                F = s * f_of(p)
                 rev.append((te, x, F, 0.0))
+                n += 1
                 # a reversal within snap of saturation is one at saturation (see _plant)
                 Fs = s if saturates and 1.0 - (1.0 - g) * p < snap else F
                 s = -s
@@ -302,9 +313,16 @@ class Run:
             else:
                 t = t1
                 grow *= 2.0
-            # state for error messages and the caller
-            st.update(x=x, v=v, p=p, s=s, t=t, sat=sat, F=s * force_of_p(p, g))
-        return done
+        self.calls += calls
+        st.update(x=x, v=v, p=p, s=s, t=t, sat=sat, F=s * f_of(p))
+        return n >= n_target
+
+    def _count_steps(self, call: BufferedIntegrator) -> None:
+        """Add the steps of the last call (interpreted integrator only; else ``steps`` = None)."""
+        try:  # statistics exist for the interpreted integrator only (memory 1: the buffer's)
+            self.steps += int(call.fun.stats(1)["n_steps"])
+        except (RuntimeError, KeyError):
+            self.steps = None
 
     def advance(self, t_target: float, n_target: float) -> bool:
         """Integrate to normalised time ``t_target`` or ``n_target`` reversals; True if the latter."""
