@@ -249,9 +249,11 @@ class Run:
         runs to the next reversal (or ``t_target``); the new branch starts here, in Python.
         Local variables only (``self.st`` is written at the end or before an error)."""
         call, L, g = self.f1, self.L, self.gamma
-        X0, P, U, out, trigger, buf = call.X0, call.P, call.U, call.out, call.trigger, call.buf
+        # memoryviews of the call's buffers: item assignment costs ~25 ns, not ~70 ns (numpy)
+        X0, P, U = memoryview(call.X0), memoryview(call.P), memoryview(call.U.reshape(-1))
+        out, trigger, buf = memoryview(call.out), call.trigger, call.buf
         ix = L.state
-        isat, ite = ix.get("sat"), ix["te"]
+        isat, ite, iv, iF = ix.get("sat"), ix["te"], ix["vh"], ix["Fh"]
         saturates, snap = isat is not None, self.snap
         if g == 1.0:
             def f_of(p: float) -> float:
@@ -277,10 +279,10 @@ class Run:
             Ax = max(A, 0.5 * A * A, min(abs(x), 1.0))
             AF = min(A, 1.0)
             P[0], P[1], P[2], P[3] = Ax, A, AF, s
-            X0[0], X0[1], X0[2], X0[ite] = 0.0, v / A, p / AF, -1.0
+            X0[iv], X0[iF], X0[ite] = v / A, p / AF, -1.0
             if saturates:
-                X0[isat] = sat
-            U[0, 0], U[0, 1] = t1 - t, t
+                X0[0], X0[isat] = 0.0, sat
+            U[0], U[1] = t1 - t, t
             calls += 1
             why = INTEGRATOR_FAILED
             try:
@@ -295,9 +297,11 @@ class Run:
                 raise self._failure(why)
             if self.steps is not None:
                 self._count_steps(call)
-            x, v, p = x + Ax * c[0], A * c[1], AF * c[2]
             if saturates:
-                sat = c[isat]
+                x, v, p, sat = x + Ax * c[0], A * c[iv], AF * c[iF], c[isat]
+            else:  # x' = s p' on the branch
+                p1 = AF * c[iF]
+                x, v, p = x + s * (p1 - p), A * c[iv], p1
             te = c[ite]
             if te > -0.5:  # a reversal at te: record it, start the branch of direction -s
                 F = s * f_of(p)

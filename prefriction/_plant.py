@@ -42,10 +42,12 @@ Events (the integrator fires when an indicator goes from positive to negative):
 
 ``eps`` and ``eps_rest`` are :data:`EPS_TOUCH` and :data:`EPS_REST` times the amplitude scale.
 
-Compact model (``PlantSpec.compact``, unforced without dense output): states ``xh, vh, Fh[, sat],
-te`` only, the direction ``s`` a parameter; the call stops at the first reversal (``te``, its
-normalised time, is set from ``-1``) and the caller starts the next branch. A step costs about
-a quarter less than with the register of two reversals (4 states instead of 11).
+Compact model (``PlantSpec.compact``, unforced without dense output): states ``vh, Fh, te``
+(gamma >= 1: the position follows from ``x - x_start = s (p - p_start)`` on the branch) or
+``xh, vh, Fh, sat, te`` (gamma < 1), the direction ``s`` a parameter; the call stops at the
+first reversal (``te``, its normalised time, is set from ``-1``) and the caller starts the next
+branch. A step costs about a third less than with the register of two reversals (3 states
+instead of 11).
 """
 
 from __future__ import annotations
@@ -162,12 +164,13 @@ class Layout:
     def _compact(self, spec: PlantSpec) -> None:
         """Layout of the compact unforced model: ``xh, vh, Fh[, sat], te``, parameters
         ``Ax, Av, AF, s``, controls ``dur, t0``."""
-        names = ["xh", "vh", "Fh"] + (["sat"] if spec.saturates else []) + ["te"]
+        # without saturation x - x_start = s (p - p_start) on the branch: no position state
+        names = (["xh", "vh", "Fh", "sat"] if spec.saturates else ["vh", "Fh"]) + ["te"]
         self.state = {k: i for i, k in enumerate(names)}
         self.xc = slice(len(names), len(names))
         self.reg = self.nx = len(names)
         self.reg_width = 0
-        self.n_active = 3
+        self.n_active = 3 if spec.saturates else 2
         self.param = {k: i for i, k in enumerate(["Ax", "Av", "AF", "s"])}
         self.p_A = self.p_B = self.p_C = self.p_D = self.p_S = self.np = len(self.param)
         self.control = {"dur": 0, "t0": 1}
@@ -388,11 +391,11 @@ def build_integrator(spec: PlantSpec, tol: float, atol: float) -> ca.Function:
 def _build_compact(spec: PlantSpec, tol: float, atol: float) -> ca.Function:
     """The unforced oscillator up to its next reversal, with as few states as possible.
 
-    States ``xh, vh, Fh`` (as in :func:`build_integrator`), ``sat`` (gamma < 1) and ``te``,
-    the normalised time of the reversal (``-1`` until it comes); the direction ``s`` is a
-    parameter. At the reversal the transition records ``te`` and the right-hand side becomes
+    States ``vh, Fh`` (as in :func:`build_integrator`; with ``xh`` and ``sat`` for gamma < 1,
+    else the caller takes ``x`` from ``p``) and ``te``, the normalised time of the reversal
+    (``-1`` until it comes); the direction ``s`` is a parameter. At the reversal the transition records ``te`` and the right-hand side becomes
     zero: the state at the end of the call is the state at the reversal, and the caller
-    starts the next branch. The cost of a step grows with the number of states: 4 here
+    starts the next branch. The cost of a step grows with the number of states: 3 here
     (5 with saturation) against 11 with a register of two reversals.
     """
     L = Layout(spec)
@@ -409,7 +412,8 @@ def _build_compact(spec: PlantSpec, tol: float, atol: float) -> ca.Function:
     v = p["Av"] * st["vh"]
     run = ca.if_else(st["te"] < -0.5, U[0], 0.0)  # dur while no reversal came, then 0
     ode = ca.SX.zeros(L.nx)
-    ode[L.state["xh"]] = run * v / p["Ax"]
+    if spec.saturates:
+        ode[L.state["xh"]] = run * v / p["Ax"]
     ode[L.state["vh"]] = -run * F / p["Av"]
     ode[L.state["Fh"]] = run * s * v * (1.0 - sat) / p["AF"]
     zero = [ca.if_else(st["te"] < -0.5, s * st["vh"], 1.0)]
