@@ -253,7 +253,7 @@ class Run:
         X0, P, U = memoryview(call.X0), memoryview(call.P), memoryview(call.U.reshape(-1))
         out, trigger, buf = memoryview(call.out), call.trigger, call.buf
         ix = L.state
-        isat, ite, iv, iF = ix.get("sat"), ix["te"], ix["vh"], ix["Fh"]
+        isat, iv, iF = ix.get("sat"), ix["vh"], ix["Fh"]
         saturates, snap = isat is not None, self.snap
         if g == 1.0:
             def f_of(p: float) -> float:
@@ -272,14 +272,14 @@ class Run:
             if n >= 2:  # the next half-cycle about as long as the last one, with a margin
                 chunk = 2.0 * (rev[-1][0] - rev[-2][0]) * grow
             else:  # F rises over a distance ~1 (time ~1/|v|): the first step must not skip it;
-                # doubled while no reversal comes (a gross slide: the scales follow the speed)
+                # quadrupled while no reversal comes (a gross slide: the scales follow the speed)
                 chunk = 2.0 * math.pi / max(1.0, abs(v)) * grow
             t1 = min(t_target, t + chunk)
             A = max(math.hypot(v, F), 1e-300)
             Ax = max(A, 0.5 * A * A, min(abs(x), 1.0))
             AF = min(A, 1.0)
             P[0], P[1], P[2], P[3] = Ax, A, AF, s
-            X0[iv], X0[iF], X0[ite] = v / A, p / AF, -1.0
+            X0[iv], X0[iF] = v / A, p / AF
             if saturates:
                 X0[0], X0[isat] = 0.0, sat
             U[0], U[1] = t1 - t, t
@@ -298,25 +298,27 @@ class Run:
             if self.steps is not None:
                 self._count_steps(call)
             if saturates:
-                x, v, p, sat = x + Ax * c[0], A * c[iv], AF * c[iF], c[isat]
+                x, p, sat = x + Ax * c[0], AF * c[iF], c[isat]
             else:  # x' = s p' on the branch
                 p1 = AF * c[iF]
-                x, v, p = x + s * (p1 - p), A * c[iv], p1
-            te = c[ite]
-            if te > -0.5:  # a reversal at te: record it, start the branch of direction -s
+                x, p = x + s * (p1 - p), p1
+            sv = s * c[iv]
+            if sv > -0.5:  # no reversal: vh is the velocity
+                v = A * c[iv]
+                t = t1
+                grow *= 4.0
+            else:  # vh = -s (1 + tau) at a reversal: record it, start the branch of direction -s
+                t = t + (t1 - t) * (-sv - 1.0)  # t0 + dur tau, as the integrator's time
+                v = 0.0
                 F = s * f_of(p)
-                rev.append((te, x, F, 0.0))
+                rev.append((t, x, F, 0.0))
                 n += 1
                 # a reversal within snap of saturation is one at saturation (see _plant)
                 Fs = s if saturates and 1.0 - (1.0 - g) * p < snap else F
                 s = -s
                 p = p_of_force(s * Fs, g)
                 sat = 0.0
-                t = te
                 grow = 1.0
-            else:
-                t = t1
-                grow *= 2.0
         self.calls += calls
         st.update(x=x, v=v, p=p, s=s, t=t, sat=sat, F=s * f_of(p))
         return n >= n_target

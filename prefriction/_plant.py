@@ -42,12 +42,12 @@ Events (the integrator fires when an indicator goes from positive to negative):
 
 ``eps`` and ``eps_rest`` are :data:`EPS_TOUCH` and :data:`EPS_REST` times the amplitude scale.
 
-Compact model (``PlantSpec.compact``, unforced without dense output): states ``vh, Fh, te``
+Compact model (``PlantSpec.compact``, unforced without dense output): states ``vh, Fh``
 (gamma >= 1: the position follows from ``x - x_start = s (p - p_start)`` on the branch) or
-``xh, vh, Fh, sat, te`` (gamma < 1), the direction ``s`` a parameter; the call stops at the
-first reversal (``te``, its normalised time, is set from ``-1``) and the caller starts the next
-branch. A step costs about a third less than with the register of two reversals (3 states
-instead of 11).
+``xh, vh, Fh, sat`` (gamma < 1), the direction ``s`` a parameter; the call stops at the first
+reversal (its transition sets ``vh = -s (1 + tau)``: the stop flag and the time of the reversal
+in one state) and the caller starts the next branch. A step costs about a third less than with
+the register of two reversals (2 states instead of 11).
 """
 
 from __future__ import annotations
@@ -162,10 +162,10 @@ class Layout:
         self.nu = len(cnames)
 
     def _compact(self, spec: PlantSpec) -> None:
-        """Layout of the compact unforced model: ``xh, vh, Fh[, sat], te``, parameters
-        ``Ax, Av, AF, s``, controls ``dur, t0``."""
+        """Layout of the compact unforced model: ``vh, Fh`` (``xh, vh, Fh, sat`` for gamma < 1),
+        parameters ``Ax, Av, AF, s``, controls ``dur, t0``."""
         # without saturation x - x_start = s (p - p_start) on the branch: no position state
-        names = (["xh", "vh", "Fh", "sat"] if spec.saturates else ["vh", "Fh"]) + ["te"]
+        names = ["xh", "vh", "Fh", "sat"] if spec.saturates else ["vh", "Fh"]
         self.state = {k: i for i, k in enumerate(names)}
         self.xc = slice(len(names), len(names))
         self.reg = self.nx = len(names)
@@ -392,11 +392,12 @@ def _build_compact(spec: PlantSpec, tol: float, atol: float) -> ca.Function:
     """The unforced oscillator up to its next reversal, with as few states as possible.
 
     States ``vh, Fh`` (as in :func:`build_integrator`; with ``xh`` and ``sat`` for gamma < 1,
-    else the caller takes ``x`` from ``p``) and ``te``, the normalised time of the reversal
-    (``-1`` until it comes); the direction ``s`` is a parameter. At the reversal the transition records ``te`` and the right-hand side becomes
-    zero: the state at the end of the call is the state at the reversal, and the caller
-    starts the next branch. The cost of a step grows with the number of states: 3 here
-    (5 with saturation) against 11 with a register of two reversals.
+    else the caller takes ``x`` from ``p``); the direction ``s`` is a parameter. Before the
+    reversal ``s vh > 0``; the transition of the reversal sets ``vh = -s (1 + tau)`` (the
+    velocity there is zero; ``tau`` in [0, 1] is the integrator time of the reversal), which
+    also stops the right-hand side: the state at the end of the call is the state at the
+    reversal, and the caller starts the next branch. The cost of a step grows with the number
+    of states: 2 here (4 with saturation) against 11 with a register of two reversals.
     """
     L = Layout(spec)
     X = ca.SX.sym("X", L.nx)
@@ -410,19 +411,20 @@ def _build_compact(spec: PlantSpec, tol: float, atol: float) -> ca.Function:
     pp = p["AF"] * st["Fh"]
     F = s * force_of_p(pp, g)
     v = p["Av"] * st["vh"]
-    run = ca.if_else(st["te"] < -0.5, U[0], 0.0)  # dur while no reversal came, then 0
+    moving = s * st["vh"] > -0.5  # no reversal yet in this call
+    run = ca.if_else(moving, U[0], 0.0)  # dur while no reversal came, then 0
     ode = ca.SX.zeros(L.nx)
     if spec.saturates:
         ode[L.state["xh"]] = run * v / p["Ax"]
     ode[L.state["vh"]] = -run * F / p["Av"]
     ode[L.state["Fh"]] = run * s * v * (1.0 - sat) / p["AF"]
-    zero = [ca.if_else(st["te"] < -0.5, s * st["vh"], 1.0)]
+    zero = [ca.if_else(moving, s * st["vh"], 1.0)]
     if spec.saturates:
-        zero.append(ca.if_else((st["te"] < -0.5) * (1.0 - sat) > 0.5, 1.0 - (1.0 - g) * pp, 1.0))
+        zero.append(ca.if_else(moving * (1.0 - sat) > 0.5, 1.0 - (1.0 - g) * pp, 1.0))
     dae = {"x": X, "p": P, "u": U, "t": tau, "ode": ode, "zero": ca.vertcat(*zero)}
     idx = ca.SX.sym("index")
     post = ca.SX(X)
-    post[L.state["te"]] = U[1] + U[0] * tau
+    post[L.state["vh"]] = -s * (1.0 + tau)
     if spec.saturates:
         post_sat = ca.SX(X)
         post_sat[L.state["sat"]] = 1.0

@@ -5,7 +5,7 @@ Between two velocity reversals the branch direction ``s`` is fixed and the Dahl 
 Runge-Kutta 5(4), compiled with gcc and cached on disk by :mod:`prefriction._jit`) locates every
 zero of ``s v`` on its dense output (to round-off) and restarts on the new branch through an
 event transition; saturation (gamma < 1), touches and rest of a forced mass are events too
-(see :mod:`prefriction._plant`). Unforced runs without dense output use a compact model (3
+(see :mod:`prefriction._plant`). Unforced runs without dense output use a compact model (2
 states for gamma >= 1: one call per reversal, the next branch started in Python); forced or dense runs record up
 to ``K = 2`` reversals per call in a register. Calls go through a persistent argument buffer, so
 the cost per reversal is the integration itself (about 54 steps at ``rtol = 1e-8``), the same
