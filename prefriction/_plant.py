@@ -452,9 +452,9 @@ def _options(spec: PlantSpec, trans: ca.Function, tol: float, atol: float) -> di
         "max_num_steps": 200000,
     }
     if spec.n_out == 1:
-        # A call covers about K + 1 half-cycles (see simulate's advance): a first step of about
-        # 1/50 of it at tol ~ 4e-10, scaled like an order-5 step, spares the ramp-up from the
-        # default estimate (about 13 % of all steps with K = 2).
+        # A call covers about K + 1 half-cycles (the compact model: 2; see the integration
+        # loop): a first step of about 1/60 of it at tol ~ 4e-10, scaled like an order-5 step,
+        # spares the ramp-up from the default estimate (about 13 % of all steps with K = 2).
         opts["step0"] = min(0.03, max(1e-4, 0.015 * (tol / 3.7e-10) ** 0.2))
     return opts
 

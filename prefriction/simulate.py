@@ -8,7 +8,7 @@ event transition; saturation (gamma < 1), touches and rest of a forced mass are 
 (see :mod:`prefriction._plant`). Unforced runs without dense output use a compact model (2
 states for gamma >= 1: one call per reversal, the next branch started in Python); forced or dense runs record up
 to ``K = 2`` reversals per call in a register. Calls go through a persistent argument buffer, so
-the cost per reversal is the integration itself (about 54 steps at ``rtol = 1e-8``), the same
+the cost per reversal is the integration itself (about 56 steps at ``rtol = 1e-8``), the same
 for 50 or 1e4 reversals.
 
 The model is integrated in normalised units (:mod:`prefriction.units`), with the branch distance
