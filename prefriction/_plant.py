@@ -258,6 +258,20 @@ def trace_signal(fun: Callable[[Any], Any], what: str) -> ca.SX:
     return val
 
 
+def _symbols(spec: PlantSpec) -> tuple:
+    """Layout, symbols (state ``X``, parameters ``P``, controls ``U``, time ``tau``) and the
+    name -> entry maps of state, parameters and controls of the model ``spec``."""
+    L = Layout(spec)
+    X = ca.SX.sym("X", L.nx)
+    P = ca.SX.sym("P", L.np)
+    U = ca.SX.sym("U", L.nu)
+    tau = ca.SX.sym("tau")
+    st = {k: X[i] for k, i in L.state.items()}
+    p = {k: P[i] for k, i in L.param.items()}
+    c = {k: U[i] for k, i in L.control.items()}
+    return L, X, P, U, tau, st, p, c
+
+
 def build_integrator(spec: PlantSpec, tol: float, atol: float) -> ca.Function:
     """CasADi integrator (``spec.method``) over ``spec.n_out`` output intervals, with events
     (the compact model of the module notes if ``spec.stops_at_reversal``).
@@ -272,14 +286,7 @@ def build_integrator(spec: PlantSpec, tol: float, atol: float) -> ca.Function:
     """
     if spec.stops_at_reversal:
         return _build_compact(spec, tol, atol)
-    L = Layout(spec)
-    X = ca.SX.sym("X", L.nx)
-    P = ca.SX.sym("P", L.np)
-    U = ca.SX.sym("U", L.nu)
-    tau = ca.SX.sym("tau")
-    st = {k: X[i] for k, i in L.state.items()}
-    p = {k: P[i] for k, i in L.param.items()}
-    c = {k: U[i] for k, i in L.control.items()}
+    L, X, P, U, tau, st, p, c = _symbols(spec)
     n = spec.n_c
     x = p["xref"] + p["Ax"] * st["xh"]
     v = p["Av"] * st["vh"]
@@ -399,13 +406,7 @@ def _build_compact(spec: PlantSpec, tol: float, atol: float) -> ca.Function:
     reversal, and the caller starts the next branch. The cost of a step grows with the number
     of states: 2 here (4 with saturation) against 11 with a register of two reversals.
     """
-    L = Layout(spec)
-    X = ca.SX.sym("X", L.nx)
-    P = ca.SX.sym("P", L.np)
-    U = ca.SX.sym("U", L.nu)
-    tau = ca.SX.sym("tau")
-    st = {k: X[i] for k, i in L.state.items()}
-    p = {k: P[i] for k, i in L.param.items()}
+    L, X, P, U, tau, st, p, _ = _symbols(spec)
     g, s = spec.gamma, p["s"]
     sat = st["sat"] if spec.saturates else 0.0
     pp = p["AF"] * st["Fh"]
