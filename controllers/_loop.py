@@ -19,7 +19,6 @@ import prefriction
 from prefriction._branch import force_after_distance
 from prefriction._feedback import LinearFeedback
 from prefriction._validation import check_positive, check_signal
-from prefriction.errors import SolverError
 from prefriction.models import Oscillator
 from prefriction.reversals import ReversalTable
 from prefriction.simulate import SimulationResult
@@ -265,9 +264,7 @@ def simulate_loop(
         A :class:`PID` with a force limit ``u_max`` in a continuous loop (the simulator's
         continuous feedback is linear; the force limit is simulated for sampled loops).
     prefriction.SolverError
-        If the integration fails, or if the samples of a continuous loop leave the Dahl branches
-        (the simulator missed a reversal: a resting mass pushed back by a force that jumps at a
-        reference sample time; use a smooth callable reference or a sampled controller).
+        If the integration fails (the message names the time, the state and what to try).
 
     Warns
     -----
@@ -325,50 +322,9 @@ def simulate_loop(
             dense = np.asarray(t_out, dtype=float)
     fb = LinearFeedback(A=C.A, B=C.B, C=C.C, D=C.D, Ts=Ts, reference=fb_reference, xc0=xc0)
     sim = prefriction.simulate(system, v0, x0=x0, F0=F0, t_end=t_end, rtol=rtol, dense=dense, feedback=fb, jit=jit)
-    if Ts is None:
-        _check_branches(sim, system, x0, F0)
     t = sim.t
     r = _evaluate(reference, t)
     return LoopResult(
         t=t, reference=r, x=sim.x, v=sim.v, F=sim.F, u=sim.u, error=r - sim.x, xc=sim.xc,
         reversals=sim.reversals, Ts=Ts, controller=C, system=system, kp=_dc_gain(C), simulation=sim,
     )
-
-
-def _check_branches(sim: SimulationResult, system: Oscillator, x0: float, F0: float) -> None:
-    """Raise :class:`prefriction.SolverError` if a continuous loop's samples leave the Dahl branches.
-
-    Dahl friction is rate-independent: between two velocity reversals the position is monotone
-    and ``F`` is the branch (3.4)/(3.5) through the previous reversal (or the initial state) as
-    a function of ``x`` alone. ``prefriction.simulate`` can miss a reversal in a continuous loop
-    when a resting mass is pushed back by a force that jumps at a reference sample time (the
-    velocity starts at exactly zero and the net force changes sign before the first step ends);
-    the mass then moves backwards on the old branch. This check finds that (a position step
-    against the branch direction by more than ``1e-6 Fc/sigma``, or ``F`` off the branch by
-    more than ``1e-6 Fc``) instead of returning a wrong trajectory.
-    """
-    fr = system.friction
-    Fc, sigma = fr.Fc, fr.sigma
-    R = sim.reversals
-    at, ax, aF = (np.concatenate(([a0], a)) for a0, a in ((0.0, R.t), (x0, R.x), (F0, R.F)))
-    seg = np.searchsorted(at, sim.t, side="right") - 1  # anchor (start of the branch) of each sample
-    d = sim.x - ax[seg]
-    s = np.where(d >= 0.0, 1.0, -1.0)
-    f = force_after_distance(np.clip(s * aF[seg] / Fc, -1.0, 1.0), np.abs(d) * sigma / Fc, fr.gamma)
-    off = np.abs(s * Fc * f - sim.F) > 1e-6 * Fc
-    first = np.concatenate(([True], seg[1:] != seg[:-1]))
-    move = sim.x - np.where(first, ax[seg], np.concatenate(([x0], sim.x[:-1])))  # since the previous sample
-    moved = np.abs(move) > 1e-6 * Fc / sigma
-    direction = np.zeros(len(at))  # of each branch: its first move
-    segs, idx = np.unique(seg[moved], return_index=True)
-    direction[segs] = np.sign(move[moved][idx])
-    off |= moved & (np.sign(move) != direction[seg])
-    bad = np.nonzero(off)[0]
-    if bad.size:
-        k = bad[0]
-        raise SolverError(
-            f"simulate left the Dahl branch through the reversal at t = {at[seg[k]]:.6g} s before t = {sim.t[k]:.6g} s "
-            f"(state there: x = {sim.x[k]:.6g} m, v = {sim.v[k]:.6g} m/s, F = {sim.F[k]:.6g} N): a velocity reversal "
-            "was missed, as happens when a resting mass is pushed back by a force that jumps at a reference sample "
-            "time. Use a smooth callable reference, or a sampled controller (Ts)"
-        )

@@ -374,22 +374,3 @@ def test_saturated_loop_delayed_step_from_rest():
     still = controllers.simulate_loop(stage(), c, 0.0, 0.001, Ts=TS)  # r = x0, F0 = 0: no force, no motion
     assert np.all(still.x == 0.0) and np.all(still.u == 0.0) and len(still.reversals) == 0
     assert still.reversals.E_0 == 0.0
-
-
-def test_branch_check_finds_a_missed_reversal():
-    """Samples built from the closed-form branch (3.4), gamma = 1: accepted; moving back on the old branch: refused."""
-    from types import SimpleNamespace
-
-    from controllers._loop import _check_branches
-
-    system = stage()  # Fc = 1 N, sigma = 1e6 N/m
-    empty = prefriction.ReversalTable(t=np.array([]), x=np.array([]), F=np.array([]), E_p=np.array([]),
-                                      E_d=np.array([]), E_0=0.0)
-    t = np.linspace(0.0, 1.0, 11)
-    x_up = 1e-6 * t  # monotone: on the loading branch F = 1 - exp(-x sigma/Fc) from F0 = 0
-    up = SimpleNamespace(t=t, x=x_up, v=np.full(t.shape, 1e-6), F=1.0 - np.exp(-x_up * SIGMA), reversals=empty)
-    _check_branches(up, system, 0.0, 0.0)
-    x_back = 1e-6 * np.minimum(t, 1.0 - t)  # goes back without a recorded reversal, F follows the old branch
-    back = SimpleNamespace(t=t, x=x_back, v=np.ones(t.shape), F=1.0 - np.exp(-x_back * SIGMA), reversals=empty)
-    with pytest.raises(prefriction.SolverError, match=r"left the Dahl branch through the reversal at t = 0 s before t = 0.6 s"):
-        _check_branches(back, system, 0.0, 0.0)
