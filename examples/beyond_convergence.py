@@ -1,7 +1,7 @@
 """Beyond the paper: reversal amplitudes over 1e4 reversals against the law ``3/(2n)``.
 
 The exact map satisfies ``a' = a - (2/3) a^2 + O(a^3)``, so ``1/a_{n+1} - 1/a_n -> 2/3`` and
-``a_n ~ 3/(2n)`` (DESIGN.md section 2): the amplitudes, and with them the displacement
+``a_n ~ 3/(2n)`` (docs/mathematics.md#convergence): the amplitudes, and with them the displacement
 amplitudes ``~ a_n Fc/sigma``, decay algebraically in the number of reversals, not
 geometrically, and the potential energy at the reversals like ``9 Fc^2/(8 sigma n^2)``.
 Starting point ``a_0 = 1`` (reversal from sliding). Universal: no sigma, Fc or m enters.

@@ -3,7 +3,7 @@
 (a) The paper's figure: starting from the reversal of largest energy, ``F_i = -Fc``
 (``E_p = 0.3069 Fc^2/sigma``; the paper does not state its starting point), the exact reversal
 map gives ``|F_{i+n}|/Fc`` and (3.14) the potential energy ``E_p(i+n)``; ``Fc = 1 N`` (not
-stated). Dashed: the asymptotic law ``9 Fc^2 / (8 sigma n^2)`` (DESIGN.md section 2).
+stated). Dashed: the asymptotic law ``9 Fc^2 / (8 sigma n^2)`` (docs/mathematics.md#convergence).
 
 (b) The same in normalised units ``E_p sigma/Fc^2``, where the exact sequence is one curve for
 every sigma/Fc, against the recursion the paper proposes, (3.13) then (3.14): with (3.13)

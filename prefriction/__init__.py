@@ -1,24 +1,30 @@
-"""prefriction: pre-sliding friction hysteresis (Ruderman 2023, Dahl model).
+"""prefriction: pre-sliding friction hysteresis (Ruderman 2023): models, simulation, analysis.
 
 Public API, re-exported from private modules:
 
-- models: :class:`Dahl`, :class:`Oscillator`, :class:`FrictionModel`
-- analytics: :mod:`prefriction.dahl` (exact and approximate reversal maps, energies)
-- exact reference: :func:`exact_reversals`
-- simulation: :func:`simulate` (closed linear loops: :class:`LinearFeedback`)
+- models (:mod:`prefriction.models`): :class:`FrictionModel` (the protocol), :class:`Dahl`,
+  :class:`Oscillator`, :class:`Parameter`
+- input signals: :mod:`prefriction.signals` (``Constant``, ``Step``, ``Ramp``, ``Sine``,
+  ``Chirp``, ``Samples`` and sums; compiled once per kind)
+- analytics: :mod:`prefriction.dahl` (exact and approximate reversal maps, energies; Dahl only)
+- exact reference: :func:`exact_reversals` (Dahl only)
+- simulation: :func:`simulate` (closed linear loops: :class:`LinearFeedback`), :func:`sweep`
 - energy analysis: :mod:`prefriction.energy`
+- model checks for new models: :mod:`prefriction.testing`
 """
 
 from __future__ import annotations
 
 from .errors import PrefrictionError, SolverError
-from .models import Dahl, FrictionModel, Oscillator
+from .models import Dahl, FrictionModel, Oscillator, Parameter
 from .reversals import ReversalTable
 from .units import Scales
 from .simulate import SimulationResult, simulate
+from .sweep import SweepResult, sweep
 from ._feedback import LinearFeedback
 from . import energy
 from . import dahl
+from . import signals
 from .exact import exact_reversals
 
 __all__ = [
@@ -26,14 +32,18 @@ __all__ = [
     "FrictionModel",
     "LinearFeedback",
     "Oscillator",
+    "Parameter",
     "PrefrictionError",
     "ReversalTable",
     "Scales",
     "SimulationResult",
     "SolverError",
+    "SweepResult",
     "dahl",
     "energy",
     "exact_reversals",
+    "signals",
     "simulate",
+    "sweep",
 ]
-__version__ = "0.1.0"
+__version__ = "0.2.0"

@@ -8,7 +8,7 @@ import warnings
 import casadi as ca
 import numpy as np
 
-from ._jit import compiled
+from ._jit import compiled, jit_available
 from ._plant import Layout, PlantSpec, build_integrator
 
 _CACHE: dict = {}
@@ -34,20 +34,34 @@ class BufferedIntegrator:
         self.buf.set_res(0, memoryview(self.out))
 
 
-def integrator(spec: PlantSpec, tol: float, atol: float, jit: bool) -> tuple[BufferedIntegrator, float, str]:
-    """Build (or reuse) the integrator of ``spec``; returns it, the setup time and the JIT mode."""
-    key = (spec, tol, atol, jit)
+def integrator(spec: PlantSpec, jit: bool) -> tuple[BufferedIntegrator, float, str]:
+    """Build (or reuse) the integrator of the structure ``spec``; returns it, the setup time and
+    the JIT mode. One per structure and process: numbers and tolerances are run-time inputs."""
+    jit = jit and jit_available()  # PREFRICTION_NO_JIT may change between calls
+    key = (spec, jit)
     if key in _CACHE:
         return _CACHE[key][0], 0.0, _CACHE[key][1] if _CACHE[key][1] == "interpreted" else "cached"
     start = time.perf_counter()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", FutureWarning)
-        fun = build_integrator(spec, tol, atol)
+        fun = build_integrator(spec)
     mode = "interpreted"
     if jit:
-        fun, info = compiled(fun)
+        fun, info = compiled(fun, _describe(spec))
         mode = info.mode
     call = BufferedIntegrator(fun, Layout(spec), spec.n_out)
     setup = time.perf_counter() - start
     _CACHE[key] = (call, mode)
     return call, setup, mode
+
+
+def _describe(spec: PlantSpec) -> str:
+    """One line on what a plant is, for the compile message."""
+    what = [type(spec.model).__name__ + repr(spec.model_key[1:] if isinstance(spec.model_key, tuple) else "")]
+    if spec.u_key is not None:
+        what.append(f"input {spec.u_key[0] if isinstance(spec.u_key, tuple) else spec.u_key}")
+    if spec.fb != "none":
+        what.append(f"{spec.fb} controller of order {spec.n_c}")
+    if spec.energy:
+        what.append("dense output")
+    return ", ".join(what)

@@ -8,13 +8,15 @@ from typing import Any, Optional
 
 import numpy as np
 
-from ._branch import branch_potential
-from ._energy_checks import ROUNDING, check_dahl
-from .models import Dahl
+from ._energy_checks import ROUNDING, check_model
+from .models import FrictionModel
 
 
-def branch_energy(F: Any, direction: Any, *, friction: Dahl) -> np.ndarray:
-    """Energy stored on a Dahl branch relative to its force zero crossing [J].
+def branch_energy(F: Any, direction: Any, *, friction: FrictionModel) -> np.ndarray:
+    """Energy stored on a branch relative to its force zero crossing [J].
+
+    For any rate-independent model whose branch energy depends on the force alone
+    (:meth:`prefriction.FrictionModel.branch_energy_of_force`); for Dahl:
 
     ``E = (Fc^2 / sigma) H_gamma(s F / Fc)`` with ``H_gamma(f) = int_0^f phi (1 - phi)^-gamma dphi``
     and ``s`` the direction of motion on the branch. At a reversal, with ``s`` the *new*
@@ -27,15 +29,15 @@ def branch_energy(F: Any, direction: Any, *, friction: Dahl) -> np.ndarray:
         Friction forces [N], ``|F| <= Fc``.
     direction : array_like
         Direction of motion on the branch, +1 or -1 (broadcast against ``F``).
-    friction : Dahl
-        The friction model (``sigma`` [N/m], ``Fc`` [N], ``gamma``).
+    friction : FrictionModel
+        The friction model, e.g. :class:`prefriction.Dahl` (``sigma`` [N/m], ``Fc`` [N], ``gamma``).
 
     Returns
     -------
     numpy.ndarray
         Stored energy [J], >= 0.
     """
-    friction = check_dahl(friction)
+    friction = check_model(friction)
     F = np.asarray(F, dtype=float)
     s = np.asarray(direction, dtype=float)
     if not np.all(np.abs(s) == 1.0):
@@ -45,8 +47,7 @@ def branch_energy(F: Any, direction: Any, *, friction: Dahl) -> np.ndarray:
     if np.any(~(np.abs(F) <= Fc * (1.0 + ROUNDING))):
         bad = F[~(np.abs(F) <= Fc * (1.0 + ROUNDING))].flat[0]
         raise ValueError(f"F must lie in [-Fc, Fc] = [{-Fc!r}, {Fc!r}] (every entry), got {float(bad)!r}")
-    f = np.clip(s * F / Fc, -1.0, 1.0)
-    return (Fc * Fc / friction.sigma) * np.asarray(branch_potential(f, friction.gamma), dtype=float)
+    return (Fc * Fc / friction.sigma) * friction.branch_energy_of_force(np.clip(F / Fc, -1.0, 1.0), s)
 
 
 def dissipation(E_p: Any, *, input_work: Any = None) -> np.ndarray:
@@ -171,7 +172,7 @@ class BoundCheck:
         return "\n".join(lines)
 
 
-def bound_check(E_p: Any, *, friction: Dahl, E_0: Optional[float] = None) -> BoundCheck:
+def bound_check(E_p: Any, *, friction: FrictionModel, E_0: Optional[float] = None) -> BoundCheck:
     """Check the bound (2.12) ``E_p(i) < Fc^2 / (2 k_min)`` and report by how much it holds.
 
     For the Dahl model (3.2) with ``gamma >= 0`` the tangent stiffness on an unloading branch
@@ -183,8 +184,8 @@ def bound_check(E_p: Any, *, friction: Dahl, E_0: Optional[float] = None) -> Bou
     ----------
     E_p : float or array_like
         Potential energy at the reversals [J], length >= 1.
-    friction : Dahl
-        The friction model.
+    friction : FrictionModel
+        The (rate-independent) friction model; ``k_min`` is its least unloading stiffness.
     E_0 : float, optional
         Energy of the initial state [J]; reported (ratio to the bound), never checked.
 
@@ -192,13 +193,13 @@ def bound_check(E_p: Any, *, friction: Dahl, E_0: Optional[float] = None) -> Bou
     -------
     BoundCheck
     """
-    friction = check_dahl(friction)
+    friction = check_model(friction)
     E_p = np.atleast_1d(np.asarray(E_p, dtype=float))
     if E_p.ndim != 1 or E_p.size < 1:
         raise ValueError(f"E_p must be a number or a non-empty 1-D array, got shape {E_p.shape}")
     scale = friction.Fc**2 / friction.sigma
-    bound = 0.5 * scale
-    sharp = scale * float(branch_potential(-1.0, friction.gamma))
+    bound = 0.5 * friction.Fc**2 / friction.k_min
+    sharp = scale * float(friction.branch_energy_of_force(np.array([-1.0]), 1.0)[0])
     i = int(np.argmax(E_p))
     top = float(E_p[i])
     e0 = None if E_0 is None else float(E_0)

@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from .models import Dahl, check_dahl_oscillator
+from .models import FrictionModel, check_oscillator
 
 QUADRATURES = ("trapezoid", "simpson")
 """Quadrature rules of the power integrals: cumulative trapezoid or Simpson (scipy)."""
@@ -62,13 +62,20 @@ def check_method(method: Any) -> str:
     return method
 
 
-def check_dahl_system(system: Any) -> tuple[Dahl, float]:
-    """Return the Dahl friction model and the mass of ``system``; ``TypeError`` otherwise."""
-    return check_dahl_oscillator(system, "the energy analysis (branch potential)"), system.mass
+def check_dahl_system(system: Any) -> tuple[FrictionModel, float]:
+    """Return the (rate-independent) friction model and the mass of ``system``; ``TypeError`` otherwise."""
+    return check_model(check_oscillator(system, "the energy analysis")), system.mass
 
 
-def check_dahl(friction: Any) -> Dahl:
-    """Return ``friction`` if it is a :class:`prefriction.Dahl` model; ``TypeError`` otherwise."""
-    if not isinstance(friction, Dahl):
-        raise TypeError(f"friction must be a prefriction.Dahl model, got {friction!r} of type {type(friction).__name__}")
+def check_model(friction: Any) -> FrictionModel:
+    """Return ``friction`` if it is a rate-independent :class:`prefriction.FrictionModel` with a
+    branch energy (the energy analysis (2.3)-(2.12) needs it); ``TypeError`` otherwise."""
+    if not isinstance(friction, FrictionModel):
+        raise TypeError(f"friction must be a prefriction.FrictionModel such as Dahl, got {friction!r} "
+                        f"of type {type(friction).__name__}")
+    if not friction.rate_independent:
+        raise TypeError(f"the energy analysis needs a rate-independent friction model, got {type(friction).__name__}")
+    if type(friction).branch_energy_of_force is FrictionModel.branch_energy_of_force:
+        raise TypeError(f"the energy analysis needs the branch energy as a function of the force; "
+                        f"{type(friction).__name__} does not define branch_energy_of_force")
     return friction

@@ -11,7 +11,6 @@ from ._energy_balance import BoundCheck, bound_check, branch_energy, dissipation
 from ._energy_checks import ROUNDING, check_dahl_system, check_method, check_samples
 from ._sampled_energy import cumulative, kinetic_energy
 from ._sampled_reversals import SampledReversals, find_reversals
-from ._signals import eval_signal, signal_kind
 from .models import Oscillator
 from .reversals import ReversalTable
 
@@ -128,7 +127,8 @@ def _rel_residual(values: np.ndarray, scale: float) -> float:
 
 def _input_power(system: Oscillator, t: np.ndarray, v: np.ndarray) -> np.ndarray:
     """Power ``u v`` [W] of the input force at the samples."""
-    return eval_signal(system.u, signal_kind(system.u), t) * v
+    u = np.asarray(system.u(t), dtype=float) if system.forced else np.zeros_like(t)
+    return u * v
 
 
 def _work_to_reversals(t: np.ndarray, p: np.ndarray, rev: SampledReversals, method: str) -> np.ndarray:

@@ -27,7 +27,7 @@ from typing import Any, Callable, Optional, Union
 
 import numpy as np
 
-from ._validation import check_positive, check_signal
+from ._validation import check_positive
 
 Reference = Union[float, Callable[[Any], Any], tuple]
 
@@ -59,9 +59,10 @@ class LinearFeedback:
     Ts : float or None, default None
         Sample period [s] of a discrete-time controller with zero-order hold on ``u``;
         ``None`` for a continuous-time controller.
-    reference : float, callable or (t, r) samples, default 0.0
-        Position reference ``r(t)`` [m]: a constant, a callable of time ``t`` [s] that accepts a
-        CasADi symbol (``numpy`` ufuncs and arithmetic do), or samples ``(t, r)`` interpolated
+    reference : float, Signal, callable or (t, r) samples, default 0.0
+        Position reference ``r(t)`` [m]: a constant, a :class:`prefriction.signals.Signal`
+        (compiled once per kind, numbers at run time), a callable of time ``t`` [s] that accepts
+        a CasADi symbol (compiled once per function), or samples ``(t, r)`` interpolated
         linearly and held constant outside the sample range.
     xc0 : array_like or None, default None
         Initial controller state, shape ``(n,)``; zeros if ``None``.
@@ -90,7 +91,9 @@ class LinearFeedback:
         object.__setattr__(self, "D", _as_matrix("D", self.D, (1, 1)))
         if self.Ts is not None:
             object.__setattr__(self, "Ts", check_positive("Ts", self.Ts))
-        object.__setattr__(self, "reference", check_signal("reference", self.reference, "m", "r"))
+        from .signals import as_signal
+
+        object.__setattr__(self, "reference", as_signal(self.reference, "reference", "m"))
         xc0 = np.zeros(n) if self.xc0 is None else np.array(self.xc0, dtype=float).reshape(-1)
         if xc0.shape != (n,) or not np.all(np.isfinite(xc0)):
             raise ValueError(f"xc0 must be a finite vector of length {n}, got {self.xc0!r}")

@@ -9,8 +9,7 @@ import numpy as np
 
 from ._buffered_integrator import INTEGRATOR_FAILED, BufferedIntegrator, integrator
 from ._feedback import LinearFeedback
-from ._plant import EPS_REST, Layout, PlantSpec, force_of_p, p_of_force
-from ._signals import eval_signal, linear_piece
+from ._plant import EPS_REST, Layout, PlantSpec
 from .errors import SolverError
 from .models import Oscillator
 from .units import Scales
@@ -27,31 +26,32 @@ class Run:
     """
 
     def __init__(self, system: Oscillator, spec: PlantSpec, fb: Optional[LinearFeedback],
-                 tol: float, atol: float, jit: bool) -> None:
+                 eps: float, jit: bool) -> None:
         self.system, self.spec, self.fb = system, spec, fb
         self.sc = Scales.of(system)
-        self.gamma = system.friction.gamma
+        self.model = system.friction
+        self.q = self.model.runtime_params()
+        self.eps = eps  # run-time tolerance: states are scaled by amplitude * eps
         self.L = Layout(spec)
-        self.f1, s1, mode = integrator(PlantSpec(**{**spec.__dict__, "n_out": 1}), tol, atol, jit)
+        self.f1, s1, mode = integrator(PlantSpec(**{**spec.__dict__, "n_out": 1}), jit)
         self.Ld: Optional[Layout] = None
         self.fd: Optional[BufferedIntegrator] = None
         sd = 0.0
         if spec.n_out > 1:
             dense_spec = PlantSpec(**{**spec.__dict__, "n_out": N_DENSE})
             self.Ld = Layout(dense_spec)
-            self.fd, sd, _ = integrator(dense_spec, tol, atol, jit)
+            self.fd, sd, _ = integrator(dense_spec, jit)
         self.setup_time = s1 + sd
         self.mode = mode
         self.calls = 0
         self.steps: Optional[int] = 0
         self.rev: list[tuple] = []  # (t~, x~, F~, W~)
         self.st: dict = {}  # current state, normalised (set by simulate)
-        self.snap = 0.0  # reversal-saturation coincidence tolerance (gamma < 1)
+        self.snap = 0.0  # reversal-event coincidence tolerance (e.g. Dahl saturation)
         self.force_scale = 0.0  # size of the applied force / Fc
         self.A_max = 0.0  # largest amplitude seen (forced)
         self.breaks = np.zeros(0)  # sample times of sampled signals (normalised)
-        self.u_kind = self.r_kind = "none"
-        self.S = np.ones(spec.n_c)  # controller state scales
+        self.S = np.ones(spec.n_c)  # controller state scales (times eps)
         self.P0 = np.zeros(self.L.np)  # parameters fixed during the run
 
     # --- state conversion -------------------------------------------------------------
@@ -69,19 +69,23 @@ class Run:
 
     def _constant_params(self, L: Layout) -> np.ndarray:
         """Parameter vector with the entries that stay fixed during the run."""
-        sc, fb = self.sc, self.fb
+        sc, fb, spec = self.sc, self.fb, self.spec
         P = np.zeros(L.np)
-        if self.spec.stops_at_reversal:  # every parameter changes per call
+        P[L.param["eps"]] = self.eps
+        P[L.q] = self.q
+        if spec.stops_at_reversal:  # the amplitudes and the direction change per call
             return P
         P[L.param["snap"]] = self.snap
         P[L.param["tunit"]] = sc.t
         P[L.param["xunit"]] = sc.x
         P[L.param["Fc"]] = sc.F
-        if "r" in L.param:
-            P[L.param["r"]] = float(fb.reference)
-        if self.spec.fb == "continuous":
+        if spec.u_sig is not None:
+            P[L.up] = spec.u_sig.params()
+        if spec.r_sig is not None:
+            P[L.rp] = spec.r_sig.params()
+        if spec.fb == "continuous":
             Ct = fb.C[0] / sc.F
-            self.S = np.where(Ct != 0, 1.0 / np.where(Ct == 0, 1.0, np.abs(Ct)), 1.0)
+            self.S = self.eps * np.where(Ct != 0, 1.0 / np.where(Ct == 0, 1.0, np.abs(Ct)), 1.0)
             P[L.p_A:L.p_B] = (fb.A * sc.t).T.ravel()  # column-major, as ca.reshape reads it
             P[L.p_B:L.p_C] = fb.B[:, 0] * sc.t * sc.x
             P[L.p_C:L.p_D] = Ct
@@ -101,11 +105,12 @@ class Run:
         st, ix, X = self.st, L.state, call.X0
         X[0] = 0.0  # xh: positions relative to xref
         X[1] = st["v"] / a["Av"]
-        X[2] = st["p"] / a["AF"]
-        X[3] = st["s"]
-        X[4] = len(self.rev)
-        if "sat" in ix:
-            X[ix["sat"]] = st["sat"]
+        for i, zi in enumerate(st["z"]):
+            X[2 + i] = zi / a["AF"]
+        X[ix["s"]] = st["s"]
+        X[ix["n"]] = len(self.rev)
+        for i, mi in enumerate(st["m"]):
+            X[ix[f"m{i}"]] = mi
         if "rest" in ix:
             X[ix["rest"]] = st["rest"]
             X[ix["Wh"]] = st["W"] / a["AE"]
@@ -118,18 +123,20 @@ class Run:
         """State of one output column; ``t`` is the stop time if the call stopped at ``nstop``."""
         ix = L.state
         c = col.tolist()  # Python floats: cheaper to index than numpy scalars
-        n = int(c[4] + 0.5)
-        s = c[3]
-        p = a["AF"] * c[2]
+        n = int(c[ix["n"]] + 0.5)
+        s = c[ix["s"]]
+        z = [a["AF"] * c[2 + i] for i in range(L.nz)]
+        m = [c[ix[f"m{i}"]] for i in range(L.nm)]
+        v = a["Av"] * c[1]
         out = {
             "x": a["xref"] + a["Ax"] * c[0],
-            "v": a["Av"] * c[1],
-            "p": p,
-            "F": s * force_of_p(p, self.gamma),
+            "v": v,
+            "z": z,
+            "m": m,
+            "F": float(self.model.force(z, m, v, s, self.q)),
             "s": s,
             "n": n,
             "frozen": n >= nstop,
-            "sat": c[ix["sat"]] if "sat" in ix else 0.0,
             "rest": c[ix["rest"]] if "rest" in ix else 0.0,
             "W": a["AE"] * c[ix["Wh"]] if "Wh" in ix else 0.0,
             "Ef": a["Efref"] + a["AE"] * c[ix["Eh"]] if "Eh" in ix else 0.0,
@@ -153,16 +160,10 @@ class Run:
         U = [0.0] * L.nu
         U[L.control["dur"]] = t1 - t0
         U[L.control["t0"]] = t0 - (t1 - t0) * j  # t~ = t0 + dur * tau, tau in [j, j + 1]
-        if "tl" in L.control:
-            ta, tb = t0 * sc.t, t1 * sc.t
-            tl = ta
-            if self.spec.u_kind == "samples":
-                tl, ua, ub = linear_piece(sys.u, ta, tb)
-                U[L.control["ua"]], U[L.control["ub"]] = ua + ub * (ta - tl), ub
-            if self.spec.r_kind == "samples":
-                tl2, ra, rb = linear_piece(fb.reference, ta, tb)
-                U[L.control["ra"]], U[L.control["rb"]] = ra + rb * (ta - tl2), rb
-            U[L.control["tl"]] = ta
+        if L.uc.stop > L.uc.start:
+            U[L.uc] = self.spec.u_sig.piece(t0 * sc.t, t1 * sc.t).tolist()
+        if L.rc.stop > L.rc.start:
+            U[L.rc] = self.spec.r_sig.piece(t0 * sc.t, t1 * sc.t).tolist()
         if "uhold" in L.control:
             U[L.control["uhold"]] = self.st["uhold"]
         return U
@@ -170,10 +171,10 @@ class Run:
     def _net_force(self) -> float:
         """Normalised net force ``u~ - F~`` on the mass in the current state."""
         st, sc = self.st, self.sc
-        t_si = np.array([st["t"] * sc.t])
-        u = float(eval_signal(self.system.u, self.u_kind, t_si)[0]) if self.system.forced else 0.0
+        t_si = st["t"] * sc.t
+        u = float(self.system.u(t_si)) if self.system.forced else 0.0
         if self.spec.fb == "continuous":
-            e = float(eval_signal(self.fb.reference, self.r_kind, t_si)[0]) - st["x"] * sc.x
+            e = float(self.fb.reference(t_si)) - st["x"] * sc.x
             u += float(self.fb.C[0] @ st["xc"] + self.fb.D[0, 0] * e)
         elif self.spec.fb == "sampled":
             u += st["uhold"]
@@ -190,8 +191,7 @@ class Run:
         if new_s != st["s"]:  # leaves backwards: a reversal at this instant
             self.rev.append((st["t"], st["x"], st["F"], st["W"]))
             st["W"] = 0.0
-            st["p"] = p_of_force(new_s * st["F"], self.gamma)
-            st["sat"] = 0.0
+            st["z"], st["m"] = self._reverse(st["z"], st["m"], new_s)
             st["s"] = new_s
         st["rest"] = 0.0
 
@@ -199,7 +199,8 @@ class Run:
         """One integrator call over the output ``times`` (normalised), stopping at ``nstop`` reversals."""
         if self.spec.forced and self.st["rest"] > 0.5:
             self._leave_rest()
-        a = self._scales()
+        eps = self.eps
+        a = {k: val * eps for k, val in self._scales().items()}
         a["xref"], a["Efref"] = self.st["x"], self.st["Ef"]
         self._params(call, L, a, nstop)
         self._pack(call, L, a)
@@ -239,37 +240,40 @@ class Run:
     def _accept(self, out: dict, t: float) -> None:
         """Take the unpacked state ``out``, at normalised time ``t`` unless the call stopped early."""
         self.rev.extend(out["new"])
-        for k in ("x", "v", "F", "p", "s", "sat", "rest", "W", "Ef", "xc"):
+        for k in ("x", "v", "F", "z", "m", "s", "rest", "W", "Ef", "xc"):
             self.st[k] = out[k]
         self.st["t"] = t if out["t"] is None else out["t"]
 
     # --- loops --------------------------------------------------------------------------
+    def _reverse(self, z: list, m: list, s_new: float) -> tuple[list, list]:
+        """The model's state just after a reversal into ``s_new`` (floats)."""
+        return self.model.reverse(z, m, s_new, self.q, self.snap)
+
     def _advance_compact(self, t_target: float, n_target: float) -> bool:
         """:meth:`advance` for the compact unforced model (``spec.stops_at_reversal``): each call
         runs to the next reversal (or ``t_target``); the new branch starts here, in Python.
         Local variables only (``self.st`` is written at the end or before an error)."""
-        call, L, g = self.f1, self.L, self.gamma
+        call, L, model, eps = self.f1, self.L, self.model, self.eps
+        q = self.q.tolist()  # floats: the model's numeric fast paths
         # memoryviews of the call's buffers: item assignment costs ~25 ns, not ~70 ns (numpy)
         X0, P, U = memoryview(call.X0), memoryview(call.P), memoryview(call.U.reshape(-1))
         out, trigger, buf = memoryview(call.out), call.trigger, call.buf
         compiled = self.mode != "interpreted"
         ix = L.state
-        isat, iv, iF = ix.get("sat"), ix["vh"], ix["Fh"]
-        saturates, snap = isat is not None, self.snap
-        if g == 1.0:
-            def f_of(p: float) -> float:
-                return -math.expm1(-p)
-        else:
-            def f_of(p: float) -> float:
-                return force_of_p(p, g)
+        iv, ixh = ix["vh"], ix.get("xh")
+        iz = [ix[f"z{i}"] for i in range(L.nz)]
+        im = [ix[f"m{i}"] for i in range(L.nm)]
+        tracks = ixh is None
+        force, travel, reverse, snap = model.force, model.travel, model.reverse, self.snap
+        P[:] = self.P0  # eps and the model's numbers q
         st, rev = self.st, self.rev
-        x, v, p, s, t, sat = st["x"], st["v"], st["p"], st["s"], st["t"], st["sat"]
+        x, v, z, m, s, t = st["x"], st["v"], st["z"], st["m"], st["s"], st["t"]
         grow = 1.0
         calls = 0
         t_stop = t_target * (1 - 1e-15) if t_target < math.inf else math.inf
         n = len(rev)
         while n < n_target and t < t_stop:
-            F = s * f_of(p)
+            F = float(force(z, m, v, s, q))
             if n >= 2:  # the next half-cycle about as long as the last one, with a margin
                 chunk = 2.0 * (rev[-1][0] - rev[-2][0]) * grow
             else:  # F rises over a distance ~1 (time ~1/|v|): the first step must not skip it;
@@ -277,12 +281,17 @@ class Run:
                 chunk = 2.0 * math.pi / max(1.0, abs(v)) * grow
             t1 = min(t_target, t + chunk)
             A = max(math.hypot(v, F), 1e-300)
-            Ax = max(A, 0.5 * A * A, min(abs(x), 1.0))
-            AF = min(A, 1.0)
-            P[0], P[1], P[2], P[3] = Ax, A, AF, s
-            X0[iv], X0[iF] = v / A, p / AF
-            if saturates:
-                X0[0], X0[isat] = 0.0, sat
+            Ax = max(A, 0.5 * A * A, min(abs(x), 1.0)) * eps
+            AF = min(A, 1.0) * eps
+            Av = A * eps
+            P[0], P[1], P[2], P[3] = Ax, Av, AF, s
+            X0[iv] = v / Av
+            for i, k in enumerate(iz):
+                X0[k] = z[i] / AF
+            for i, k in enumerate(im):
+                X0[k] = m[i]
+            if not tracks:
+                X0[ixh] = 0.0
             U[0], U[1] = t1 - t, t
             calls += 1
             why = INTEGRATOR_FAILED
@@ -297,34 +306,28 @@ class Run:
             c = out.tolist()
             if not (ok and math.isfinite(math.fsum(c))):
                 self.calls += calls
-                st.update(x=x, v=v, p=p, s=s, t=t, sat=sat, F=F)
+                st.update(x=x, v=v, z=z, m=m, s=s, t=t, F=F)
                 raise self._failure(why)
             if self.steps is not None:
                 self._count_steps(call)
-            if saturates:
-                x, p, sat = x + Ax * c[0], AF * c[iF], c[isat]
-            else:  # x' = s p' on the branch
-                p1 = AF * c[iF]
-                x, p = x + s * (p1 - p), p1
-            sv = s * c[iv]
+            z1 = [AF * c[k] for k in iz]
+            x = x + travel(z, z1, s, q) if tracks else x + Ax * c[ixh]
+            z, m = z1, [c[k] for k in im]
+            sv = s * c[iv] * eps
             if sv > -0.5:  # no reversal: vh is the velocity
-                v = A * c[iv]
+                v = Av * c[iv]
                 t = t1
                 grow *= 4.0
-            else:  # vh = -s (1 + tau) at a reversal: record it, start the branch of direction -s
+            else:  # vh eps = -s (1 + tau) at a reversal: record it, start the branch of direction -s
                 t = t + (t1 - t) * (-sv - 1.0)  # t0 + dur tau, as the integrator's time
                 v = 0.0
-                F = s * f_of(p)
-                rev.append((t, x, F, 0.0))
+                rev.append((t, x, float(force(z, m, 0.0, s, q)), 0.0))
                 n += 1
-                # a reversal within snap of saturation is one at saturation (see _plant)
-                Fs = s if saturates and 1.0 - (1.0 - g) * p < snap else F
                 s = -s
-                p = p_of_force(s * Fs, g)
-                sat = 0.0
+                z, m = reverse(z, m, s, q, snap)
                 grow = 1.0
         self.calls += calls
-        st.update(x=x, v=v, p=p, s=s, t=t, sat=sat, F=s * f_of(p))
+        st.update(x=x, v=v, z=z, m=m, s=s, t=t, F=float(force(z, m, v, s, q)))
         return n >= n_target
 
     def _count_steps(self, call: BufferedIntegrator) -> None:

@@ -14,6 +14,7 @@ import hashlib
 import os
 import shutil
 import subprocess
+import sys
 import tempfile
 import time
 from dataclasses import dataclass
@@ -55,13 +56,15 @@ def jit_available() -> bool:
     return os.environ.get("PREFRICTION_NO_JIT", "") in ("", "0") and _compiler() is not None
 
 
-def compiled(fun: ca.Function) -> tuple[ca.Function, CompileInfo]:
+def compiled(fun: ca.Function, what: str = "") -> tuple[ca.Function, CompileInfo]:
     """Return a compiled equivalent of ``fun`` (loaded from the cache if present) and how it was made.
 
     Parameters
     ----------
     fun : casadi.Function
         A Function that supports code generation (e.g. an ``erk`` or ``rosenbrock`` integrator).
+    what : str, optional
+        What the Function is, for the one line printed to stderr when it is compiled.
 
     Returns
     -------
@@ -93,6 +96,8 @@ def compiled(fun: ca.Function) -> tuple[ca.Function, CompileInfo]:
                 return ca.external(name, str(lib)), CompileInfo("cached", 0.0, str(lib))
             except RuntimeError:
                 lib.unlink(missing_ok=True)  # corrupt or foreign library: rebuild it below
+        print(f"prefriction: compiling {name} ({what or 'plant'}) once per structure; cached in {directory}",
+              file=sys.stderr, flush=True)
         try:
             directory.mkdir(parents=True, exist_ok=True)
             part = Path(tmp) / lib.name

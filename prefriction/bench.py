@@ -14,8 +14,9 @@ One run measures, against :func:`prefriction.exact_reversals`:
 Error = max relative error over the first 50 reversals of the times, the positions (relative to
 ``max(|x|, Fc / sigma)``) and the forces; a missing or extra reversal is an infinite error.
 Run times are warm (compiled code loaded, minimum of repeats); the one-time JIT compile time is
-reported separately. Peers integrate the same normalised equations (DESIGN.md section 2), with
-``rtol = tol`` and ``atol = tol / 100``.
+reported separately. Peers integrate the same normalised equations
+(``docs/mathematics.md#normalised-units``), with ``rtol = tol`` and ``atol = tol / 100``. The
+error definition, the cases and the targets are described in ``docs/bench.md``.
 """
 
 from __future__ import annotations

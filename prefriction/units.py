@@ -1,8 +1,9 @@
-"""Normalised units that make the unforced Dahl oscillator parameter-free (DESIGN.md section 2).
+"""Normalised units that make the unforced Dahl oscillator parameter-free.
 
 ``x~ = x sigma / Fc``, ``F~ = F / Fc``, ``t~ = t sqrt(sigma / m)``, ``v~ = v sqrt(m sigma) / Fc``,
 ``E~ = E sigma / Fc^2``. In these units ``x~' = v~``, ``v~' = u~ - F~`` and
-``F~' = v~ (1 - s F~)^gamma``: every sigma, Fc and m is the same problem.
+``F~' = v~ (1 - s F~)^gamma``: every sigma, Fc and m is the same problem
+(``docs/mathematics.md#normalised-units``).
 """
 
 from __future__ import annotations

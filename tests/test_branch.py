@@ -125,7 +125,7 @@ def test_loading_end_inverts_potential(g: float) -> None:
 
 
 def test_loading_end_gamma1_lambert_w() -> None:
-    # DESIGN.md: L = c + 1 + W0(-exp(-(1 + c)))
+    # docs/mathematics.md#reversal-map: L = c + 1 + W0(-exp(-(1 + c)))
     for c in [1e-6, 0.3, 5.0, 1e6]:
         with mp.workdps(60):
             ref = mp.mpf(c) + 1 + mp.lambertw(-mp.exp(-(1 + mp.mpf(c))))

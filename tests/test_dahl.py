@@ -15,7 +15,7 @@ from prefriction import dahl
 
 
 def mp_next(a: float, dps: int = 40) -> mp.mpf:
-    """Exact map via the Lambert-W root of (3.10) (DESIGN.md section 2) at high precision."""
+    """Exact map via the Lambert-W root of (3.10) (docs/mathematics.md#reversal-map) at high precision."""
     with mp.workdps(dps):
         am = mp.mpf(a)
         c = am - mp.log1p(am)
@@ -138,7 +138,7 @@ def test_paper_approximation_erratum_and_errors() -> None:
     a = np.array([1.0, 0.6, 0.2, 1e-6])
     y_paper = dahl.next_reversal_position_paper(-a, 1.0, 1.0)  # sigma = Fc = 1: normalised
     err = np.array([float(y / mp_position(x) - 1) for x, y in zip(a, y_paper)])
-    # DESIGN.md: 0.15 % at a = 1, 5 % at 0.6, 12 % at 0.2, factor 5/6 as a -> 0
+    # docs/mathematics.md#erratum-3-13: 0.15 % at a = 1, 5 % at 0.6, 12 % at 0.2, factor 5/6 as a -> 0
     assert abs(err[0]) == pytest.approx(0.0015, abs=3e-4)
     assert abs(err[1]) == pytest.approx(0.05, abs=0.01)
     assert abs(err[2]) == pytest.approx(0.12, abs=0.01)

@@ -470,7 +470,7 @@ def test_model_validation_messages():
         energy.branch_energy([1.0, 2.5], 1, friction=d)
     with pytest.raises(ValueError, match="direction must be \\+1 or -1 \\(every entry\\), got 0.0"):
         energy.branch_energy([1.0], 0, friction=d)
-    with pytest.raises(TypeError, match="friction must be a prefriction.Dahl model"):
+    with pytest.raises(TypeError, match="friction must be a prefriction.FrictionModel such as Dahl"):
         energy.branch_energy([1.0], 1, friction="dahl")
     with pytest.raises(TypeError, match="system must be a prefriction.Oscillator"):
         energy.analyze_samples([0, 1], [0, 1], [1, -1], [0, 0], system=d)

@@ -275,7 +275,7 @@ def test_table_command_prints_the_default_case(capsys):
     assert main([]) == 0
     out = capsys.readouterr().out
     # default: sigma = 1e4, Fc = 1, m = 1, v0 = 0.01 -> first excursion stores c = 0.5 Fc^2/sigma;
-    # first reversal force 1 - exp(-y), y = c + 1 + W0(-exp(-(1 + c))) (DESIGN.md section 2)
+    # first reversal force 1 - exp(-y), y = c + 1 + W0(-exp(-(1 + c))) (docs/mathematics.md#first-excursion)
     with mp.workdps(30):
         y = mp.mpf("1.5") + mp.lambertw(-mp.exp(-mp.mpf("1.5")))
         F1 = float(-mp.expm1(-y))
@@ -309,7 +309,7 @@ def test_table_command_options_and_bad_input(capsys):
     Fc=st.floats(min_value=1e-3, max_value=1e3),
 )
 def test_normalised_table_is_independent_of_sigma_fc_and_mass(g, log_c, f0, log_sigma, log_m, Fc):
-    """(2.1) with (3.2) in the units x Fc/sigma, t sqrt(m/sigma) is parameter-free (DESIGN.md 2)."""
+    """(2.1) with (3.2) in the units x Fc/sigma, t sqrt(m/sigma) is parameter-free (docs/mathematics.md#normalised-units)."""
     assume(not (g >= 1.0 and f0 == 1.0))  # infinite branch energy: rejected, tested above
     unit = pf.Oscillator(pf.Dahl(sigma=1.0, Fc=1.0, gamma=g), mass=1.0)
     other = pf.Oscillator(pf.Dahl(sigma=10.0**log_sigma, Fc=Fc, gamma=g), mass=10.0**log_m)

@@ -52,16 +52,16 @@ def test_dahl_slope_is_rest_stiffness_at_zero_force(gamma):
 def test_oscillator_validation():
     d = Dahl(1e4, 1.0)
     assert Oscillator(d).mass == 1.0 and not Oscillator(d).forced
-    assert Oscillator(d, u=2).u == 2.0 and Oscillator(d, u=2).forced
+    assert Oscillator(d, u=2).u(0.7) == 2.0 and Oscillator(d, u=2).forced
     with pytest.raises(ValueError, match=r"mass must be finite and > 0, got -1.0"):
         Oscillator(d, mass=-1.0)
     with pytest.raises(TypeError, match="friction must be a FrictionModel"):
         Oscillator(1.0)  # type: ignore[arg-type]
-    with pytest.raises(TypeError, match=r"u must be a number \[N\], a callable u\(t\)"):
+    with pytest.raises(TypeError, match=r"u must be None, a Signal \(prefriction.signals\), a finite real number \[N\]"):
         Oscillator(d, u="3")  # type: ignore[arg-type]
     with pytest.raises(ValueError, match="strictly increasing"):
         Oscillator(d, u=([0.0, 0.0], [1.0, 2.0]))
-    with pytest.raises(ValueError, match="equal length"):
+    with pytest.raises(ValueError, match="same length as u sample times"):
         Oscillator(d, u=([0.0, 1.0], [1.0]))
     with pytest.raises(ValueError, match="finite"):
         Oscillator(d, u=([0.0, 1.0], [1.0, math.nan]))
@@ -81,25 +81,40 @@ def test_scales_are_consistent_units(sigma, Fc, m):
     assert sigma * s.t**2 / m == pytest.approx(1.0)  # natural period of the rest-stiffness spring
 
 
-class _Linear(FrictionModel):
-    """A friction model that is not Dahl: a linear spring (for the type checks)."""
+class _Viscous(FrictionModel):
+    """A rate-dependent model (viscous friction ``F = v``): not for the Dahl-only or the
+    energy functions (for the type checks)."""
 
     sigma, Fc = 1.0, 1.0
+    rate_independent = False
+    n_states = 0
 
-    def slope(self, f):
-        return 1.0 + 0.0 * f
+    def runtime_params(self):
+        return np.zeros(0)
+
+    def initial_state(self, f0, s):
+        return [], []
+
+    def rate(self, z, m, v, s, q):
+        return []
+
+    def force(self, z, m, v, s, q):
+        return v
+
+    def reverse(self, z, m, s_new, q, snap):
+        return [], []
 
 
 @pytest.mark.parametrize(
-    ("call", "purpose"),
+    ("call", "message"),
     [
-        (lambda s: pf.exact_reversals(s, 0.1, 3), "exact_reversals"),
-        (lambda s: pf.simulate(s, 0.1, reversals=3), "simulate"),
-        (lambda s: pf.energy.total_energy([0.0, 1.0], [0.1, 0.1], [0.0, 0.0], system=s), "the energy analysis"),
+        (lambda s: pf.exact_reversals(s, 0.1, 3), "exact_reversals is Dahl-only"),
+        (lambda s: pf.energy.total_energy([0.0, 1.0], [0.1, 0.1], [0.0, 0.0], system=s),
+         "the energy analysis needs a rate-independent friction model"),
     ],
 )
-def test_dahl_only_functions_name_what_needs_dahl(call, purpose):
-    with pytest.raises(TypeError, match=rf"{purpose}.* needs system.friction to be a prefriction.Dahl model"):
-        call(Oscillator(_Linear()))
+def test_dahl_only_functions_name_what_they_need(call, message):
+    with pytest.raises(TypeError, match=message):
+        call(Oscillator(_Viscous()))
     with pytest.raises(TypeError, match="system must be a prefriction.Oscillator, got 3"):
         call(3)

@@ -29,7 +29,7 @@ def test_paper_command_writes_report_and_every_png(tmp_path, capsys):
     assert "E_p(F_i) / (Fc (1 - r^(3/5)))" in report
     assert "0.306853 Fc^2/sigma" in report
     assert "## Where the toolbox disagrees with the paper" in report
-    # the error table carries the values of DESIGN.md: +0.15 % at a = 1, -5.05 % at 0.6, -12.11 % at 0.2
+    # the error table carries the values of docs/mathematics.md#erratum-3-13: +0.15 % at a = 1, -5.05 % at 0.6, -12.11 % at 0.2
     assert re.search(r"\| 1 \| 0\.59362\d+ \| [\d.]+ \| \+0\.15 % \|", report)
     assert re.search(r"\| 0\.6 \| [\d.]+ \| [\d.]+ \| -5\.05 % \|", report)
     assert re.search(r"\| 0\.2 \| [\d.]+ \| [\d.]+ \| -12\.11 % \|", report)

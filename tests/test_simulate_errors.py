@@ -86,7 +86,7 @@ def test_no_compiler_fallback_gives_the_same_table(monkeypatch: pytest.MonkeyPat
     """PREFRICTION_NO_JIT=1: the interpreted integrator, same reversal table to round-off."""
     ref = pf.simulate(SYS, 1.0, reversals=20, rtol=3e-9)
     monkeypatch.setenv("PREFRICTION_NO_JIT", "1")
-    res = pf.simulate(SYS, 1.0, reversals=20, rtol=3.0000001e-9)  # new tolerance: not in memory
+    res = pf.simulate(SYS, 1.0, reversals=20, rtol=3.0000001e-9)
     assert res.stats.jit == "interpreted" and res.stats.steps is not None and res.stats.steps > 0
     np.testing.assert_allclose(res.reversals.F, ref.reversals.F, rtol=1e-7)
     np.testing.assert_allclose(res.reversals.t, ref.reversals.t, rtol=1e-9)

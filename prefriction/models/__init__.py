@@ -1,0 +1,12 @@
+"""Friction models behind one protocol, and the oscillator (2.1) they act in.
+
+- :class:`FrictionModel` (``base.py``): the contract every model implements (``docs/models.md``);
+- :class:`Dahl` (``dahl.py``): the Dahl model (3.2) of the paper;
+- :class:`Oscillator` (``oscillator.py``): mass, friction model and input force.
+"""
+
+from .base import FrictionModel, Parameter
+from .dahl import Dahl
+from .oscillator import Oscillator, check_dahl_oscillator, check_oscillator
+
+__all__ = ["Dahl", "FrictionModel", "Oscillator", "Parameter", "check_dahl_oscillator", "check_oscillator"]

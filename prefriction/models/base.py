@@ -1,0 +1,189 @@
+"""The friction-model protocol: what a model tells the simulator and the energy analysis.
+
+See ``docs/models.md`` for how to add a model in one file and the reusable test that holds it
+to the generic invariants.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+from typing import Any, ClassVar, Hashable, Sequence
+
+import numpy as np
+
+from .._validation import check_nonnegative, check_positive, check_real
+
+__all__ = ["FrictionModel", "Parameter"]
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """Declaration of one model parameter: name, unit and allowed closed range ``[low, high]``.
+
+    ``low_open``/``high_open`` make an end of the range open (``0 < sigma`` is ``low=0,
+    low_open=True``).
+    """
+
+    name: str
+    unit: str
+    low: float = -np.inf
+    high: float = np.inf
+    low_open: bool = False
+    high_open: bool = False
+
+    def check(self, value: Any) -> float:
+        """Return ``value`` as a float inside the range; ``TypeError``/``ValueError`` naming it."""
+        if self.low == 0.0 and self.high == np.inf:
+            return (check_positive if self.low_open else check_nonnegative)(self.name, value)
+        v = check_real(self.name, value)
+        lo_ok = v > self.low if self.low_open else v >= self.low
+        hi_ok = v < self.high if self.high_open else v <= self.high
+        if not (np.isfinite(v) and lo_ok and hi_ok):
+            lo = "(" if self.low_open else "["
+            hi = ")" if self.high_open else "]"
+            raise ValueError(
+                f"{self.name} must be a finite number in {lo}{self.low!r}, {self.high!r}{hi} "
+                f"[{self.unit}], got {v!r}"
+            )
+        return v
+
+
+class FrictionModel(ABC):
+    """Contract of a friction model for the simulator, the sweeps and the energy analysis.
+
+    Everything is stated in the normalised units of :mod:`prefriction.units`, built on the
+    model's reference stiffness ``sigma`` [N/m] and reference force ``Fc`` [N]: force
+    ``F~ = F / Fc``, displacement ``x~ = x sigma / Fc``, time ``t~ = t sqrt(sigma / m)``,
+    velocity ``v~ = v sqrt(m sigma) / Fc``, energy ``E~ = E sigma / Fc^2``.
+
+    Between two velocity reversals the direction ``s = sign(v) = +-1`` is fixed and the model
+    is smooth: the simulator integrates it with an adaptive Runge-Kutta method, locates every
+    zero of ``s v`` (a reversal, where it calls :meth:`reverse`) and every zero of the
+    indicators of :meth:`events` (where it calls :meth:`on_event`).
+
+    The state of a model is
+
+    - ``z``: ``n_states`` continuous states, normalised so that they are of the size of the
+      normalised force; the simulator scales them by the current force amplitude for its
+      error control (so small motions get the same relative accuracy as large ones);
+    - ``m``: ``n_flags`` discrete flags (modes such as "saturated" or "slipping"), 0.0 or 1.0,
+      changed only by :meth:`on_event` and :meth:`reverse`.
+
+    **Compile once per structure.** The simulator builds one CasADi function per
+    :meth:`structure_key`. Everything that may change without changing the generated code is a
+    run-time number returned by :meth:`runtime_params` (``q``); :meth:`rate`, :meth:`force`,
+    :meth:`events`, :meth:`on_event` and :meth:`reverse` must build their expressions from
+    ``q`` and never from the instance's own numbers, and must work on Python floats, numpy
+    arrays and CasADi ``SX`` symbols alike (the test helper
+    :func:`prefriction.testing.check_model` checks this).
+
+    **Rate-independent models** (``rate_independent = True``) return a rate proportional to
+    ``v`` and a force independent of ``v``, and give the energy stored on the current branch
+    (:meth:`branch_energy`), which the energy analysis (2.3)-(2.12) needs: the potential
+    energy ``E_p`` at a reversal is the stored energy of the branch that starts there.
+    ``k_min`` is the least tangent stiffness on an unloading branch [N/m], for the bound (2.12).
+    """
+
+    parameters: ClassVar[tuple[Parameter, ...]] = ()
+    """The physical parameters, validated on construction (each an attribute of that name)."""
+    rate_independent: ClassVar[bool] = True
+    tracks_position: ClassVar[bool] = False
+    """True if :meth:`travel` gives the displacement along a branch from the state alone (the
+    simulator then integrates no position state in unforced runs)."""
+
+    def _validate(self) -> None:
+        """Check every declared parameter (call from ``__post_init__``)."""
+        for par in self.parameters:
+            object.__setattr__(self, par.name, par.check(getattr(self, par.name)))
+
+    # --- normalisation: attributes (or properties) of every model -----------------------
+    sigma: float
+    """Reference (rest) stiffness [N/m] of the normalised units."""
+    Fc: float
+    """Reference force [N] of the normalised units (the Coulomb force for Dahl)."""
+
+    @property
+    def k_min(self) -> float:
+        """Least tangent stiffness on an unloading branch [N/m], for the bound (2.12)."""
+        return self.sigma
+
+    # --- structure and numbers ----------------------------------------------------------
+    @property
+    @abstractmethod
+    def n_states(self) -> int:
+        """Number of continuous states ``z``."""
+
+    @property
+    def n_flags(self) -> int:
+        """Number of discrete flags ``m`` (0.0 or 1.0 each)."""
+        return 0
+
+    @property
+    def n_events(self) -> int:
+        """Number of in-branch event indicators returned by :meth:`events`."""
+        return 0
+
+    def structure_key(self) -> Hashable:
+        """What changes the generated code; models with equal keys share one compiled plant."""
+        return (type(self).__module__, type(self).__qualname__, self.n_states, self.n_flags, self.n_events)
+
+    @abstractmethod
+    def runtime_params(self) -> np.ndarray:
+        """Normalised numbers ``q`` that enter the compiled plant as run-time inputs."""
+
+    # --- dynamics (floats, numpy and CasADi SX alike) ------------------------------------
+    @abstractmethod
+    def initial_state(self, f0: float, s: float) -> tuple[list[float], list[float]]:
+        """State ``(z, m)`` with normalised force ``f0`` at the start of a branch of direction ``s``."""
+
+    @abstractmethod
+    def rate(self, z: Sequence[Any], m: Sequence[Any], v: Any, s: Any, q: Any) -> list[Any]:
+        """Time derivative ``dz/dt~`` on a branch of direction ``s`` at normalised velocity ``v``."""
+
+    @abstractmethod
+    def force(self, z: Sequence[Any], m: Sequence[Any], v: Any, s: Any, q: Any) -> Any:
+        """Normalised friction force ``F~``."""
+
+    def events(self, z: Sequence[Any], m: Sequence[Any], s: Any, q: Any) -> list[Any]:
+        """In-branch event indicators: positive before the event, the event where one turns negative.
+
+        An indicator that must not fire (e.g. its element already slips) returns a positive
+        constant. The list has :attr:`n_events` entries.
+        """
+        return []
+
+    def on_event(self, k: int, z: Sequence[Any], m: Sequence[Any], s: Any, q: Any) -> tuple[list[Any], list[Any]]:
+        """State ``(z, m)`` just after in-branch event ``k``."""
+        raise NotImplementedError(f"{type(self).__name__} has no in-branch events")
+
+    @abstractmethod
+    def reverse(self, z: Sequence[Any], m: Sequence[Any], s_new: Any, q: Any, snap: Any) -> tuple[list[Any], list[Any]]:
+        """State ``(z, m)`` just after a velocity reversal into direction ``s_new``.
+
+        ``snap`` is the relative tolerance of the run: an event whose indicator is within
+        ``snap`` of zero at the reversal may be taken as coinciding with it.
+        """
+
+    def travel(self, z0: Sequence[float], z1: Sequence[float], s: float, q: Any) -> float:
+        """Normalised displacement between states ``z0`` and ``z1`` of one branch (if
+        :attr:`tracks_position`)."""
+        raise NotImplementedError(f"{type(self).__name__} does not track the position")
+
+    # --- energy (rate-independent models) -------------------------------------------------
+    def branch_energy(self, z: Sequence[float], m: Sequence[float], s: float, q: Any) -> float:
+        """Normalised energy stored on the current branch (direction ``s``) in state ``(z, m)``.
+
+        The area between the branch and the displacement axis from the state back to the
+        branch's force zero crossing: the potential energy ``E_p`` (3.9) when taken just after
+        a reversal. The default uses :meth:`branch_energy_of_force` with the state's force.
+        """
+        return float(self.branch_energy_of_force(np.array([float(self.force(z, m, 0.0, s, q))]), s)[0])
+
+    def branch_energy_of_force(self, F: np.ndarray, s: Any) -> np.ndarray:
+        """Normalised stored energy on a branch of direction ``s`` at forces ``F~`` (numpy),
+        for models whose branch energy depends on the force alone (Dahl); the sample-based
+        energy analysis needs it. Other models raise ``NotImplementedError``."""
+        raise NotImplementedError(
+            f"{type(self).__name__} gives no branch energy as a function of the force alone"
+        )

@@ -1,0 +1,459 @@
+"""Parameter sweeps: many :func:`prefriction.simulate` runs, serially or on any executor.
+
+:func:`sweep` runs one simulation per oscillator (any mix of friction models, parameters and
+inputs) with shared keyword arguments, in the calling process or on a
+:class:`concurrent.futures.Executor` (process pool, thread pool, dask.distributed). The results
+come back in input order in a :class:`SweepResult`; a run that raises leaves its exception in its
+place and the others go on.
+
+Compiling is the expensive part of a first run (about 1 s), so before anything is submitted to an
+executor the first system of each *structure group* (systems that share generated code) runs in
+the calling process: the compiled code lands in the disk cache (``$PREFRICTION_CACHE``), where
+worker processes on the same machine load it instead of compiling it again.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import inspect
+import itertools
+import math
+import sys
+import threading
+import time
+import warnings
+from numbers import Real
+from typing import Any, Hashable, Iterable, Optional, Sequence, Sized, Union
+
+import numpy as np
+
+from .models import Oscillator
+from .simulate import simulate
+
+__all__ = ["MAX_SYSTEMS", "SweepResult", "sweep"]
+
+MAX_SYSTEMS = 1_000_000
+"""Largest number of systems :func:`sweep` accepts in one call."""
+
+_PROGRESS_AFTER = 1.0  # automatic progress: show only once the sweep has run this long [s]
+_PROGRESS_EVERY = 0.5  # least interval between two progress lines [s]
+_MAX_LISTED = 10  # failed indices listed in the warning and in summary()
+
+# Runs of the same structure share one compiled integrator and its argument buffers per process
+# (prefriction._buffered_integrator), so two runs must never overlap in one process: threads of
+# a ThreadPoolExecutor or of a multi-threaded dask worker take turns on this lock.
+_RUN_LOCK = threading.Lock()
+
+
+class SweepResult(list):
+    """Results of :func:`sweep`: a list with one entry per system, in input order.
+
+    Each entry is the :class:`prefriction.SimulationResult` of that system, or the exception its
+    run raised. ``repr`` is compact (no arrays); :meth:`summary` lists the failures.
+
+    Attributes
+    ----------
+    failed : list of int
+        Indices of the runs that raised, increasing.
+    errors : dict
+        Index -> exception of each failed run.
+    wall_time : float
+        Wall time of the whole sweep [s], compiling included.
+    """
+
+    def __init__(self, results: Iterable[Any] = (), wall_time: float = 0.0) -> None:
+        super().__init__(results)
+        self.failed: list[int] = [i for i, r in enumerate(self) if isinstance(r, BaseException)]
+        self.errors: dict[int, BaseException] = {i: self[i] for i in self.failed}
+        self.wall_time = float(wall_time)
+
+    def __repr__(self) -> str:
+        return f"SweepResult({len(self)} runs, {len(self.failed)} failed, {self.wall_time:.2f} s)"
+
+    __str__ = __repr__
+
+    def summary(self) -> str:
+        """One line of counts and wall time, then one line per failed run (at most 10).
+
+        Returns
+        -------
+        str
+            E.g. ``"20 runs, 1 failed, 1.23 s\\n  [7] ValueError: ..."``.
+        """
+        n_ok = len(self) - len(self.failed)
+        lines = [f"{len(self)} runs, {n_ok} succeeded, {len(self.failed)} failed, {self.wall_time:.2f} s"]
+        for i in self.failed[:_MAX_LISTED]:
+            lines.append(f"  [{i}] {_describe(self.errors[i])}")
+        if len(self.failed) > _MAX_LISTED:
+            lines.append(f"  ... and {len(self.failed) - _MAX_LISTED} more")
+        return "\n".join(lines)
+
+
+def sweep(
+    systems: Union[Sequence[Oscillator], Iterable[Oscillator]],
+    v0: Union[float, Sequence[float]],
+    *,
+    executor: Optional[cf.Executor] = None,
+    progress: Optional[bool] = None,
+    **simulate_kwargs: Any,
+) -> SweepResult:
+    """Simulate many oscillators with the same settings, serially or on an executor.
+
+    Parameters
+    ----------
+    systems : sequence or iterable of Oscillator
+        The systems, one run each: any mix of friction models, parameters and input forces.
+        At least 1 and at most :data:`MAX_SYSTEMS` (1 000 000).
+    v0 : float or sequence of float
+        Initial velocity [m/s]: one number for every run, or one finite number per system.
+    executor : concurrent.futures.Executor, optional
+        Where to run: ``None`` (default) runs serially in the calling process. Any
+        :class:`concurrent.futures.Executor` works: ``ProcessPoolExecutor``,
+        ``ThreadPoolExecutor`` (correct but no faster than serial: runs in one process take
+        turns, since they share compiled integrators), or dask.distributed's
+        ``client.get_executor()`` (a ``Client`` itself is accepted and converted). The first
+        system of each structure group runs in the calling process first, so that the compiled
+        code is in the disk cache before the workers start (workers on other machines need the
+        cache directory ``$PREFRICTION_CACHE`` on a shared file system, or compile once each).
+        With a ``ProcessPoolExecutor`` the systems are pickled: a callable input ``u`` must be a
+        module-level function (dask pickles lambdas too).
+    progress : bool, optional
+        ``None`` (default): print a progress line such as ``sweep: 12/40 runs, 3.1 s`` to
+        stderr, updated in place every 0.5 s, once the sweep has run for 1 s (short sweeps print
+        nothing). ``True``: always print it; ``False``: never.
+    **simulate_kwargs
+        Keyword arguments of :func:`prefriction.simulate` for every run, passed unchanged
+        (``reversals``, ``t_end``, ``rtol``, ``x0``, ``F0``, ``dense``, ``feedback``, ...).
+
+    Returns
+    -------
+    SweepResult
+        A list of :class:`prefriction.SimulationResult`, in the order of ``systems``; the entry of
+        a run that raised is its exception (indices in ``.failed``, exceptions in ``.errors``).
+        ``.wall_time`` is the wall time of the sweep [s].
+
+    Raises
+    ------
+    TypeError
+        Before any run: for a keyword that :func:`prefriction.simulate` does not take, an entry
+        of ``systems`` that is not an :class:`prefriction.Oscillator` (the message names
+        ``systems[i]``), a non-real ``v0`` or an ``executor`` without ``submit``.
+    ValueError
+        Before any run: for no systems, more than :data:`MAX_SYSTEMS`, or a ``v0`` sequence whose
+        length differs from the number of systems or that holds a non-finite value.
+
+    Warns
+    -----
+    RuntimeWarning
+        Once, if some runs failed: how many, their indices and the first error message. The
+        runs themselves are not retried; inspect ``result.errors``.
+
+    Notes
+    -----
+    Runs are deterministic: the same system and settings give bitwise the same result serially
+    or on any executor. Arguments that are invalid for :func:`prefriction.simulate` (a negative
+    ``reversals``, a forced system without ``t_end``, ...) are not checked up front: those runs
+    fail and their exceptions sit in their places.
+
+    A structure group is what decides the generated code: the friction model's class and
+    ``structure_key()``, the input's ``key`` (or type), whether samples are requested
+    (``dense``) and the feedback's type. Grouping affects only the order of the runs and how
+    often code is compiled, never the results.
+
+    Examples
+    --------
+    A gamma sweep of the Dahl oscillator, serially:
+
+    >>> import prefriction as pf
+    >>> from prefriction.sweep import sweep
+    >>> systems = [pf.Oscillator(pf.Dahl(sigma=1e4, Fc=1.0, gamma=g), mass=1.0)
+    ...            for g in (1.0, 1.5, 2.0, 3.0)]
+    >>> res = sweep(systems, 1.0, reversals=50)
+    >>> res  # doctest: +ELLIPSIS
+    SweepResult(4 runs, 0 failed, ... s)
+    >>> [r.reversals.F[-1] for r in res]  # doctest: +SKIP
+
+    The same on a dask cluster (two local worker processes here):
+
+    >>> from dask.distributed import Client, LocalCluster  # doctest: +SKIP
+    >>> client = Client(LocalCluster(n_workers=2))  # doctest: +SKIP
+    >>> res = sweep(systems, 1.0, reversals=50, executor=client.get_executor())  # doctest: +SKIP
+
+    or on a process pool (in a script, under ``if __name__ == "__main__":``):
+
+    >>> from concurrent.futures import ProcessPoolExecutor  # doctest: +SKIP
+    >>> with ProcessPoolExecutor(max_workers=4) as pool:  # doctest: +SKIP
+    ...     res = sweep(systems, [0.5, 1.0, 2.0, 4.0], reversals=50, executor=pool)
+    """
+    start = time.perf_counter()
+    kwargs = _check_kwargs(simulate_kwargs)
+    executor = _check_executor(executor)
+    if progress is not None and not isinstance(progress, bool):
+        raise TypeError(f"progress must be None, True or False, got {progress!r} of type {type(progress).__name__}")
+    systems = _check_systems(systems)
+    v0s = _check_v0(v0, len(systems))
+
+    n = len(systems)
+    results: list[Any] = [None] * n
+    bar = _Progress(n, progress, start)
+    if executor is None:
+        for i in range(n):
+            results[i] = _run_caught(systems[i], v0s[i], kwargs)
+            bar.update(i + 1)
+    else:
+        _run_on(executor, systems, v0s, kwargs, results, bar)
+    bar.close(n)
+
+    out = SweepResult(results, time.perf_counter() - start)
+    if out.failed:
+        warnings.warn(_failure_message(out), RuntimeWarning, stacklevel=2)
+    return out
+
+
+def _run_one(system: Oscillator, v0: float, kwargs: dict) -> Any:
+    """One :func:`prefriction.simulate` run (module level, so that executors can pickle it)."""
+    with _RUN_LOCK:
+        return simulate(system, v0, **kwargs)
+
+
+def _run_caught(system: Oscillator, v0: float, kwargs: dict) -> Any:
+    """:func:`_run_one`, returning the exception instead of raising it (``Exception`` only)."""
+    try:
+        return _run_one(system, v0, kwargs)
+    except Exception as exc:  # noqa: BLE001 - a failed run is a result of the sweep
+        return exc
+
+
+def _group_key(system: Oscillator, kwargs: dict) -> Hashable:
+    """Structure group of a run: runs with equal keys share compiled code.
+
+    Built from the friction model's class name and ``structure_key()`` (None if it has none),
+    the input's ``key`` (else its type name), whether dense samples are requested and the type
+    of the feedback; parts that are not hashable enter through their ``repr``.
+    """
+    friction = system.friction
+    structure_key = getattr(friction, "structure_key", None)
+    try:
+        structure = structure_key() if callable(structure_key) else None
+    except Exception:  # noqa: BLE001 - the key only orders the runs
+        structure = None
+    u_key = getattr(system.u, "key", type(system.u).__name__)
+    dense = kwargs.get("dense", False)
+    parts = (
+        type(friction).__name__,
+        structure,
+        u_key,
+        not (dense is None or dense is False),
+        type(kwargs.get("feedback")),
+    )
+    return tuple(_hashable(p) for p in parts)
+
+
+def _hashable(value: Any) -> Hashable:
+    """``value`` if it is hashable, else its ``repr``."""
+    try:
+        hash(value)
+    except TypeError:
+        return repr(value)
+    return value
+
+
+def _run_on(executor: cf.Executor, systems: list, v0s: list, kwargs: dict, results: list, bar: "_Progress") -> None:
+    """Fill ``results`` from ``executor``: the first run of each group here, the others submitted."""
+    first: dict = {}
+    for i, system in enumerate(systems):
+        first.setdefault(_group_key(system, kwargs), i)
+    warm = sorted(first.values())
+    done = 0
+    for i in warm:  # compile once, in this process, into the disk cache the workers load from
+        results[i] = _run_caught(systems[i], v0s[i], kwargs)
+        done += 1
+        bar.update(done)
+    warm_set = set(warm)
+    futures: dict = {}
+    try:
+        for i in range(len(systems)):
+            if i not in warm_set:
+                futures[executor.submit(_run_one, systems[i], v0s[i], kwargs)] = i
+                bar.update(done)
+        pending = set(futures)
+        if all(isinstance(f, cf.Future) for f in pending):
+            while pending:
+                finished, pending = cf.wait(pending, timeout=_PROGRESS_EVERY, return_when=cf.FIRST_COMPLETED)
+                for f in finished:
+                    results[futures[f]] = _outcome(f)
+                done += len(finished)
+                bar.update(done)
+        else:  # futures of another kind: collect in order
+            for f, i in futures.items():
+                try:
+                    results[i] = f.result()
+                except Exception as exc:  # noqa: BLE001
+                    results[i] = exc
+                done += 1
+                bar.update(done)
+    except BaseException:
+        for f in futures:
+            f.cancel()
+        raise
+
+
+def _outcome(future: cf.Future) -> Any:
+    """Result of a finished future, or its exception (a cancelled run gives ``CancelledError``)."""
+    try:
+        exc = future.exception(timeout=0)
+    except cf.CancelledError as cancelled:
+        return cancelled
+    return exc if exc is not None else future.result(timeout=0)
+
+
+class _Progress:
+    """A progress line on stderr, rewritten in place (``mode``: None automatic, True, False)."""
+
+    def __init__(self, n: int, mode: Optional[bool], start: float) -> None:
+        self.n, self.mode, self.start = n, mode, start
+        self.last: Optional[float] = None
+        self.width = 0
+
+    def update(self, done: int) -> None:
+        if self.mode is False:
+            return
+        now = time.perf_counter()
+        if self.mode is None and now - self.start < _PROGRESS_AFTER:
+            return
+        if self.last is not None and now - self.last < _PROGRESS_EVERY:
+            return
+        self.last = now
+        self._write(done, now)
+
+    def close(self, done: int) -> None:
+        if self.mode is True or (self.mode is None and self.last is not None):
+            self._write(done, time.perf_counter())
+            sys.stderr.write("\n")
+            sys.stderr.flush()
+
+    def _write(self, done: int, now: float) -> None:
+        text = f"sweep: {done}/{self.n} runs, {now - self.start:.1f} s"
+        sys.stderr.write("\r" + text.ljust(self.width))
+        sys.stderr.flush()
+        self.width = max(self.width, len(text))
+
+
+# --- validation ------------------------------------------------------------------------------
+
+
+def _check_kwargs(kwargs: dict) -> dict:
+    """The keyword arguments for :func:`prefriction.simulate`; ``TypeError`` naming unknown ones."""
+    allowed = [
+        name for name, par in inspect.signature(simulate).parameters.items()
+        if par.kind is inspect.Parameter.KEYWORD_ONLY
+    ]
+    unknown = [name for name in kwargs if name not in allowed]
+    if unknown:
+        names = ", ".join(repr(u) for u in unknown)
+        raise TypeError(
+            f"sweep() got unexpected keyword argument(s) {names}: not keyword arguments of "
+            f"prefriction.simulate, which takes {', '.join(allowed)} (systems and v0 are given "
+            f"to sweep directly; sweep's own are executor and progress)"
+        )
+    return dict(kwargs)
+
+
+def _check_executor(executor: Any) -> Optional[cf.Executor]:
+    """``executor`` as a ``concurrent.futures.Executor`` (a dask ``Client`` is converted) or None."""
+    if executor is None or isinstance(executor, cf.Executor):
+        return executor
+    get_executor = getattr(executor, "get_executor", None)
+    if callable(get_executor):  # dask.distributed.Client
+        return get_executor()
+    if callable(getattr(executor, "submit", None)):
+        return executor
+    raise TypeError(
+        f"executor must be None or a concurrent.futures.Executor (e.g. ProcessPoolExecutor, or "
+        f"client.get_executor() of dask.distributed), got {executor!r} of type {type(executor).__name__}"
+    )
+
+
+def _check_systems(systems: Any) -> list:
+    """``systems`` as a list of :class:`Oscillator`, 1 to :data:`MAX_SYSTEMS` of them."""
+    if isinstance(systems, Oscillator):
+        raise TypeError("systems must be a sequence of prefriction.Oscillator, got a single Oscillator; wrap it in a list")
+    if isinstance(systems, (str, bytes)) or not isinstance(systems, Iterable):
+        raise TypeError(
+            f"systems must be a sequence of prefriction.Oscillator, got {systems!r} of type {type(systems).__name__}"
+        )
+    items = list(itertools.islice(systems, MAX_SYSTEMS + 1))
+    if not items:
+        raise ValueError("systems is empty: give at least one prefriction.Oscillator")
+    if len(items) > MAX_SYSTEMS:
+        raise ValueError(
+            f"systems holds more than {MAX_SYSTEMS:,} systems, the limit of one sweep; split it into several sweeps"
+        )
+    for i, system in enumerate(items):
+        if not isinstance(system, Oscillator):
+            raise TypeError(
+                f"systems[{i}] must be a prefriction.Oscillator, got {_short_repr(system)} of type "
+                f"{type(system).__name__}"
+            )
+    return items
+
+
+def _check_v0(v0: Any, n: int) -> list[float]:
+    """One finite initial velocity per system, from a number or a sequence of ``n`` numbers."""
+    if isinstance(v0, np.ndarray) and v0.ndim == 0:
+        v0 = v0[()]
+    if _is_real(v0):
+        v = float(v0)
+        if not math.isfinite(v):
+            raise ValueError(f"v0 must be finite, got {v!r}")
+        return [v] * n
+    if isinstance(v0, (str, bytes, bool)) or not isinstance(v0, Iterable):
+        raise TypeError(
+            f"v0 must be a real number or a sequence of one per system, got {_short_repr(v0)} of type "
+            f"{type(v0).__name__}"
+        )
+    values = list(v0) if isinstance(v0, Sized) else list(itertools.islice(v0, n + 1))
+    if len(values) != n:
+        got = f"{len(values)}" if isinstance(v0, Sized) or len(values) <= n else f"more than {n}"
+        raise ValueError(
+            f"v0 has {got} values but there are {n} systems: give one v0 per system, or one number for all"
+        )
+    out = []
+    for i, value in enumerate(values):
+        if not _is_real(value):
+            raise TypeError(f"v0[{i}] must be a real number, got {_short_repr(value)} of type {type(value).__name__}")
+        v = float(value)
+        if not math.isfinite(v):
+            raise ValueError(f"v0[{i}] must be finite, got {v!r}")
+        out.append(v)
+    return out
+
+
+def _is_real(value: Any) -> bool:
+    """True for a real number (not a bool)."""
+    return not isinstance(value, bool) and isinstance(value, (Real, np.floating, np.integer))
+
+
+def _short_repr(value: Any, limit: int = 80) -> str:
+    text = repr(value)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def _describe(exc: BaseException) -> str:
+    """``"Type: message"`` of an exception, the message cut to 300 characters."""
+    msg = str(exc)
+    if len(msg) > 300:
+        msg = msg[:297] + "..."
+    return f"{type(exc).__name__}: {msg}" if msg else type(exc).__name__
+
+
+def _failure_message(res: SweepResult) -> str:
+    k, n = len(res.failed), len(res)
+    idx = ", ".join(str(i) for i in res.failed[:_MAX_LISTED])
+    if k > _MAX_LISTED:
+        idx += ", ..."
+    first = res.failed[0]
+    return (
+        f"{k} of {n} runs failed (indices {idx}); their exceptions are in place "
+        f"(result.errors); first error, run {first}: {_describe(res.errors[first])}"
+    )

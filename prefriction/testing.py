@@ -1,0 +1,187 @@
+"""Reusable checks that hold any friction model to the protocol and the generic invariants.
+
+``check_model(model)`` is what ``docs/models.md`` asks of every new model: use it in a test
+(``tests/test_protocol.py`` does, for Dahl and for a model written only through the protocol).
+The reference it compares the simulator with is an independent scipy integration (DOP853 at
+rtol 1e-12, restarted at every reversal and every model event) of the model's own numeric
+equations, so it tests the simulator and the plant, not the model's equations themselves.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import casadi as ca
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from .models import FrictionModel, Oscillator
+
+__all__ = ["ModelCheck", "check_model", "reference_reversals"]
+
+
+@dataclass(frozen=True)
+class ModelCheck:
+    """What :func:`check_model` measured (normalised units).
+
+    Attributes
+    ----------
+    n_reversals : int
+        Reversals found by both the simulator and the reference.
+    max_error : float
+        Largest relative error of the simulated reversal times, positions and forces against the
+        reference (relative to the largest position / force of the run).
+    branch_energy_error : float
+        Largest difference between the model's branch energy at a reversal and the work
+        ``-int F dx`` from that reversal to the force's zero crossing on the reference
+        trajectory, relative to the initial energy (rate-independent models; else 0).
+    """
+
+    n_reversals: int
+    max_error: float
+    branch_energy_error: float
+
+
+def _contract(model: FrictionModel, rng: np.random.Generator) -> None:
+    """The symbolic functions built from a symbolic ``q`` agree with the numeric ones."""
+    q_num = model.runtime_params()
+    nz, nm = model.n_states, model.n_flags
+    z, m = ca.SX.sym("z", nz), ca.SX.sym("m", nm)
+    v, s, q = ca.SX.sym("v"), ca.SX.sym("s"), ca.SX.sym("q", len(q_num))
+    zl, ml = [z[i] for i in range(nz)], [m[i] for i in range(nm)]
+    out = [model.force(zl, ml, v, s, q)] + list(model.rate(zl, ml, v, s, q)) + list(model.events(zl, ml, s, q))
+    assert len(model.events(zl, ml, s, q)) == model.n_events, "events() must return n_events indicators"
+    f = ca.Function("contract", [z, m, v, s, q], [ca.vertcat(*out)])
+    for _ in range(20):
+        s_ = float(rng.choice([-1.0, 1.0]))
+        z0, m0 = model.initial_state(float(rng.uniform(-0.9, 0.9)), s_)
+        v_ = float(rng.uniform(-2, 2)) * s_ ** 2 * abs(s_)
+        sym = np.array(f(z0, m0, abs(v_) * s_, s_, q_num)).ravel()
+        qf = q_num.tolist()
+        num = [model.force(z0, m0, abs(v_) * s_, s_, qf)] + list(model.rate(z0, m0, abs(v_) * s_, s_, qf))
+        num += list(model.events(z0, m0, s_, qf))
+        np.testing.assert_allclose(sym, np.array(num, dtype=float), rtol=1e-13, atol=1e-14,
+                                   err_msg="symbolic and numeric model functions differ")
+
+
+def reference_reversals(model: FrictionModel, v0: float, n: int, *, rtol: float = 1e-12) -> tuple[np.ndarray, np.ndarray]:
+    """Reversals ``(t~, x~, F~)`` rows and the branch-energy work check of the unforced
+    oscillator in normalised units, by scipy DOP853 restarted at every reversal and event.
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray)
+        Reversal rows ``(t, x, F)`` (shape ``(k, 3)``) and, per reversal, ``-int F dx`` from the
+        reversal to the next zero crossing of ``F`` (NaN where the run ended before it).
+    """
+    q = model.runtime_params().tolist()
+    nz = model.n_states
+    s = 1.0 if v0 > 0 else -1.0
+    z, m = model.initial_state(0.0, s)
+    y = np.array([0.0, v0, *z, 0.0])  # x, v, z, work -int F dx since the last reversal
+    t, rows, works, pending = 0.0, [], [], False
+    snap = 1e-12
+    while len(rows) < n:
+        mm = list(m)
+
+        def rhs(_t: float, y: np.ndarray, s: float = s, mm: list = mm) -> np.ndarray:
+            zz = y[2:2 + nz].tolist()
+            F = model.force(zz, mm, y[1], s, q)
+            return np.array([y[1], -F, *model.rate(zz, mm, y[1], s, q), -F * y[1]])
+
+        def rev(_t: float, y: np.ndarray, s: float = s) -> float:
+            return s * y[1]
+
+        def zero_force(_t: float, y: np.ndarray, s: float = s, mm: list = mm) -> float:
+            return model.force(y[2:2 + nz].tolist(), mm, y[1], s, q)
+
+        rev.terminal, rev.direction = True, -1.0
+        zero_force.terminal = False
+        evs = [rev, zero_force]
+        for k in range(model.n_events):
+            def ev(_t: float, y: np.ndarray, k: int = k, s: float = s, mm: list = mm) -> float:
+                return model.events(y[2:2 + nz].tolist(), mm, s, q)[k]
+            ev.terminal, ev.direction = True, -1.0
+            evs.append(ev)
+        sol = solve_ivp(rhs, (t, t + 1e4), y, method="DOP853", rtol=rtol, atol=1e-14, events=evs, dense_output=False)
+        if sol.status != 1:
+            raise RuntimeError(f"reference integration did not reach an event: {sol.message}")
+        if pending and len(sol.t_events[1]):
+            works[-1] = float(sol.y_events[1][0][-1])
+            pending = False
+        which = min((float(te[0]), i) for i, te in enumerate(sol.t_events) if len(te) and i != 1)
+        t, i = which
+        y = sol.y_events[i][0].copy()
+        zz = y[2:2 + nz].tolist()
+        if i == 0:  # reversal
+            rows.append((t, y[0], model.force(zz, m, 0.0, s, q)))
+            works.append(math.nan)
+            pending = True
+            s = -s
+            z, m = model.reverse(zz, m, s, q, snap)
+            y[1], y[-1] = 0.0, 0.0
+        else:  # a model event
+            z, m = model.on_event(i - 2, zz, m, s, q)
+        y[2:2 + nz] = [float(v) for v in z]
+    return np.array(rows), np.array(works)
+
+
+def check_model(model: FrictionModel, *, v0: float = 1.5, reversals: int = 12, rtol: float = 1e-8,
+                tol_factor: float = 20.0, seed: int = 0) -> ModelCheck:
+    """Hold ``model`` to the protocol and the generic invariants; ``AssertionError`` if it fails.
+
+    1. The symbolic functions (from a symbolic ``q``) equal the numeric ones: the parametric
+       plant compiled once for the structure is right for this instance.
+    2. :func:`prefriction.simulate` finds the same reversals (count, times, positions, forces)
+       as an independent scipy reference, within ``tol_factor * rtol``: no reversal missed.
+    3. Rate-independent models: energy balance at every reversal (the potential energy ``E_p``
+       of the table equals the work ``-int F dx`` until the force's zero crossing on the
+       reference), dissipation ``E_p(i) - E_p(i+1) >= 0`` on every half-cycle, and the bound
+       (2.12) ``E_p <= Fc^2 / (2 k_min)`` after the first reversal.
+
+    Parameters
+    ----------
+    model : FrictionModel
+        The model under test (its ``sigma`` and ``Fc`` set the units; the check runs in them).
+    v0 : float, default 1.5
+        Initial normalised velocity (from ``F = 0``).
+    reversals : int, default 12
+        Number of reversals compared.
+    rtol : float, default 1e-8
+        Tolerance of the simulation.
+    tol_factor : float, default 20
+        Allowed error in units of ``rtol``.
+    seed : int, default 0
+        Seed of the random states of the contract check.
+
+    Returns
+    -------
+    ModelCheck
+    """
+    from .simulate import simulate
+    from .units import Scales
+
+    _contract(model, np.random.default_rng(seed))
+    system = Oscillator(model, mass=1.0)
+    sc = Scales.of(system)
+    ref, works = reference_reversals(model, v0, reversals)
+    sim = simulate(system, v0 * sc.v, reversals=reversals, rtol=rtol)
+    tab = sim.reversals
+    assert len(tab.t) == len(ref), f"simulate found {len(tab.t)} reversals, the reference {len(ref)}"
+    got = np.column_stack([tab.t / sc.t, tab.x / sc.x, tab.F / sc.F])
+    size = np.maximum(np.max(np.abs(ref), axis=0), 1e-300)
+    err = float(np.max(np.abs(got - ref) / np.maximum(np.abs(ref), size * 1e-3)))
+    assert err <= tol_factor * rtol, f"reversals differ from the reference by {err:.3g} (> {tol_factor} rtol)"
+    energy_err = 0.0
+    if model.rate_independent:
+        E_p = tab.E_p / sc.E
+        E0 = 0.5 * v0 * v0
+        ok = ~np.isnan(works)
+        energy_err = float(np.max(np.abs(works[ok] - E_p[ok]), initial=0.0) / E0)
+        assert energy_err <= 1e-6, f"branch energy differs from -int F dx by {energy_err:.3g} E_0"
+        assert np.all(np.diff(E_p) <= 1e-9 * E0), "negative dissipation on a half-cycle"
+        bound = 0.5 * model.Fc ** 2 / model.k_min / (sc.E)
+        assert np.all(E_p[1:] <= bound * (1 + 1e-9)), "bound (2.12) violated after the first reversal"
+    return ModelCheck(len(ref), err, energy_err)

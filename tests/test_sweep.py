@@ -1,0 +1,139 @@
+"""sweep(): many simulate runs, serially, on a process pool and on dask, in input order."""
+
+from __future__ import annotations
+
+import multiprocessing
+import warnings
+from concurrent.futures import ProcessPoolExecutor
+
+import numpy as np
+import pytest
+
+import prefriction as pf
+from prefriction.sweep import SweepResult, _group_key, sweep
+
+GAMMAS = (1.0, 1.5, 2.0, 3.0)
+N_REV = 10
+RTOL = 1e-8  # simulate's default; sweep leaves it alone
+SYSTEMS = [pf.Oscillator(pf.Dahl(sigma=1e4, Fc=1.0, gamma=g), mass=1.0) for g in GAMMAS]
+V0 = [0.5, 1.0, 2.0, 0.25]  # per system, so that a mix-up of the order shows
+
+
+def _rel(a: np.ndarray, b: np.ndarray, floor: float = 0.0) -> float:
+    return float(np.max(np.abs(a - b) / np.maximum(np.abs(b), floor)))
+
+
+def _same(a: pf.SimulationResult, b: pf.SimulationResult) -> bool:
+    ta, tb = a.reversals, b.reversals
+    return all(np.array_equal(getattr(ta, f), getattr(tb, f)) for f in ("t", "x", "F", "E_p", "E_d"))
+
+
+@pytest.fixture(scope="module")
+def serial() -> SweepResult:
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        return sweep(SYSTEMS, V0, reversals=N_REV, progress=False)
+
+
+def test_serial_sweep_matches_exact_reversals_in_input_order(serial: SweepResult) -> None:
+    assert isinstance(serial, SweepResult) and len(serial) == len(SYSTEMS)
+    assert serial.failed == [] and serial.errors == {} and serial.wall_time > 0
+    for system, v0, res in zip(SYSTEMS, V0, serial):
+        ref = pf.exact_reversals(system, v0, n=N_REV)
+        tab = res.reversals
+        assert len(tab) == N_REV
+        xs = system.friction.Fc / system.friction.sigma
+        assert _rel(tab.t, ref.t) <= 20 * RTOL, system
+        assert _rel(tab.F, ref.F) <= 20 * RTOL, system
+        assert _rel(tab.x, ref.x, xs) <= 20 * RTOL, system
+    assert repr(serial).startswith("SweepResult(4 runs, 0 failed, ") and repr(serial).endswith(" s)")
+    assert "4 runs" in serial.summary()
+
+
+def test_process_pool_gives_the_serial_results(serial: SweepResult) -> None:
+    ctx = multiprocessing.get_context("spawn")  # fresh workers: they load the compiled code from disk
+    with ProcessPoolExecutor(max_workers=2, mp_context=ctx) as pool:
+        res = sweep(SYSTEMS, V0, reversals=N_REV, executor=pool, progress=False)
+    assert res.failed == []
+    assert all(_same(a, b) for a, b in zip(res, serial))
+
+
+def test_dask_executor_gives_the_serial_results(serial: SweepResult) -> None:
+    distributed = pytest.importorskip("dask.distributed")
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+        res = sweep(SYSTEMS, V0, reversals=N_REV, executor=client.get_executor(), progress=False)
+    assert res.failed == []
+    assert all(_same(a, b) for a, b in zip(res, serial))
+
+
+def test_failing_run_keeps_its_exception_in_place(serial: SweepResult) -> None:
+    # v0 = 0 with F0 = 0 and no input: the mass rests, simulate raises ValueError for run 2 only
+    v0 = [V0[0], V0[1], 0.0, V0[3]]
+    with pytest.warns(RuntimeWarning, match=r"1 of 4 runs failed \(indices 2\).*the mass rests"):
+        res = sweep(SYSTEMS, v0, reversals=N_REV, progress=False)
+    assert res.failed == [2] and set(res.errors) == {2}
+    assert isinstance(res[2], ValueError) and res.errors[2] is res[2]
+    assert "the mass rests" in str(res[2])
+    assert all(_same(res[i], serial[i]) for i in (0, 1, 3))
+    assert repr(res).startswith("SweepResult(4 runs, 1 failed, ")
+    assert "[2] ValueError" in res.summary()
+
+
+def test_serial_sweep_is_the_same_with_a_thread_pool(serial: SweepResult) -> None:
+    # runs of one structure share compiled buffers: sweep makes threads take turns
+    from concurrent.futures import ThreadPoolExecutor
+
+    systems = SYSTEMS * 3
+    with ThreadPoolExecutor(max_workers=4) as pool:
+        res = sweep(systems, V0 * 3, reversals=N_REV, executor=pool, progress=False)
+    assert res.failed == []
+    assert all(_same(a, serial[i % 4]) for i, a in enumerate(res))
+
+
+def test_progress_line(capsys: pytest.CaptureFixture) -> None:
+    sweep(SYSTEMS[:2], 1.0, reversals=N_REV, progress=True)
+    err = capsys.readouterr().err
+    assert err.startswith("\rsweep: ") and "2/2 runs" in err and err.endswith("\n")
+    sweep(SYSTEMS[:2], 1.0, reversals=N_REV)  # automatic: a short sweep prints nothing
+    sweep(SYSTEMS[:2], 1.0, reversals=N_REV, progress=False)
+    assert capsys.readouterr().err == ""
+
+
+def test_group_key_follows_the_structure() -> None:
+    a, b = SYSTEMS[0], SYSTEMS[3]
+    assert _group_key(a, {}) == _group_key(b, {})
+    assert _group_key(a, {"dense": True}) != _group_key(a, {"dense": False})
+    assert _group_key(a, {"dense": np.linspace(0, 1, 5)}) == _group_key(a, {"dense": True})
+
+
+def test_bad_input_is_refused_before_any_run() -> None:
+    with pytest.raises(TypeError, match="revrsals"):
+        sweep(SYSTEMS, 1.0, revrsals=N_REV)
+    with pytest.raises(TypeError, match="'system'"):
+        sweep(SYSTEMS, 1.0, system=SYSTEMS[0], reversals=N_REV)
+    with pytest.raises(ValueError, match="empty"):
+        sweep([], 1.0, reversals=N_REV)
+    with pytest.raises(ValueError, match="empty"):
+        sweep(iter(()), 1.0, reversals=N_REV)
+    with pytest.raises(TypeError, match=r"systems\[2\].*Dahl"):
+        sweep([SYSTEMS[0], SYSTEMS[1], SYSTEMS[2].friction], 1.0, reversals=N_REV)
+    with pytest.raises(TypeError, match="single Oscillator"):
+        sweep(SYSTEMS[0], 1.0, reversals=N_REV)
+    with pytest.raises(ValueError, match=r"v0 has 3 values but there are 4 systems"):
+        sweep(SYSTEMS, [1.0, 1.0, 1.0], reversals=N_REV)
+    with pytest.raises(ValueError, match=r"v0\[1\] must be finite"):
+        sweep(SYSTEMS, [1.0, float("nan"), 1.0, 1.0], reversals=N_REV)
+    with pytest.raises(ValueError, match="v0 must be finite"):
+        sweep(SYSTEMS, float("inf"), reversals=N_REV)
+    with pytest.raises(TypeError, match="v0"):
+        sweep(SYSTEMS, "1.0", reversals=N_REV)
+    with pytest.raises(TypeError, match="executor"):
+        sweep(SYSTEMS, 1.0, reversals=N_REV, executor=object())
+    with pytest.raises(TypeError, match="progress"):
+        sweep(SYSTEMS, 1.0, reversals=N_REV, progress="yes")
+
+
+def test_more_than_a_million_systems_is_refused() -> None:
+    with pytest.raises(ValueError, match="1,000,000"):
+        sweep(iter([SYSTEMS[0]] * 1_000_001), 1.0, reversals=N_REV)
