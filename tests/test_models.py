@@ -68,7 +68,7 @@ def test_oscillator_validation():
     forced = Oscillator(d, u=([0.0, 1.0], [1.0, 2.0]))
     assert forced.forced
     with pytest.raises(ValueError):
-        forced.u[1][0] = 5.0  # samples are read-only
+        forced.u.u[0] = 5.0  # samples are read-only
 
 
 @pytest.mark.parametrize("sigma,Fc,m", [(1e4, 1.0, 1.0), (1e10, 3e-3, 1e-6), (1e-2, 50.0, 1e3)])
