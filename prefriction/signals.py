@@ -145,6 +145,13 @@ def _vector(x: Any, n: int, name: str, casadi: bool) -> Any:
 # base class
 
 
+def _rebuild(cls: type, state: dict) -> "Signal":
+    """Inverse of :meth:`Signal.__reduce__`."""
+    obj = cls.__new__(cls)
+    obj._set(**state)
+    return obj
+
+
 class Signal(ABC):
     """Scalar signal of time: structure (:attr:`key`) compiled once, numbers given at run time.
 
@@ -161,6 +168,11 @@ class Signal(ABC):
     def _set(self, **fields: Any) -> None:
         for name, value in fields.items():
             object.__setattr__(self, name, value)
+
+    def __reduce__(self) -> tuple:
+        """Pickle by the slot values (process pools and dask ship signals to workers)."""
+        names = [n for cls in type(self).__mro__ for n in getattr(cls, "__slots__", ())]
+        return (_rebuild, (type(self), {n: getattr(self, n) for n in names if hasattr(self, n)}))
 
     # --- structure ---------------------------------------------------------------------------
 

@@ -331,3 +331,16 @@ def test_as_signal_conversions():
 def test_as_signal_errors_name_the_argument(value, exc):
     with pytest.raises(exc, match="reference"):
         as_signal(value, "reference", "m")
+
+
+def test_signals_pickle_for_process_pools():
+    import pickle
+
+    from prefriction.signals import Chirp, Ramp, Samples, Sine, Step
+
+    for sig in (Sine(0.5, 2.0, 0.1), Step(0.1, 0.0, 1.0) + Ramp(0.2, 3.0), Chirp(1.0, 1.0, 2.0, 3.0),
+                Samples(np.array([0.0, 1.0, 2.0]), np.array([1.0, -2.0, 0.5]))):
+        back = pickle.loads(pickle.dumps(sig))
+        t = np.linspace(0.0, 2.5, 11)
+        assert back.key == sig.key and type(back) is type(sig)
+        np.testing.assert_array_equal(back(t), sig(t))
