@@ -32,17 +32,9 @@ class Run:
         self.model = system.friction
         self.q = self.model.runtime_params()
         self.eps = eps  # run-time tolerance: states are scaled by amplitude * eps
-        self.L = Layout(spec)
-        self.f1, s1, mode = integrator(PlantSpec(**{**spec.__dict__, "n_out": 1}), jit)
-        self.Ld: Optional[Layout] = None
-        self.fd: Optional[BufferedIntegrator] = None
-        sd = 0.0
-        if spec.n_out > 1:
-            dense_spec = PlantSpec(**{**spec.__dict__, "n_out": N_DENSE})
-            self.Ld = Layout(dense_spec)
-            self.fd, sd, _ = integrator(dense_spec, jit)
-        self.setup_time = s1 + sd
-        self.mode = mode
+        self.L = Layout(spec)  # the same for any number of outputs per call
+        # one plant: a dense run makes its single-output calls on the dense plant, padded
+        self.f1, self.setup_time, self.mode = integrator(spec, jit)
         self.calls = 0
         self.steps: Optional[int] = 0
         self.rev: list[tuple] = []  # (t~, x~, F~, W~)
@@ -205,11 +197,15 @@ class Run:
         self._params(call, L, a, nstop)
         self._pack(call, L, a)
         t_prev = self.st["t"]
+        times = list(times)
+        n_out = call.U.shape[0]
+        while len(times) < n_out:  # padding outputs just after the last one, discarded
+            times.append(times[-1] + 1e-3 * (times[-1] - self.st["t"]) + 1e-9)
         for j, t1 in enumerate(times):
             call.U[j] = self._controls(t_prev, t1, j)
             t_prev = t1
         self._trigger(call)
-        xf = call.out.reshape(len(times), L.nx).T
+        xf = call.out.reshape(n_out, L.nx).T
         if not math.isfinite(float(call.out.sum())):
             raise self._failure("the integrator returned non-finite values")
         return xf, a
@@ -397,13 +393,11 @@ class Run:
                 return samples, True
             pts = list(grid[i:i + N_DENSE])
             m = len(pts)
-            while len(pts) < N_DENSE:  # padding outputs, discarded
-                pts.append(pts[-1] + 1e-3 * (pts[-1] - self.st["t"]) + 1e-9)
             nstop = min(n_target, 1e18)
-            xf, a = self._call(self.fd, self.Ld, pts, nstop)
+            xf, a = self._call(self.f1, self.L, pts, nstop)
             used = m
             for j in range(m):
-                out = self._unpack(self.Ld, xf[:, j], a, len(self.rev), nstop)
+                out = self._unpack(self.L, xf[:, j], a, len(self.rev), nstop)
                 if out["overflow"]:  # more than K reversals between two outputs: redo that piece
                     if self.advance(pts[j], n_target):
                         return samples, True
