@@ -58,8 +58,14 @@ def integrator(spec: PlantSpec, jit: bool) -> tuple[BufferedIntegrator, float, s
 def _describe(spec: PlantSpec) -> str:
     """One line on what a plant is, for the compile message."""
     what = [type(spec.model).__name__ + repr(spec.model_key[1:] if isinstance(spec.model_key, tuple) else "")]
-    if spec.u_key is not None:
-        what.append(f"input {spec.u_key[0] if isinstance(spec.u_key, tuple) else spec.u_key}")
+    for name, key in (("input", spec.u_key), ("reference", spec.r_key)):
+        if key is None:
+            continue
+        if key[0] == "Traced":
+            what.append(f"{name} from a Python callable: compiled once per function object; "
+                        f"prefriction.signals (Sine, Step, Ramp, Chirp, Samples) compile once per kind")
+        else:
+            what.append(f"{name} {key}")
     if spec.fb != "none":
         what.append(f"{spec.fb} controller of order {spec.n_c}")
     if spec.energy:

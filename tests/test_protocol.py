@@ -114,3 +114,23 @@ def test_dahl_only_functions_say_so():
     system = pf.Oscillator(ElasticPlastic(1.0, 1.0))
     with pytest.raises(TypeError, match="exact_reversals is Dahl-only"):
         pf.exact_reversals(system, 0.1, 3)
+
+
+def test_loops_and_sweeps_run_any_protocol_model():
+    """controllers.simulate_loop and sweep with the elastic-plastic element: in its elastic
+    range it is a spring k, so the PD loop is python-control's linear closed loop."""
+    import control
+
+    import controllers
+
+    k, m, kp, kd, tau, r0 = 1e6, 1.0, 2e6, 2000.0, 5e-5, 1e-6
+    stage = pf.Oscillator(ElasticPlastic(k, 1e8), mass=m)  # never slips: F = k x
+    res = controllers.simulate_loop(stage, controllers.pd(kp, kd, tau=tau), r0, 0.02)
+    C = control.tf([kd + kp * tau, kp], [tau, 1.0])
+    T = control.feedback(control.tf([1.0], [m, 0.0, k]) * C, 1)
+    lin = control.forced_response(T, res.t, np.full(res.t.shape, r0)).outputs
+    assert float(np.max(np.abs(res.x - lin)) / np.max(np.abs(lin))) <= 1e-6
+    systems = [pf.Oscillator(ElasticPlastic(1e4, 1.0)), pf.Oscillator(pf.Dahl(1e4, 1.0, 1.5))]
+    out = pf.sweep(systems, 0.005, reversals=3)  # both elastic / pre-sliding: v0 below slip
+    np.testing.assert_allclose(out[0].reversals.t, math.pi / 2 * math.sqrt(1e-4) * (1 + 2 * np.arange(3)), rtol=1e-8)
+    np.testing.assert_allclose(out[1].reversals.F, pf.exact_reversals(systems[1], 0.005, 3).F, rtol=1e-7)
