@@ -57,7 +57,8 @@ def integrator(spec: PlantSpec, jit: bool) -> tuple[BufferedIntegrator, float, s
 
 def _describe(spec: PlantSpec) -> str:
     """One line on what a plant is, for the compile message."""
-    what = [type(spec.model).__name__ + repr(spec.model_key[1:] if isinstance(spec.model_key, tuple) else "")]
+    key = spec.model_key
+    what = [" ".join(str(k) for k in key) if isinstance(key, tuple) else str(key)]
     for name, key in (("input", spec.u_key), ("reference", spec.r_key)):
         if key is None:
             continue

@@ -135,7 +135,7 @@ class Dahl(FrictionModel):
         return 1 if self.saturates else 0
 
     def structure_key(self) -> Hashable:
-        return ("Dahl", self.saturates)
+        return ("Dahl", "gamma < 1, saturating" if self.saturates else "gamma >= 1")
 
     def runtime_params(self) -> np.ndarray:
         return np.array([self.gamma])
