@@ -464,7 +464,14 @@ def main(argv: Optional[list[str]] = None) -> int:
     ap.add_argument("--stability", action="store_true",
                     help="stability section only (stiff and extreme cases), no headline peers")
     ap.add_argument("--repeats", type=int, default=None, help="warm repeats per point (min is taken)")
+    ap.add_argument("--sweep", action="store_true",
+                    help="parameter sweeps instead: compiles and end-to-end time of cold and warm sweeps "
+                         "against scipy DOP853 (prefriction.bench_sweep; uses --out, --quick)")
     args = ap.parse_args(argv)
+    if args.sweep:
+        from .bench_sweep import main as sweep_main
+
+        return sweep_main(["--out", args.out] + (["--quick"] if args.quick else []))
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     ladder = QUICK_LADDER if args.quick else LADDER
