@@ -1,7 +1,7 @@
 """Closed-loop simulation of a python-control controller around the reversal-aware Dahl stage.
 
 :func:`simulate_loop` turns any SISO, proper python-control LTI controller (error ``e = r - x``
-[m] to force ``u`` [N]) into a :class:`prefriction._feedback.LinearFeedback` and runs
+[m] to force ``u`` [N]) into a :class:`prefriction.simulation.feedback.LinearFeedback` and runs
 :func:`prefriction.simulate`, which integrates ``m x'' = u - F`` with the Dahl friction (3.2)
 and lands on every velocity reversal (also inside a sample interval of a sampled controller).
 """
@@ -16,8 +16,8 @@ import control
 import numpy as np
 
 import prefriction
-from prefriction._branch import force_after_distance
-from prefriction._feedback import LinearFeedback
+from prefriction.analysis.branch import force_after_distance
+from prefriction.simulation.feedback import LinearFeedback
 from prefriction._validation import check_positive, check_signal
 from prefriction.models import Oscillator
 from prefriction.reversals import ReversalTable
@@ -62,7 +62,7 @@ class LoopResult:
     kp : float or None
         Static gain of the controller at ``s = 0`` (or ``z = 1``) if it is finite and
         positive (PD), ``None`` otherwise: then ``Fc / kp`` bounds the residual error.
-    simulation : prefriction.simulate.SimulationResult or None
+    simulation : prefriction.simulation.simulate.SimulationResult or None
         The raw result of :func:`prefriction.simulate` (run statistics, work of the input);
         ``None`` for a saturated (``u_max``) loop, which calls the simulator once per sample.
     """

@@ -1,6 +1,6 @@
 """Sampled-data loop with a force limit and back-calculation anti-windup.
 
-``prefriction.simulate``'s :class:`~prefriction._feedback.LinearFeedback` is a linear law and
+``prefriction.simulate``'s :class:`~prefriction.simulation.feedback.LinearFeedback` is a linear law and
 cannot saturate, so this path steps the sampled loop itself: at each sample instant ``t_k``
 
     e[k]  = r(t_k) - x(t_k)
@@ -27,7 +27,7 @@ import control
 import numpy as np
 
 import prefriction
-from prefriction._branch import branch_potential
+from prefriction.analysis.branch import branch_potential
 from prefriction.models import Oscillator
 from prefriction.reversals import ReversalTable
 

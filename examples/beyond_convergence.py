@@ -30,7 +30,7 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
         ``n`` (1..N), ``a`` (``a_n = |F_n|/Fc`` after n reversals of the map from ``a_0``),
         ``law`` (``3/(2n)``), ``offset`` (``1/a_n - 2n/3``, bounded if the law holds),
         ``rel_dev`` (``a_n / (3/(2n)) - 1``), ``refined`` (the law with its corrections,
-        :func:`prefriction.dahl.asymptotic_amplitude`); ``png``.
+        :func:`prefriction.analysis.dahl.asymptotic_amplitude`); ``png``.
     """
     n_rev = 2_000 if quick else N_REVERSALS
     seq = np.asarray(dahl.amplitude_sequence(A0, n_rev), dtype=float)

@@ -15,17 +15,16 @@ Public API, re-exported from private modules:
 
 from __future__ import annotations
 
-from .errors import PrefrictionError, SolverError
-from .models import Dahl, FrictionModel, Oscillator, Parameter
-from .reversals import ReversalTable
-from .units import Scales
-from .simulate import SimulationResult, simulate
-from .sweep import SweepResult, sweep
-from ._feedback import LinearFeedback
-from . import energy
-from . import dahl
-from . import signals
-from .exact import exact_reversals
+from prefriction.errors import PrefrictionError, SolverError
+from prefriction.models import Dahl, FrictionModel, Oscillator, Parameter
+from prefriction.reversals import ReversalTable
+from prefriction.units import Scales
+from prefriction.simulate import SimulationResult, simulate
+from prefriction.simulation.sweep import SweepResult, sweep
+from prefriction.simulation.feedback import LinearFeedback
+from prefriction.analysis import dahl, energy
+from prefriction import signals
+from prefriction.analysis.exact import exact_reversals
 
 __all__ = [
     "Dahl",

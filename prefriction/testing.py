@@ -17,7 +17,7 @@ import casadi as ca
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from .models import FrictionModel, Oscillator
+from prefriction.models import FrictionModel, Oscillator
 
 __all__ = ["ModelCheck", "check_model", "reference_reversals"]
 
@@ -160,8 +160,8 @@ def check_model(model: FrictionModel, *, v0: float = 1.5, reversals: int = 12, r
     -------
     ModelCheck
     """
-    from .simulate import simulate
-    from .units import Scales
+    from prefriction.simulate import simulate
+    from prefriction.units import Scales
 
     _contract(model, np.random.default_rng(seed))
     system = Oscillator(model, mass=1.0)

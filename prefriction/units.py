@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .models import Oscillator
+from prefriction.models import Oscillator
 
 
 @dataclass(frozen=True)

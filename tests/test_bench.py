@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from prefriction.bench import HEADLINE, main, reversal_error
+from prefriction.cli.bench import HEADLINE, main, reversal_error
 from prefriction.cli import main as cli_main
 from prefriction.reversals import ReversalTable
 

@@ -8,8 +8,8 @@ import math
 import numpy as np
 
 import prefriction as pf
-from prefriction.bench import main as bench_main
-from prefriction.bench_sweep import QUICK_VALUES, main, reversal_error, scipy_reversals, sweep_cases
+from prefriction.cli.bench import main as bench_main
+from prefriction.cli.bench_sweep import QUICK_VALUES, main, reversal_error, scipy_reversals, sweep_cases
 
 
 def test_quick_sweep_bench(tmp_path, monkeypatch, capsys) -> None:

@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from prefriction import _branch as br
+from prefriction.analysis import branch as br
 
 GAMMAS = [0.0, 0.3, 0.5, 1 - 1e-9, 1.0, 1 + 1e-9, 1.5, 2 - 1e-10, 2.0, 2.5, 5.0]
 

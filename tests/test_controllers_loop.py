@@ -85,12 +85,15 @@ def test_linear_regime_sampled_matches_exact_discretised_loop(kp, ki, kd, tau):
 def test_linear_regime_references_callable_and_samples():
     system = linear_stage()
     kp, kd, tau = 2e6, 2000.0, 5e-5
-    ramp = lambda t: 1e-6 * (1.0 - np.exp(-t / 2e-3))  # noqa: E731  (CasADi-traceable)
+    # continuous loop: samples of 1e-6 (1 - exp(-t / 2 ms)) every 50 us, on the output grid (5 us), so
+    # that forced_response (linear between its time points) sees the same piecewise-linear reference
+    tr = np.linspace(0.0, 0.01, 201)
+    ramp = (tr, 1e-6 * (1.0 - np.exp(-tr / 2e-3)))
     res = controllers.simulate_loop(system, controllers.pd(kp, kd, tau=tau), ramp, 0.01)
     T = control.feedback(plant_tf() * pid_tf(kp, 0.0, kd, tau), 1)
-    lin = control.forced_response(T, res.t, ramp(res.t)).outputs
+    lin = control.forced_response(T, res.t, np.interp(res.t, *ramp)).outputs
     assert rel_err(res.x, lin) <= 1e-6
-    np.testing.assert_allclose(res.reference, ramp(res.t), rtol=1e-14)
+    np.testing.assert_allclose(res.reference, np.interp(res.t, *ramp), rtol=1e-14)
     # sampled loop: samples (t, r), linear between them, read at the instants k Ts
     Cd = control.c2d(pid_tf(kp, 0.0, kd, tau), TS, "zoh")
     Tz = control.feedback(control.c2d(plant_tf(), TS, "zoh") * Cd, 1)
@@ -341,9 +344,14 @@ def _lsoda_continuous(C, ref, y0, t):
 def test_continuous_loop_moves_a_resting_mass_with_a_smooth_reference():
     system = stage()
     pd = controllers.design_pd(system, wn=2 * np.pi * 300, zeta=0.5)
-    ref = lambda t: 1e-6 * (0.5 - 0.5 * np.tanh((t - 0.0405) / 1e-4))  # noqa: E731  (CasADi-traceable)
+    # 1e-6 (1 - tanh((t - 40.5 ms) / 0.1 ms)) / 2 sampled every 10 us over its transition (1 ms
+    # elsewhere): a smooth reference as samples, linear between them (LSODA reads the same samples)
+    coarse = np.linspace(0.0, 0.046, 47)
+    tr = np.concatenate((coarse[coarse < 0.0395], np.linspace(0.0395, 0.0415, 201), coarse[coarse > 0.0415]))
+    samples = (tr, 1e-6 * (0.5 - 0.5 * np.tanh((tr - 0.0405) / 1e-4)))
+    ref = lambda tt: np.interp(tt, *samples)  # noqa: E731
     t = np.linspace(0.0, 0.046, 461)
-    res = controllers.simulate_loop(system, pd, ref, 0.046, t_out=t)
+    res = controllers.simulate_loop(system, pd, samples, 0.046, t_out=t)
     k = 390  # 39 ms: creeping, |v| < 1e-11 m/s
     assert abs(res.v[k]) < 1e-11 and res.x[k] - res.x[-1] > 5e-7
     y0 = np.concatenate(([res.x[k], res.v[k], res.F[k]], res.xc[k]))

@@ -1,4 +1,4 @@
-"""Energy analysis (prefriction.energy) against closed forms and independent references.
+"""Energy analysis (prefriction.analysis.energy) against closed forms and independent references.
 
 References used: analytic signals (harmonic motion, polynomials), the closed-form Dahl
 branches (3.4)-(3.7) for gamma = 1, the Prandtl stop (gamma = 0) parallelogram, the exact

@@ -270,7 +270,7 @@ def test_system_errors():
 
 
 def test_table_command_prints_the_default_case(capsys):
-    from prefriction.table import main
+    from prefriction.cli.table import main
 
     assert main([]) == 0
     out = capsys.readouterr().out
@@ -288,7 +288,7 @@ def test_table_command_prints_the_default_case(capsys):
 
 
 def test_table_command_options_and_bad_input(capsys):
-    from prefriction.table import main
+    from prefriction.cli.table import main
 
     assert main(["--gamma", "0", "--v0", "0.05", "--n", "4", "--sigma", "1e6", "--Fc", "2"]) == 0
     out = capsys.readouterr().out

@@ -15,7 +15,7 @@ import mpmath as mp
 import numpy as np
 import pytest
 
-from prefriction.paper import load_example
+from prefriction.cli.paper import load_example
 
 mp.mp.dps = 30
 

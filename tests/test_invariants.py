@@ -6,7 +6,7 @@
 - on the exact reference trajectory (prefriction.exact_reversals): E_p strictly decreasing
   (gamma > 0), (2.10) and (2.11) to rounding, (2.12) after the first reversal, gamma = 0
   conserving energy after saturation, E_p equal to (3.9) for gamma = 1 (mpmath), and the
-  energy analysis of prefriction.energy agreeing with the table;
+  energy analysis of prefriction.analysis.energy agreeing with the table;
 - samples from prefriction.simulate, analysed by prefriction.energy.analyze_samples, agree with
   the exact table and with the simulator's own integrated power (2.8) and input work.
 """
@@ -24,7 +24,7 @@ from scipy.integrate import quad
 from scipy.optimize import brentq
 
 from prefriction import Dahl, Oscillator, energy
-from prefriction.exact import exact_reversals
+from prefriction.analysis.exact import exact_reversals
 
 EPS = np.finfo(float).eps
 FAST = settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])

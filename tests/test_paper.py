@@ -11,7 +11,7 @@ matplotlib.use("Agg")
 import pytest
 
 from prefriction import cli
-from prefriction.paper import FIGURES, examples_dir
+from prefriction.cli.paper import FIGURES, examples_dir
 
 
 def test_paper_command_writes_report_and_every_png(tmp_path, capsys):

@@ -98,7 +98,7 @@ def test_dahl_passes_the_reusable_checks(gamma):
 
 
 def test_one_structure_for_every_gamma_and_tolerance():
-    from prefriction._buffered_integrator import _CACHE
+    from prefriction.simulation.integrator import _CACHE
 
     before = len(_CACHE)
     for gamma in (1.0, 1.7, 3.0):

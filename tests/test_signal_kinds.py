@@ -63,7 +63,8 @@ def test_dense_samples_on_the_regular_grid_with_sampled_input():
 
 def test_analyze_samples_constant_input_work():
     sigma, Fc, m, u = 1e4, 1.0, 1.0, 0.2
-    system = pf.Oscillator(pf.Dahl(sigma=sigma, Fc=Fc), mass=m, u=u)
+    # the constant force as two equal samples (exactly u): the structure of the sampled inputs
+    system = pf.Oscillator(pf.Dahl(sigma=sigma, Fc=Fc), mass=m, u=(np.array([0.0, 0.3]), np.array([u, u])))
     res = pf.simulate(system, 0.05, t_end=0.3, dense=True, rtol=1e-10)
     rep = energy.analyze_samples(res.t, res.x, res.v, res.F, system=system, method="simpson")
     assert len(rep) >= 3

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 import prefriction as pf
-from prefriction.bench import Case, reversal_error, stability_cases
-from prefriction.exact import exact_reversals
+from prefriction.cli.bench import Case, reversal_error, stability_cases
+from prefriction.analysis.exact import exact_reversals
 
 CASES = stability_cases()
 

@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 import prefriction as pf
-from prefriction._feedback import LinearFeedback
-from prefriction._jit import compiled
+from prefriction.simulation.feedback import LinearFeedback
+from prefriction.simulation.compiled import compiled
 
 SYS = pf.Oscillator(pf.Dahl(1e4, 1.0))
 

@@ -14,7 +14,8 @@ import pytest
 import scipy.linalg as sla
 
 import prefriction as pf
-from prefriction._feedback import LinearFeedback
+from prefriction.signals import Sine
+from prefriction.simulation.feedback import LinearFeedback
 
 K_SPRING, MASS, FC_HUGE = 1e4, 2.0, 1e12
 
@@ -25,10 +26,12 @@ def spring_system(u=None) -> pf.Oscillator:
 
 def test_sinusoidal_input_matches_closed_form() -> None:
     """m x'' + k x = A sin(w t): homogeneous plus particular solution."""
-    A, w, v0 = 3.0, 50.0, 0.01
+    A, v0 = 3.0, 0.01
+    f = 50.0 / (2.0 * math.pi)  # [Hz]
+    w = 2.0 * math.pi * f  # the signal's angular frequency, bit for bit (Sine evaluates 2 pi f t)
     w0 = math.sqrt(K_SPRING / MASS)
     t = np.linspace(0.0, 0.5, 201)
-    res = pf.simulate(spring_system(lambda s: A * np.sin(w * s)), v0, t_end=0.5, dense=t, rtol=1e-10)
+    res = pf.simulate(spring_system(Sine(A, f)), v0, t_end=0.5, dense=t, rtol=1e-10)
     xp = A / (MASS * (w0**2 - w**2))
     x = (v0 - xp * w) / w0 * np.sin(w0 * t) + xp * np.sin(w * t)
     v = (v0 - xp * w) * np.cos(w0 * t) + xp * w * np.cos(w * t)
@@ -55,11 +58,15 @@ def test_sampled_input_matches_python_control() -> None:
 
 
 def test_velocity_touching_zero_is_not_a_reversal() -> None:
-    """x = t - sin t: v = 1 - cos t touches 0 at t = 2 pi without changing sign."""
+    """x = t - sin t: v = 1 - cos t touches 0 at t = 2 pi without changing sign.
+
+    m x'' + k x = u with x = X (t/T - sin(t/T)), T = sqrt(m/k): the inertial and the spring terms
+    in sin(t/T) cancel, so u = k X t/T, a ramp from rest (x(0) = v(0) = 0): two samples, linear.
+    """
     T = 1.0 / math.sqrt(K_SPRING / MASS)  # time unit; x(t) = X (t/T - sin(t/T))
     X = 1e-3
-    u = lambda s: MASS * X / T**2 * np.sin(s / T) + K_SPRING * X * (s / T - np.sin(s / T))  # noqa: E731
     t_end = 4.5 * math.pi * T
+    u = (np.array([0.0, t_end]), np.array([0.0, K_SPRING * X * t_end / T]))
     res = pf.simulate(spring_system(u), X / T * 0.0, t_end=t_end, dense=np.linspace(0, t_end, 50),
                       rtol=1e-10)
     assert len(res.reversals) == 0
@@ -75,13 +82,13 @@ def test_rest_is_recognised() -> None:
     assert np.all(res.x[before] == 0.0) and np.all(res.v[before] == 0.0)
     assert np.max(res.x) > 0  # moves once u exceeds F
     assert np.all(np.diff(res.reversals.t) > 1e-3)  # no chattering pairs
-    still = pf.simulate(pf.Oscillator(pf.Dahl(1e4, 1.0), u=lambda t: 0.3 + 0 * t), 0.0, F0=0.3, t_end=10.0)
+    still = pf.simulate(pf.Oscillator(pf.Dahl(1e4, 1.0), u=0.3), 0.0, F0=0.3, t_end=10.0)
     assert len(still.reversals) == 0 and still.stats.calls < 10
 
 
 def test_forced_energy_balance_uses_input_work() -> None:
     """E_d[k] = E_p[k-1] + W_u[k] - E_p[k]; W_u against the trapezoid of u v on dense samples."""
-    sys_ = pf.Oscillator(pf.Dahl(1e3, 1.0), mass=1.0, u=lambda t: 0.4 * np.sin(3.0 * t))
+    sys_ = pf.Oscillator(pf.Dahl(1e3, 1.0), mass=1.0, u=Sine(0.4, 3.0 / (2.0 * math.pi)))
     t = np.linspace(0.0, 20.0, 200_001)
     res = pf.simulate(sys_, 0.05, t_end=20.0, dense=t, rtol=1e-10)
     tab = res.reversals
@@ -187,7 +194,10 @@ def test_net_force_reversing_within_the_first_step_is_a_reversal() -> None:
 
 
 def test_no_force_on_a_mass_at_rest_keeps_it_at_rest() -> None:
-    """u = 0, v0 = 0, F0 = 0: the equilibrium; the mass stays at x = 0 (was: ZeroDivisionError)."""
-    res = pf.simulate(pf.Oscillator(pf.Dahl(1e6, 1.0), u=0.0), 0.0, t_end=1e-3, dense=True)
+    """u = 0, v0 = 0, F0 = 0: the equilibrium; the mass stays at x = 0 (was: ZeroDivisionError).
+
+    u = 0 as samples (t, 0): the same all-zero force, on the structure of the other sampled inputs."""
+    res = pf.simulate(pf.Oscillator(pf.Dahl(1e6, 1.0), u=(np.array([0.0, 1e-3]), np.zeros(2))), 0.0, t_end=1e-3,
+                      dense=True)
     assert res.status == "t_end" and len(res.reversals) == 0 and res.reversals.E_0 == 0.0
     assert np.all(res.x == 0.0) and np.all(res.v == 0.0) and np.all(res.F == 0.0)

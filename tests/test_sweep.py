@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import prefriction as pf
-from prefriction.sweep import SweepResult, _group_key, sweep
+from prefriction.simulation.sweep import SweepResult, _group_key, sweep
 
 GAMMAS = (1.0, 1.5, 2.0, 3.0)
 N_REV = 10

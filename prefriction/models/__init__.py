@@ -5,8 +5,8 @@
 - :class:`Oscillator` (``oscillator.py``): mass, friction model and input force.
 """
 
-from .base import FrictionModel, Parameter
-from .dahl import Dahl
-from .oscillator import Oscillator, check_dahl_oscillator, check_oscillator
+from prefriction.models.base import FrictionModel, Parameter
+from prefriction.models.dahl import Dahl
+from prefriction.models.oscillator import Oscillator, check_dahl_oscillator, check_oscillator
 
 __all__ = ["Dahl", "FrictionModel", "Oscillator", "Parameter", "check_dahl_oscillator", "check_oscillator"]

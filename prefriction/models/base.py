@@ -12,7 +12,7 @@ from typing import Any, ClassVar, Hashable, Sequence
 
 import numpy as np
 
-from .._validation import check_nonnegative, check_positive, check_real
+from prefriction._validation import check_nonnegative, check_positive, check_real
 
 __all__ = ["FrictionModel", "Parameter"]
 

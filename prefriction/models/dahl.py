@@ -14,8 +14,8 @@ from typing import Any, Hashable, Sequence
 import casadi as ca
 import numpy as np
 
-from .._branch import branch_potential
-from .base import FrictionModel, Parameter
+from prefriction.analysis.branch import branch_potential
+from prefriction.models.base import FrictionModel, Parameter
 
 __all__ = ["Dahl", "distance_of_log_gap", "force_of_p", "p_of_force"]
 
@@ -193,5 +193,5 @@ class Dahl(FrictionModel):
         return s * (distance_of_log_gap(z1[0], g) - distance_of_log_gap(z0[0], g))
 
     def branch_energy_of_force(self, F: np.ndarray, s: Any) -> np.ndarray:
-        """``H_gamma(s F~)`` (:func:`prefriction._branch.branch_potential`), (3.9) for gamma = 1."""
+        """``H_gamma(s F~)`` (:func:`prefriction.analysis.branch.branch_potential`), (3.9) for gamma = 1."""
         return np.asarray(branch_potential(np.clip(s * np.asarray(F, dtype=float), -1.0, 1.0), self.gamma), dtype=float)

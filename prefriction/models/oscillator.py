@@ -5,8 +5,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
-from .._validation import check_positive
-from .base import FrictionModel
+from prefriction._validation import check_positive
+from prefriction.models.base import FrictionModel
 
 __all__ = ["Oscillator", "check_oscillator", "check_dahl_oscillator"]
 
@@ -35,7 +35,7 @@ class Oscillator:
     u: Any = field(default=None)
 
     def __post_init__(self) -> None:
-        from ..signals import as_signal  # signals import the models' validation helpers
+        from prefriction.signals import as_signal  # signals import the models' validation helpers
 
         if not isinstance(self.friction, FrictionModel):
             raise TypeError(
@@ -80,7 +80,7 @@ def check_dahl_oscillator(system: Any, purpose: str) -> Any:
     purpose : str
         What needs the Dahl model, for the message (e.g. ``"exact_reversals"``).
     """
-    from .dahl import Dahl
+    from prefriction.models.dahl import Dahl
 
     friction = check_oscillator(system, purpose)
     if not isinstance(friction, Dahl):

@@ -6,8 +6,8 @@ from typing import Optional
 
 import numpy as np
 
-from ._feedback import LinearFeedback
-from .models import Oscillator
+from prefriction.simulation.feedback import LinearFeedback
+from prefriction.models import Oscillator
 
 
 def applied_force_scale(system: Oscillator, fb: Optional[LinearFeedback], x0: float, t_end: float) -> float:

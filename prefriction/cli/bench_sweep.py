@@ -43,9 +43,9 @@ from typing import Any, Callable, Optional, Sequence
 
 import numpy as np
 
-from .models import Dahl, Oscillator
-from .signals import Sine
-from .units import Scales
+from prefriction.models import Dahl, Oscillator
+from prefriction.signals import Sine
+from prefriction.units import Scales
 
 __all__ = ["SweepCase", "SweepRow", "main", "reversal_error", "scipy_reversals", "sweep_cases", "worker"]
 
@@ -201,7 +201,7 @@ def reversal_error(t: np.ndarray, x: np.ndarray, F: np.ndarray, ref_t: np.ndarra
 
 def _exact_tables(case: SweepCase) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
     """Reversals ``(t, x, F)`` of :func:`prefriction.exact_reversals` for every value (unforced)."""
-    from .exact import exact_reversals
+    from prefriction.analysis.exact import exact_reversals
 
     out = []
     for value in case.values:
@@ -438,7 +438,7 @@ def worker(spec: dict[str, Any], import_seconds: float) -> dict[str, Any]:
         ``setup_s``, ``jit`` (modes and their counts), ``failed``, ``errors`` per value and
         ``error`` (their maximum), ``import_s``.
     """
-    from .sweep import sweep
+    from prefriction.simulation.sweep import sweep
 
     case = next(c for c in sweep_cases(int(spec["n"])) if c.key == spec["case"])
     systems = [case.system(v) for v in case.values]
@@ -474,7 +474,7 @@ _CHILD = (
     "t0 = time.perf_counter()\n"
     "import prefriction\n"
     "ti = time.perf_counter() - t0\n"
-    "from prefriction.bench_sweep import worker\n"
+    "from prefriction.cli.bench_sweep import worker\n"
     "print(json.dumps(worker(json.loads(sys.argv[1]), ti)))\n"
 )
 
@@ -775,7 +775,7 @@ def main(argv: Optional[list[str]] = None) -> int:
     with tempfile.TemporaryDirectory(prefix="prefriction-bench-sweep-") as tmp:
         for case in cases:
             rows.extend(measure_case(case, Path(tmp), warm_repeats, scipy_repeats))
-    print(f"Sweeps of prefriction.sweep, sigma = {SIGMA:g} N/m, Fc = {FC:g} N, m = {MASS:g} kg, rtol 1e-8: "
+    print(f"Sweeps of prefriction.simulation.sweep, sigma = {SIGMA:g} N/m, Fc = {FC:g} N, m = {MASS:g} kg, rtol 1e-8: "
           f"unforced {N_REV} reversals from v0 = {V0_FREE:g} m/s, forced {T_END:g} s from rest.\n"
           f"cold: new process, empty cache; warm: new process, cache from the cold run (min of "
           f"{warm_repeats}). end-to-end = the sweep call incl. compile/load, import excluded.\n"

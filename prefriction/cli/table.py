@@ -13,10 +13,10 @@ import math
 
 import numpy as np
 
-from . import dahl
-from .exact import exact_reversals
-from .models import Dahl, Oscillator
-from .reversals import ReversalTable
+from prefriction import dahl
+from prefriction.analysis.exact import exact_reversals
+from prefriction.models import Dahl, Oscillator
+from prefriction.reversals import ReversalTable
 
 
 def _parser() -> argparse.ArgumentParser:

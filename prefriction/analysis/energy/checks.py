@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from .models import FrictionModel, check_oscillator
+from prefriction.models import FrictionModel, check_oscillator
 
 QUADRATURES = ("trapezoid", "simpson")
 """Quadrature rules of the power integrals: cumulative trapezoid or Simpson (scipy)."""

@@ -8,8 +8,8 @@ from typing import Any, Optional
 
 import numpy as np
 
-from ._energy_checks import ROUNDING, check_model
-from .models import FrictionModel
+from prefriction.analysis.energy.checks import ROUNDING, check_model
+from prefriction.models import FrictionModel
 
 
 def branch_energy(F: Any, direction: Any, *, friction: FrictionModel) -> np.ndarray:

@@ -7,12 +7,12 @@ from typing import Optional
 
 import numpy as np
 
-from ._buffered_integrator import INTEGRATOR_FAILED, BufferedIntegrator, integrator
-from ._feedback import LinearFeedback
-from ._plant import EPS_REST, Layout, PlantSpec
-from .errors import SolverError
-from .models import Oscillator
-from .units import Scales
+from prefriction.simulation.integrator import INTEGRATOR_FAILED, BufferedIntegrator, integrator
+from prefriction.simulation.feedback import LinearFeedback
+from prefriction.simulation.plant import EPS_REST, Layout, PlantSpec
+from prefriction.errors import SolverError
+from prefriction.models import Oscillator
+from prefriction.units import Scales
 
 N_DENSE = 16  # output times per call of the dense-output integrator
 

@@ -10,9 +10,9 @@ import importlib
 import sys
 
 COMMANDS = {
-    "table": ("prefriction.table", "exact reversal table of an unforced Dahl oscillator"),
-    "bench": ("prefriction.bench", "error against run time of simulate and its peers"),
-    "paper": ("prefriction.paper", "reproduce the paper's figures and write a report"),
+    "table": ("prefriction.cli.table", "exact reversal table of an unforced Dahl oscillator"),
+    "bench": ("prefriction.cli.bench", "error against run time of simulate and its peers"),
+    "paper": ("prefriction.cli.paper", "reproduce the paper's figures and write a report"),
 }
 
 

@@ -33,11 +33,11 @@ from typing import Callable, Optional
 
 import numpy as np
 
-from .dahl import next_amplitude
-from .models import Dahl, Oscillator
-from .reversals import ReversalTable
-from .simulate import METHODS, simulate
-from .units import Scales
+from prefriction.analysis.dahl import next_amplitude
+from prefriction.models import Dahl, Oscillator
+from prefriction.reversals import ReversalTable
+from prefriction.simulate import METHODS, simulate
+from prefriction.units import Scales
 
 N_REV = 50
 LADDER = [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11]
@@ -85,7 +85,7 @@ def stability_cases() -> list[Case]:
 
 
 def _exact(case: Case, n: int) -> ReversalTable:
-    from .exact import exact_reversals
+    from prefriction.analysis.exact import exact_reversals
 
     return exact_reversals(case.system, case.v0, n, x0=0.0, F0=case.F0)
 
@@ -329,7 +329,7 @@ def _progress(message: str) -> None:
 
 
 def analytics_timing(repeats: int, n_amp: int = 1_000_000, n_rev: int = 10_000) -> list[str]:
-    """Lines timing the exact analytics: :func:`prefriction.dahl.next_amplitude` on ``n_amp``
+    """Lines timing the exact analytics: :func:`prefriction.analysis.dahl.next_amplitude` on ``n_amp``
     amplitudes against ``numpy.exp`` on the same array, and :func:`exact_reversals` for ``n_rev``
     reversals of the headline case (minimum of ``repeats`` warm runs)."""
     a = np.logspace(-12, 0, n_amp)
@@ -466,10 +466,10 @@ def main(argv: Optional[list[str]] = None) -> int:
     ap.add_argument("--repeats", type=int, default=None, help="warm repeats per point (min is taken)")
     ap.add_argument("--sweep", action="store_true",
                     help="parameter sweeps instead: compiles and end-to-end time of cold and warm sweeps "
-                         "against scipy DOP853 (prefriction.bench_sweep; uses --out, --quick)")
+                         "against scipy DOP853 (prefriction.cli.bench_sweep; uses --out, --quick)")
     args = ap.parse_args(argv)
     if args.sweep:
-        from .bench_sweep import main as sweep_main
+        from prefriction.cli.bench_sweep import main as sweep_main
 
         return sweep_main(["--out", args.out] + (["--quick"] if args.quick else []))
     out = Path(args.out)

@@ -7,7 +7,7 @@ from typing import Any, Optional
 
 import numpy as np
 
-from ._energy_checks import check_samples
+from prefriction.analysis.energy.checks import check_samples
 
 
 @dataclass(frozen=True, eq=False)

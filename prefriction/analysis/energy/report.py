@@ -7,12 +7,12 @@ from typing import Any, Optional
 
 import numpy as np
 
-from ._energy_balance import BoundCheck, bound_check, branch_energy, dissipation, series
-from ._energy_checks import ROUNDING, check_dahl_system, check_method, check_samples
-from ._sampled_energy import cumulative, kinetic_energy
-from ._sampled_reversals import SampledReversals, find_reversals
-from .models import Oscillator
-from .reversals import ReversalTable
+from prefriction.analysis.energy.balance import BoundCheck, bound_check, branch_energy, dissipation, series
+from prefriction.analysis.energy.checks import ROUNDING, check_dahl_system, check_method, check_samples
+from prefriction.analysis.energy.sampled_energy import cumulative, kinetic_energy
+from prefriction.analysis.energy.sampled_reversals import SampledReversals, find_reversals
+from prefriction.models import Oscillator
+from prefriction.reversals import ReversalTable
 
 
 @dataclass(frozen=True, eq=False)

@@ -9,11 +9,11 @@ from typing import Any
 import numpy as np
 from scipy.integrate import cumulative_simpson, cumulative_trapezoid
 
-from ._energy_balance import branch_energy
-from ._energy_checks import check_dahl_system, check_method, check_samples
-from ._sampled_reversals import find_reversals
-from ._validation import check_positive
-from .models import Oscillator
+from prefriction.analysis.energy.balance import branch_energy
+from prefriction.analysis.energy.checks import check_dahl_system, check_method, check_samples
+from prefriction.analysis.energy.sampled_reversals import find_reversals
+from prefriction._validation import check_positive
+from prefriction.models import Oscillator
 
 
 def kinetic_energy(v: Any, *, mass: float) -> np.ndarray:

@@ -2,10 +2,10 @@
 
 Between two velocity reversals the branch direction ``s`` is fixed and the Dahl right-hand side
 (3.2) is smooth. The integrator (``casadi.integrator``, plugin ``erk``: adaptive explicit
-Runge-Kutta 5(4), compiled with gcc and cached on disk by :mod:`prefriction._jit`) locates every
+Runge-Kutta 5(4), compiled with gcc and cached on disk by :mod:`prefriction.simulation.compiled`) locates every
 zero of ``s v`` on its dense output (to round-off) and restarts on the new branch through an
 event transition; saturation (gamma < 1), touches and rest of a forced mass are events too
-(see :mod:`prefriction._plant`). Unforced runs without dense output use a compact model (2
+(see :mod:`prefriction.simulation.plant`). Unforced runs without dense output use a compact model (2
 states for gamma >= 1: one call per reversal, the next branch started in Python); forced or dense runs record up
 to ``K = 2`` reversals per call in a register. Calls go through a persistent argument buffer, so
 the cost per reversal is the integration itself (about 56 steps at ``rtol = 1e-8``), the same
@@ -20,8 +20,8 @@ times, positions and forces over 50 reversals stays below ``rtol`` (``prefrictio
 global errors grow linearly with the number of cycles, as for any one-step method.
 
 This module validates the arguments and assembles the result; the integration loop is
-:mod:`prefriction._integration_loop`, the compiled integrator and its buffers
-:mod:`prefriction._buffered_integrator`, the input and reference signals :mod:`prefriction._signals`.
+:mod:`prefriction.simulation.run`, the compiled integrator and its buffers
+:mod:`prefriction.simulation.integrator`, the input and reference signals :mod:`prefriction.simulation.force_scale`.
 """
 
 from __future__ import annotations
@@ -33,14 +33,14 @@ from typing import Any, Optional, Union
 
 import numpy as np
 
-from ._feedback import LinearFeedback
-from ._integration_loop import N_DENSE, Run
-from ._plant import Layout, PlantSpec
-from ._signals import applied_force_scale
-from ._validation import check_count, check_finite, check_positive
-from .models import Oscillator, check_oscillator
-from .reversals import ReversalTable
-from .units import Scales
+from prefriction.simulation.feedback import LinearFeedback
+from prefriction.simulation.run import N_DENSE, Run
+from prefriction.simulation.plant import Layout, PlantSpec
+from prefriction.simulation.force_scale import applied_force_scale
+from prefriction._validation import check_count, check_finite, check_positive
+from prefriction.models import Oscillator, check_oscillator
+from prefriction.reversals import ReversalTable
+from prefriction.units import Scales
 
 __all__ = ["METHODS", "RunStats", "SimulationResult", "simulate"]
 
@@ -168,7 +168,7 @@ def simulate(
         these times [s], increasing, within ``[0, t_end]``.
     feedback : LinearFeedback, optional
         Closed loop ``u = C xc + D (r - x)`` added to the input force (see
-        :class:`prefriction._feedback.LinearFeedback`). A sampled controller also returns
+        :class:`prefriction.simulation.feedback.LinearFeedback`). A sampled controller also returns
         samples at its sample instants.
     jit : bool, default True
         Compile the integrator with the C compiler (cached on disk); the environment variable

@@ -30,7 +30,7 @@ from typing import NamedTuple
 import numpy as np
 from scipy.special import exprel
 
-from ._validation import check_nonnegative
+from prefriction._validation import check_nonnegative
 
 __all__ = [
     "BranchEnd",

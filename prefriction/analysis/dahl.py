@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from ._validation import check_array_interval, check_count, check_interval, check_positive
+from prefriction._validation import check_array_interval, check_count, check_interval, check_positive
 
 __all__ = [
     "MAX_POTENTIAL_FACTOR",

@@ -8,8 +8,8 @@ import warnings
 import casadi as ca
 import numpy as np
 
-from ._jit import compiled, jit_available
-from ._plant import Layout, PlantSpec, build_integrator
+from prefriction.simulation.compiled import compiled, jit_available
+from prefriction.simulation.plant import Layout, PlantSpec, build_integrator
 
 _CACHE: dict = {}
 INTEGRATOR_FAILED = (

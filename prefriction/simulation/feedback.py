@@ -27,7 +27,7 @@ from typing import Any, Callable, Optional, Union
 
 import numpy as np
 
-from ._validation import check_positive
+from prefriction._validation import check_positive
 
 Reference = Union[float, Callable[[Any], Any], tuple]
 
@@ -91,7 +91,7 @@ class LinearFeedback:
         object.__setattr__(self, "D", _as_matrix("D", self.D, (1, 1)))
         if self.Ts is not None:
             object.__setattr__(self, "Ts", check_positive("Ts", self.Ts))
-        from .signals import as_signal
+        from prefriction.signals import as_signal
 
         object.__setattr__(self, "reference", as_signal(self.reference, "reference", "m"))
         xc0 = np.zeros(n) if self.xc0 is None else np.array(self.xc0, dtype=float).reshape(-1)

@@ -70,7 +70,7 @@ from typing import Any, Callable, Hashable, Iterator
 import casadi as ca
 import numpy as np
 
-from .models.base import FrictionModel
+from prefriction.models.base import FrictionModel
 
 __all__ = ["EPS_TOUCH", "EPS_REST", "Layout", "PlantSpec", "build_integrator"]
 
@@ -203,7 +203,7 @@ class Layout:
 
 def trace_signal(fun: Callable[[Any], Any], what: str) -> ca.SX:
     """Evaluate ``fun`` on a CasADi symbol; ``TypeError`` with advice if it cannot be traced."""
-    from .signals import Traced
+    from prefriction.signals import Traced
 
     return ca.SX(Traced(fun, name=what).expr(ca.SX.sym("t"), ()))
 

@@ -27,8 +27,8 @@ from typing import Any, Hashable, Iterable, Optional, Sequence, Sized, Union
 
 import numpy as np
 
-from .models import Oscillator
-from .simulate import simulate
+from prefriction.models import Oscillator
+from prefriction.simulate import simulate
 
 __all__ = ["MAX_SYSTEMS", "SweepResult", "sweep"]
 
@@ -40,7 +40,7 @@ _PROGRESS_EVERY = 0.5  # least interval between two progress lines [s]
 _MAX_LISTED = 10  # failed indices listed in the warning and in summary()
 
 # Runs of the same structure share one compiled integrator and its argument buffers per process
-# (prefriction._buffered_integrator), so two runs must never overlap in one process: threads of
+# (prefriction.simulation.integrator), so two runs must never overlap in one process: threads of
 # a ThreadPoolExecutor or of a multi-threaded dask worker take turns on this lock.
 _RUN_LOCK = threading.Lock()
 
@@ -165,7 +165,7 @@ def sweep(
     A gamma sweep of the Dahl oscillator, serially:
 
     >>> import prefriction as pf
-    >>> from prefriction.sweep import sweep
+    >>> from prefriction.simulation.sweep import sweep
     >>> systems = [pf.Oscillator(pf.Dahl(sigma=1e4, Fc=1.0, gamma=g), mass=1.0)
     ...            for g in (1.0, 1.5, 2.0, 3.0)]
     >>> res = sweep(systems, 1.0, reversals=50)

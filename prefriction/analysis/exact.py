@@ -4,9 +4,9 @@ Everything is computed in the normalised units of :mod:`prefriction.units` (the 
 system is then parameter-free apart from ``gamma``) and returned in SI units.
 
 Positions and forces come from the energy balance (2.3) on closed-form branches
-(:mod:`prefriction._branch`): a half-cycle that starts at rest with normalised force ``-a``
+(:mod:`prefriction.analysis.branch`): a half-cycle that starts at rest with normalised force ``-a``
 ends at rest at the force ``b`` with ``H(b) = H(-a)``; for ``gamma = 1`` this is the map
-:func:`prefriction.dahl.next_amplitude`. Times are quadratures of
+:func:`prefriction.analysis.dahl.next_amplitude`. Times are quadratures of
 ``t = int dxi / sqrt(2 K(xi))`` (``K`` the kinetic energy) split at the force zero crossing,
 with the integrable ``1/sqrt`` endpoint singularities removed by ``xi = xi_end - L u^2``, and
 ``K`` near each end written as a positive integral of the force over the remaining distance
@@ -26,8 +26,8 @@ from functools import lru_cache
 
 import numpy as np
 
-from . import dahl
-from ._branch import (
+from prefriction import dahl
+from prefriction.analysis.branch import (
     branch_distance,
     branch_potential,
     gauss_legendre_01,
@@ -36,10 +36,10 @@ from ._branch import (
     log_gap,
     potential_of_log_gap,
 )
-from ._validation import check_count, check_finite
-from .models import Oscillator, check_dahl_oscillator
-from .reversals import ReversalTable
-from .units import Scales
+from prefriction._validation import check_count, check_finite
+from prefriction.models import Oscillator, check_dahl_oscillator
+from prefriction.reversals import ReversalTable
+from prefriction.units import Scales
 
 __all__ = ["exact_reversals"]
 

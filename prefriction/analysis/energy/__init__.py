@@ -22,18 +22,18 @@ the energy dissipated in the half-cycle from reversal ``k`` to reversal ``k + 1`
 paper's ``E_d(i)`` in (2.10). :class:`prefriction.ReversalTable` indexes ``E_d`` by the
 half-cycle that *ends* at a reversal instead: ``table.E_d[k + 1]`` is ``E_d[k]`` here.
 
-The functions live in private modules: reversals in samples :mod:`prefriction._sampled_reversals`,
-energies along samples :mod:`prefriction._sampled_energy`, energies at reversals
-:mod:`prefriction._energy_balance`, the report :mod:`prefriction._energy_report`, argument checks
-:mod:`prefriction._energy_checks`.
+The functions live in private modules: reversals in samples :mod:`prefriction.analysis.energy.sampled_reversals`,
+energies along samples :mod:`prefriction.analysis.energy.sampled_energy`, energies at reversals
+:mod:`prefriction.analysis.energy.balance`, the report :mod:`prefriction.analysis.energy.report`, argument checks
+:mod:`prefriction.analysis.energy.checks`.
 """
 
 from __future__ import annotations
 
-from ._energy_balance import BoundCheck, bound_check, branch_energy, dissipation, series
-from ._energy_report import EnergyReport, analyze_samples, analyze_table
-from ._sampled_energy import integrated_power, kinetic_energy, loop_integral, total_energy, work_integral
-from ._sampled_reversals import SampledReversals, find_reversals
+from prefriction.analysis.energy.balance import BoundCheck, bound_check, branch_energy, dissipation, series
+from prefriction.analysis.energy.report import EnergyReport, analyze_samples, analyze_table
+from prefriction.analysis.energy.sampled_energy import integrated_power, kinetic_energy, loop_integral, total_energy, work_integral
+from prefriction.analysis.energy.sampled_reversals import SampledReversals, find_reversals
 
 __all__ = [
     "BoundCheck",

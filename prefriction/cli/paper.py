@@ -272,12 +272,12 @@ Substituting Omega* = 1 - K x with K = (sigma/Fc) r^(3/5), r = Fc/(Fc - F_i), fr
 
 The printed form carries an extra factor Fc/sigma [m] inside the bracket, where a pure number
 belongs; the two agree only when sigma/Fc = 1 1/m. The toolbox implements the corrected form
-(`prefriction.dahl.next_amplitude_paper`) and shows the printed one only to quantify the erratum."""
+(`prefriction.analysis.dahl.next_amplitude_paper`) and shows the printed one only to quantify the erratum."""
 
 
 def write_report(outdir: Path, results: dict, *, seconds: float, quick: bool) -> Path:
     """Write ``outdir/report.md`` from the figure results; return its path."""
-    from . import dahl
+    from prefriction import dahl
 
     outdir = Path(outdir)
     lines = [
