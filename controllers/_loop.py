@@ -21,7 +21,7 @@ from prefriction.simulation.feedback import LinearFeedback
 from prefriction._validation import check_positive, check_signal
 from prefriction.models import Oscillator
 from prefriction.reversals import ReversalTable
-from prefriction.simulate import SimulationResult
+from prefriction.simulation.simulate import SimulationResult
 
 from ._linear import _check_system, _sample_time, as_lti, closed_loop
 from ._pid import PID

@@ -19,7 +19,7 @@ from prefriction.errors import PrefrictionError, SolverError
 from prefriction.models import Dahl, FrictionModel, Oscillator, Parameter
 from prefriction.reversals import ReversalTable
 from prefriction.units import Scales
-from prefriction.simulate import SimulationResult, simulate
+from prefriction.simulation.simulate import SimulationResult, simulate
 from prefriction.simulation.sweep import SweepResult, sweep
 from prefriction.simulation.feedback import LinearFeedback
 from prefriction.analysis import dahl, energy

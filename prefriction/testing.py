@@ -160,7 +160,7 @@ def check_model(model: FrictionModel, *, v0: float = 1.5, reversals: int = 12, r
     -------
     ModelCheck
     """
-    from prefriction.simulate import simulate
+    from prefriction.simulation.simulate import simulate
     from prefriction.units import Scales
 
     _contract(model, np.random.default_rng(seed))

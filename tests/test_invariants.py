@@ -238,7 +238,7 @@ def test_prandtl_conserves_energy_after_saturation(case):
 def test_sampled_analysis_of_simulation_agrees_with_exact_table():
     # prefriction.simulate (CasADi) samples, analysed model-free and with the Dahl potential,
     # against the exact reversal table: (2.8)-(2.12) on a trajectory nobody tabulated.
-    from prefriction.simulate import simulate
+    from prefriction.simulation.simulate import simulate
 
     system = Oscillator(Dahl(1e4, 2.0, 1.0), mass=0.5)
     sim = simulate(system, 0.3, reversals=6, rtol=1e-10, dense=np.linspace(0.0, 0.2, 20001), jit=False)
@@ -258,7 +258,7 @@ def test_sampled_analysis_of_simulation_agrees_with_exact_table():
 
 
 def test_sampled_analysis_of_forced_simulation_counts_input_work():
-    from prefriction.simulate import simulate
+    from prefriction.simulation.simulate import simulate
 
     U = 0.6
     system = Oscillator(Dahl(1e4, 2.0, 1.0), mass=0.5, u=lambda t: U + 0 * t)

@@ -36,7 +36,7 @@ import numpy as np
 from prefriction.analysis.dahl import next_amplitude
 from prefriction.models import Dahl, Oscillator
 from prefriction.reversals import ReversalTable
-from prefriction.simulate import METHODS, simulate
+from prefriction.simulation.simulate import METHODS, simulate
 from prefriction.units import Scales
 
 N_REV = 50

@@ -28,7 +28,7 @@ from typing import Any, Hashable, Iterable, Optional, Sequence, Sized, Union
 import numpy as np
 
 from prefriction.models import Oscillator
-from prefriction.simulate import simulate
+from prefriction.simulation.simulate import simulate
 
 __all__ = ["MAX_SYSTEMS", "SweepResult", "sweep"]
 
