@@ -134,3 +134,17 @@ def test_loops_and_sweeps_run_any_protocol_model():
     out = pf.sweep(systems, 0.005, reversals=3)  # both elastic / pre-sliding: v0 below slip
     np.testing.assert_allclose(out[0].reversals.t, math.pi / 2 * math.sqrt(1e-4) * (1 + 2 * np.arange(3)), rtol=1e-8)
     np.testing.assert_allclose(out[1].reversals.F, pf.exact_reversals(systems[1], 0.005, 3).F, rtol=1e-7)
+
+
+def test_check_model_catches_a_model_that_bakes_its_numbers_into_the_plant():
+    """A Dahl variant whose symbolic rate reads self.gamma instead of q would compile a plant
+    that is wrong for every other gamma; the contract check compares with a sibling instance."""
+
+    @dataclass(frozen=True)
+    class BakedDahl(pf.Dahl):
+        def rate(self, z, m, v, s, q):
+            return super().rate(z, m, v, s, [self.gamma])
+
+    with pytest.raises(AssertionError, match="must use q"):
+        check_model(BakedDahl(1e4, 1.0, 2.0), reversals=3)
+    check_model(pf.Dahl(1e4, 1.0, 2.0), reversals=3)  # the same check passes for Dahl itself

@@ -57,7 +57,7 @@ def integrator(spec: PlantSpec, jit: bool) -> tuple[BufferedIntegrator, float, s
 
 def _describe(spec: PlantSpec) -> str:
     """One line on what a plant is, for the compile message."""
-    key = spec.model_key
+    key = spec.model_key[2]
     what = [" ".join(str(k) for k in key) if isinstance(key, tuple) else str(key)]
     for name, key in (("input", spec.u_key), ("reference", spec.r_key)):
         if key is None:

@@ -112,7 +112,8 @@ class PlantSpec:
     @classmethod
     def of(cls, model: FrictionModel, u_sig: Any = None, r_sig: Any = None, **kw: Any) -> "PlantSpec":
         """The spec of ``model`` with input ``u_sig`` and reference ``r_sig`` (keys filled in)."""
-        return cls(model=model, model_key=model.structure_key(), u_sig=u_sig,
+        key = (type(model).__module__, type(model).__qualname__, model.structure_key())
+        return cls(model=model, model_key=key, u_sig=u_sig,
                    u_key=None if u_sig is None else u_sig.key, r_sig=r_sig,
                    r_key=None if r_sig is None else r_sig.key, **kw)
 

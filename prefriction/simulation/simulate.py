@@ -1,27 +1,32 @@
-"""Time simulation of the pre-sliding oscillator (2.1) with reversal handling, through CasADi.
+"""Time simulation of the oscillator (2.1) with any friction model, every reversal located (CasADi).
 
-Between two velocity reversals the branch direction ``s`` is fixed and the Dahl right-hand side
-(3.2) is smooth. The integrator (``casadi.integrator``, plugin ``erk``: adaptive explicit
-Runge-Kutta 5(4), compiled with gcc and cached on disk by :mod:`prefriction.simulation.compiled`) locates every
-zero of ``s v`` on its dense output (to round-off) and restarts on the new branch through an
-event transition; saturation (gamma < 1), touches and rest of a forced mass are events too
-(see :mod:`prefriction.simulation.plant`). Unforced runs without dense output use a compact model (2
-states for gamma >= 1: one call per reversal, the next branch started in Python); forced or dense runs record up
-to ``K = 2`` reversals per call in a register. Calls go through a persistent argument buffer, so
-the cost per reversal is the integration itself (about 56 steps at ``rtol = 1e-8``), the same
+Between two velocity reversals the branch direction ``s`` is fixed and the model's right-hand
+side is smooth (:class:`prefriction.FrictionModel`). The integrator (``casadi.integrator``,
+plugin ``erk``: adaptive explicit Runge-Kutta 5(4), compiled with gcc and cached on disk by
+:mod:`prefriction.simulation.compiled`) locates every zero of ``s v`` on its dense output (to
+round-off) and restarts on the new branch through an event transition; the model's own events
+(Dahl's saturation for gamma < 1), touches and rest of a forced mass are events too (see
+:mod:`prefriction.simulation.plant`). One plant is compiled per model structure: numbers,
+input numbers and the tolerance are run-time inputs (``docs/simulator.md``).
+
+Unforced runs without dense output use a compact model (2 states for Dahl with gamma >= 1: one
+call per reversal, the next branch started in Python); forced or dense runs record up to
+``K = 2`` reversals per call in a register. Calls go through a persistent argument buffer, so
+the cost per reversal is the integration itself (about 60 steps at ``rtol = 1e-8``), the same
 for 50 or 1e4 reversals.
 
-The model is integrated in normalised units (:mod:`prefriction.units`), with the branch distance
-``p`` (``p' = s v``) as the force state and every state scaled per call by the current
-amplitude, so the relative accuracy does not depend on ``sigma``, ``Fc``, the mass or the energy
-(1e-20 to 1e6 times ``Fc^2 / sigma`` in the first excursion); results are converted to SI.
-The internal tolerance is ``rtol`` times a calibration factor such that the error of reversal
-times, positions and forces over 50 reversals stays below ``rtol`` (``prefriction bench``);
-global errors grow linearly with the number of cycles, as for any one-step method.
+The model is integrated in normalised units (:mod:`prefriction.units`) with every state scaled
+per call by the current amplitude, so the relative accuracy does not depend on ``sigma``,
+``Fc``, the mass or the energy (1e-20 to 1e6 times ``Fc^2 / sigma`` in the first excursion);
+results are converted to SI. The tolerance ``eps`` of the plant is ``rtol`` times a calibration
+factor such that the error of reversal times, positions and forces over 50 reversals stays
+below ``rtol`` (``prefriction bench``); global errors grow linearly with the number of cycles,
+as for any one-step method.
 
 This module validates the arguments and assembles the result; the integration loop is
 :mod:`prefriction.simulation.run`, the compiled integrator and its buffers
-:mod:`prefriction.simulation.integrator`, the input and reference signals :mod:`prefriction.simulation.force_scale`.
+:mod:`prefriction.simulation.integrator`, the force scale of forced runs
+:mod:`prefriction.simulation.force_scale`.
 """
 
 from __future__ import annotations
@@ -133,14 +138,16 @@ def simulate(
     feedback: Optional[LinearFeedback] = None,
     jit: bool = True,
 ) -> SimulationResult:
-    """Simulate the oscillator (2.1) ``m x'' = u - F`` with Dahl friction (3.2), every reversal located.
+    """Simulate the oscillator (2.1) ``m x'' = u - F`` with any friction model, every reversal located.
 
     Parameters
     ----------
     system : Oscillator
-        Mass, friction model (:class:`prefriction.Dahl`) and optional input force ``u(t)`` [N]
-        (a callable that accepts a CasADi symbol, or samples ``(t, u)``, linear between samples
-        and held constant outside them; the integration is broken at the sample times).
+        Mass, friction model (:class:`prefriction.Dahl` or any :class:`prefriction.FrictionModel`)
+        and optional input force ``u(t)`` [N]: a :mod:`prefriction.signals` signal (compiled once
+        per kind), samples ``(t, u)`` (linear between samples, held outside them; the
+        integration is broken at the sample times) or a callable that accepts a CasADi symbol
+        (compiled once per function).
     v0 : float
         Initial velocity [m/s]. If ``v0 = 0`` the motion starts in direction ``-sign(F0)``
         (unforced) or ``sign(u(0) - F0)`` (forced); with no net force the mass rests.
@@ -155,8 +162,9 @@ def simulate(
         Relative tolerance, ``1e-13 <= rtol <= 1e-2``; reversal times, positions and forces come
         out with a relative error of about ``rtol`` (see ``prefriction bench``).
     atol : float, optional
-        Absolute tolerance relative to the current amplitude of the motion (dimensionless);
-        defaults to ``rtol``.
+        Tolerance relative to the current amplitude of the motion (dimensionless); defaults to
+        ``rtol``. The error control is absolute on states scaled by that amplitude, so the two
+        act alike and the smaller one is used (``docs/simulator.md``).
     method : str, default "erk"
         CasADi integrator plugin; one of :data:`METHODS`. Only ``"erk"`` is exposed: it passes
         every case of ``prefriction bench``. (``"rosenbrock"`` works with the same events but is
@@ -363,8 +371,12 @@ def _reversal_table(rev: list, system: Oscillator, s0: float, v0: float, F0: flo
     R = np.array(rev, dtype=float).reshape(-1, 4)
     t_r, x_r, F_r, W_r = R[:, 0] * sc.t, R[:, 1] * sc.x, R[:, 2] * sc.F, R[:, 3] * sc.E
     s_after = s0 * (-1.0) ** (np.arange(1, len(R) + 1))
-    E_p = model.branch_energy_of_force(R[:, 2], s_after) * sc.E if len(R) else np.zeros(0)
-    E0 = 0.5 * system.mass * v0 * v0 + float(model.branch_energy_of_force(np.array([F0 / sc.F]), s0)[0]) * sc.E
+    if not model.rate_independent:  # no stored branch energy: E_p is not defined (NaN), E_0 kinetic
+        E_p = np.full(len(R), np.nan)
+        E0 = 0.5 * system.mass * v0 * v0
+    else:
+        E_p = model.branch_energy_of_force(R[:, 2], s_after) * sc.E if len(R) else np.zeros(0)
+        E0 = 0.5 * system.mass * v0 * v0 + float(model.branch_energy_of_force(np.array([F0 / sc.F]), s0)[0]) * sc.E
     E_d = np.empty(len(R))
     if len(R):
         E_d[0] = E0 - E_p[0] + W_r[0]

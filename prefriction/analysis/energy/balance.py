@@ -160,7 +160,7 @@ class BoundCheck:
     def format(self) -> str:
         """Readable summary of the check, one line per bound."""
         lines = [
-            f"(2.12) E_p <= Fc^2/(2 sigma) = {self.bound:.6e} J: "
+            f"(2.12) E_p <= Fc^2/(2 k_min) = {self.bound:.6e} J: "
             f"{'holds' if self.holds else 'VIOLATED'}{'' if self.strict or not self.holds else ' (with equality)'}, "
             f"max E_p = {self.max_E_p:.6e} J at reversal {self.index + 1}, ratio {self.ratio:.6f}, margin {self.margin:.3e} J",
             f"sharp bound (Fc^2/sigma) H_gamma(-1) = {self.bound_sharp:.6e} J: "
