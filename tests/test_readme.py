@@ -37,7 +37,17 @@ def test_quick_start_prints_what_the_readme_shows():
 
 
 def test_controllers_example_runs_and_respects_the_pd_bound():
-    code = [body for lang, body in BLOCKS if lang == "python"][1]
+    code = next(body for lang, body in BLOCKS if lang == "python" and "controllers" in body)
     out = _run(code)
     ratio = float(re.search(r"\|e\| / bound = ([0-9.]+)", out).group(1))
     assert 0.0 < ratio <= 1.0
+
+
+def test_sweep_example_matches_the_exact_reference():
+    code = next(body for lang, body in BLOCKS if lang == "python" and "pf.sweep" in body)
+    out = _run(code)
+    assert out.startswith("SweepResult(5 runs, 0 failed")
+    import prefriction as pf
+
+    exact = abs(pf.exact_reversals(pf.Oscillator(pf.Dahl(1e4, 1.0, 3.0)), 1.0, 50).F[-1])
+    assert float(re.search(r"gamma = 3: ([0-9.]+) N", out).group(1)) == round(exact, 6)
