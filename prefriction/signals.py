@@ -39,6 +39,7 @@ import casadi as ca
 import numpy as np
 
 __all__ = [
+    "compiled_form",
     "Chirp",
     "Constant",
     "Ramp",
@@ -202,6 +203,16 @@ class Signal(ABC):
         numpy.ndarray
             The numbers of this signal in SI units, length :attr:`n_params`.
         """
+
+    def linear_piece(self, ta: float, tb: float) -> Optional[tuple[float, float]]:
+        """``(value at ta, slope)`` on ``[ta, tb]`` if the signal is piecewise linear there
+        (no :meth:`breaks` strictly inside), else ``None``.
+
+        Piecewise-linear kinds (:class:`Constant`, :class:`Step`, :class:`Ramp`,
+        :class:`Samples` and their sums) share one compiled plant: the simulator passes their
+        pieces per interval (:func:`compiled_form`).
+        """
+        return None
 
     def piece(self, ta: float, tb: float) -> np.ndarray:
         """Per-interval numbers for a time interval inside which the signal is smooth.
@@ -370,6 +381,10 @@ class Constant(_Analytic):
     def _expr(self, t: Any, theta: Any, piece: Any, ops: Any) -> Any:
         return theta[0]
 
+    def linear_piece(self, ta: float, tb: float) -> tuple[float, float]:
+        """``(value, 0)``: a constant is piecewise linear."""
+        return self.value, 0.0
+
     def bound(self, t_end: float) -> float:
         """Magnitude of the value.
 
@@ -412,6 +427,10 @@ class Step(_Analytic):
 
     def _expr(self, t: Any, theta: Any, piece: Any, ops: Any) -> Any:
         return ops.where(t >= theta[0], theta[2], theta[1])
+
+    def linear_piece(self, ta: float, tb: float) -> tuple[float, float]:
+        """``(before or after, 0)`` by the midpoint of ``[ta, tb]``."""
+        return (self.after if 0.5 * (ta + tb) >= self.time else self.before), 0.0
 
     def breaks(self) -> np.ndarray:
         """Switching time.
@@ -466,6 +485,12 @@ class Ramp(_Analytic):
 
     def _expr(self, t: Any, theta: Any, piece: Any, ops: Any) -> Any:
         return theta[2] + theta[1] * ops.fmax(t - theta[0], 0.0)
+
+    def linear_piece(self, ta: float, tb: float) -> tuple[float, float]:
+        """``(offset + slope (ta - time), slope)`` after ``time``, ``(offset, 0)`` before."""
+        if 0.5 * (ta + tb) > self.time:
+            return self.offset + self.slope * (ta - self.time), self.slope
+        return self.offset, 0.0
 
     def breaks(self) -> np.ndarray:
         """Start of the ramp.
@@ -674,6 +699,11 @@ class Samples(Signal):
             Empty array.
         """
         return np.zeros(0)
+
+    def linear_piece(self, ta: float, tb: float) -> tuple[float, float]:
+        """Value at ``ta`` and slope of the linear piece of :meth:`piece`."""
+        tl, a, b = self.piece(ta, tb)
+        return float(a + b * (ta - tl)), float(b)
 
     def piece(self, ta: float, tb: float) -> np.ndarray:
         """Linear piece ``a + b (t - tl)`` valid on ``[ta, tb]``.
@@ -928,6 +958,16 @@ class Sum(Signal):
         """
         return np.concatenate([term.params() for term in self.terms])
 
+    def linear_piece(self, ta: float, tb: float) -> Optional[tuple[float, float]]:
+        """Sum of the terms' pieces if every term is piecewise linear, else ``None``."""
+        a = b = 0.0
+        for term in self.terms:
+            lp = term.linear_piece(ta, tb)
+            if lp is None:
+                return None
+            a, b = a + lp[0], b + lp[1]
+        return a, b
+
     def piece(self, ta: float, tb: float) -> np.ndarray:
         """Per-interval numbers of the terms, concatenated.
 
@@ -998,6 +1038,69 @@ class Sum(Signal):
 
 # --------------------------------------------------------------------------------------------
 # conversion
+
+
+class _PiecewiseLinear(Signal):
+    """A piecewise-linear signal as the simulator compiles it: one structure for every
+    piecewise-linear kind, the value and slope of each interval as per-interval numbers."""
+
+    __slots__ = ("base",)
+
+    def __init__(self, base: Signal) -> None:
+        self._set(base=base)
+
+    @property
+    def key(self) -> Hashable:
+        return ("PiecewiseLinear",)
+
+    @property
+    def n_params(self) -> int:
+        return 0
+
+    @property
+    def n_piece(self) -> int:
+        return 3
+
+    def params(self) -> np.ndarray:
+        return np.zeros(0)
+
+    def piece(self, ta: float, tb: float) -> np.ndarray:
+        a, b = self.base.linear_piece(ta, tb)
+        return np.array([ta, a, b])
+
+    def _expr(self, t: Any, theta: Any, piece: Any, ops: Any) -> Any:
+        return piece[1] + piece[2] * (t - piece[0])
+
+    def __call__(self, t: Any) -> Union[float, np.ndarray]:
+        return self.base(t)
+
+    def breaks(self) -> np.ndarray:
+        return self.base.breaks()
+
+    def bound(self, t_end: float) -> float:
+        return self.base.bound(t_end)
+
+    def __repr__(self) -> str:
+        return f"PiecewiseLinear({self.base!r})"
+
+
+def compiled_form(sig: Optional[Signal]) -> Optional[Signal]:
+    """The form in which the simulator compiles ``sig``: piecewise-linear signals (constants,
+    steps, ramps, samples and their sums) all share the structure ``("PiecewiseLinear",)``,
+    their numbers given per integration interval; other signals are compiled as they are.
+
+    Parameters
+    ----------
+    sig : Signal or None
+        The signal.
+
+    Returns
+    -------
+    Signal or None
+    """
+    if sig is None or isinstance(sig, _PiecewiseLinear):
+        return sig
+    return _PiecewiseLinear(sig) if sig.linear_piece(0.0, 0.0) is not None else sig
 
 
 def as_signal(value: Any, name: str, unit: str) -> Optional[Signal]:

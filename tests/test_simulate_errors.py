@@ -76,11 +76,11 @@ def test_feedback_validation() -> None:
 def test_solver_failure_raises_solver_error_naming_time_and_state() -> None:
     """An input that becomes NaN at t = 0.01 s makes the integrator fail: SolverError, no NaN result.
 
-    Deliberately a plain Python callable (no parametric signal becomes NaN): the suite's one input
-    that takes the compiled-once-per-function-object path (prefriction.signals.Traced)."""
+    Deliberately a plain Python callable (no parametric signal becomes NaN), traced into the plant
+    (prefriction.signals.Traced); interpreted (jit=False), so that it costs the suite no compile."""
     sys_ = pf.Oscillator(pf.Dahl(1e4, 1.0), u=lambda t: 0.5 * np.sqrt(0.01 - t))
     with pytest.raises(pf.SolverError) as info, np.errstate(invalid="ignore"):
-        pf.simulate(sys_, 0.1, t_end=0.05)
+        pf.simulate(sys_, 0.1, t_end=0.05, jit=False)
     msg = str(info.value)
     assert "t = " in msg and "x = " in msg and "v = " in msg and "F = " in msg and "Try" in msg
 

@@ -112,7 +112,10 @@ class PlantSpec:
     @classmethod
     def of(cls, model: FrictionModel, u_sig: Any = None, r_sig: Any = None, **kw: Any) -> "PlantSpec":
         """The spec of ``model`` with input ``u_sig`` and reference ``r_sig`` (keys filled in)."""
+        from prefriction.signals import compiled_form
+
         key = (type(model).__module__, type(model).__qualname__, model.structure_key())
+        u_sig, r_sig = compiled_form(u_sig), compiled_form(r_sig)
         return cls(model=model, model_key=key, u_sig=u_sig,
                    u_key=None if u_sig is None else u_sig.key, r_sig=r_sig,
                    r_key=None if r_sig is None else r_sig.key, **kw)

@@ -53,6 +53,7 @@ METHODS = ("erk",)
 """Integrator plugins exposed by :func:`simulate` (each tested on the whole case set)."""
 
 _K = 2  # reversals recorded per integrator call (register length; forced or dense runs)
+_MIN_ORDER = 2  # continuous controllers are padded to this order (one plant for P, PD, PID)
 _CAL = 0.1  # calibration of the run-time tolerance eps: global error over 50 reversals ~ 0.7 rtol
 _DENSE_STEP = 2.0 * math.pi / 64.0  # normalised spacing of dense=True samples (64 per small cycle)
 
@@ -225,9 +226,12 @@ def simulate(
 
     sc = Scales.of(system)
     fb_kind, n_c = "none", 0
+    n_user = 0 if feedback is None else feedback.n_states
     if feedback is not None:
         fb_kind = "sampled" if feedback.sampled else "continuous"
-        n_c = feedback.n_states if fb_kind == "continuous" else 0
+        if fb_kind == "continuous":
+            feedback = _padded(feedback, _MIN_ORDER)  # P, PD and PID loops share one plant
+            n_c = feedback.n_states
     want_dense = not (dense is False or dense is None)
     times_si = _dense_times(dense, t_end_si) if want_dense and not isinstance(dense, bool) else None
     if want_dense and fb_kind == "sampled":
@@ -270,7 +274,7 @@ def simulate(
 
     table, W_r = _reversal_table(run.rev[: int(min(len(run.rev), n_target))], system, s0, v0, F0)
     stats = RunStats(wall_time=wall, setup_time=run.setup_time, calls=run.calls, steps=run.steps, jit=run.mode)
-    extra = _samples_si(run, samples, u_hist, times_si) if samples else {}
+    extra = _samples_si(run, samples, u_hist, times_si, n_user) if samples else {}
     return SimulationResult(reversals=table, status=status, stats=stats, work_input=W_r, **extra)
 
 
@@ -384,7 +388,22 @@ def _reversal_table(rev: list, system: Oscillator, s0: float, v0: float, F0: flo
     return ReversalTable(t=t_r, x=x_r, F=F_r, E_p=E_p, E_d=E_d, E_0=E0), W_r
 
 
-def _samples_si(run: Run, samples: list, u_hist: list, times_si: Optional[np.ndarray]) -> dict:
+def _padded(fb: LinearFeedback, order: int) -> LinearFeedback:
+    """``fb`` with zero states appended up to ``order`` (they never move and add no force)."""
+    n = fb.n_states
+    if n >= order:
+        return fb
+    A = np.zeros((order, order))
+    A[:n, :n] = fb.A
+    B = np.zeros((order, 1))
+    B[:n] = fb.B
+    C = np.zeros((1, order))
+    C[:, :n] = fb.C
+    xc0 = np.concatenate([fb.xc0, np.zeros(order - n)])
+    return LinearFeedback(A=A, B=B, C=C, D=fb.D, Ts=fb.Ts, reference=fb.reference, xc0=xc0)
+
+
+def _samples_si(run: Run, samples: list, u_hist: list, times_si: Optional[np.ndarray], n_user: int) -> dict:
     """The samples ``(t~, x~, v~, F~, E_f~, xc)`` of ``run`` as the SI fields of :class:`SimulationResult`;
     ``times_si`` are the requested sample times [s] (None: every ``_DENSE_STEP``)."""
     system, feedback, sc = run.system, run.fb, run.sc
@@ -409,5 +428,5 @@ def _samples_si(run: Run, samples: list, u_hist: list, times_si: Optional[np.nda
                 uu = uu + (xcs @ feedback.C[0] if run.spec.n_c else 0.0) + feedback.D[0, 0] * e
             extra["u"] = uu
     if feedback is not None:
-        extra["xc"] = np.array(S[5]).reshape(len(ts), -1)
+        extra["xc"] = np.array(S[5]).reshape(len(ts), -1)[:, :n_user]
     return extra
