@@ -8,11 +8,14 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
-from typing import Any, ClassVar, Hashable, Sequence
+from typing import TYPE_CHECKING, Any, ClassVar, Hashable, Sequence
 
 import numpy as np
 
 from prefriction._validation import check_nonnegative, check_positive, check_real
+
+if TYPE_CHECKING:  # prefriction.units imports the models
+    from prefriction.units import Scales
 
 __all__ = ["FrictionModel", "Parameter"]
 
@@ -72,7 +75,8 @@ class FrictionModel(ABC):
 
     **Compile once per structure.** The simulator builds one CasADi function per
     :meth:`structure_key`. Everything that may change without changing the generated code is a
-    run-time number returned by :meth:`runtime_params` (``q``); :meth:`rate`, :meth:`force`,
+    run-time number returned by :meth:`runtime_params_for` (``q``; by default
+    :meth:`runtime_params`, numbers independent of the mass); :meth:`rate`, :meth:`force`,
     :meth:`events`, :meth:`on_event` and :meth:`reverse` must build their expressions from
     ``q`` and never from the instance's own numbers, and must work on Python floats, numpy
     arrays and CasADi ``SX`` symbols alike (the test helper
@@ -130,7 +134,18 @@ class FrictionModel(ABC):
 
     @abstractmethod
     def runtime_params(self) -> np.ndarray:
-        """Normalised numbers ``q`` that enter the compiled plant as run-time inputs."""
+        """Normalised numbers ``q`` that enter the compiled plant as run-time inputs (for a unit
+        mass if they depend on the mass, see :meth:`runtime_params_for`)."""
+
+    def runtime_params_for(self, scales: "Scales") -> np.ndarray:
+        """Normalised numbers ``q`` for a system with the units ``scales`` (:class:`prefriction.Scales`).
+
+        The simulator calls this. Numbers that involve the time or velocity unit depend on the
+        mass, which the model does not know (e.g. LuGre's damping ``sigma1 scales.v / Fc`` and
+        Stribeck velocity ``vs / scales.v``): such models override this method. The default is
+        :meth:`runtime_params` (numbers independent of the mass, e.g. Dahl's ``gamma``).
+        """
+        return self.runtime_params()
 
     # --- dynamics (floats, numpy and CasADi SX alike) ------------------------------------
     @abstractmethod

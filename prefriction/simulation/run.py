@@ -30,9 +30,11 @@ class Run:
         self.system, self.spec, self.fb = system, spec, fb
         self.sc = Scales.of(system)
         self.model = system.friction
-        self.q = self.model.runtime_params()
+        self.q = self.model.runtime_params_for(self.sc)  # may depend on the mass (units)
         self.eps = eps  # run-time tolerance: states are scaled by amplitude * eps
         self.L = Layout(spec)  # the same for any number of outputs per call
+        # a sampled controller on a plant without a hold control: its force joins the input piece
+        self.hold_in_piece = fb is not None and fb.sampled and spec.fb == "none"
         # one plant: a dense run makes its single-output calls on the dense plant, padded
         self.f1, self.setup_time, self.mode = integrator(spec, jit)
         self.calls = 0
@@ -154,6 +156,8 @@ class Run:
         U[L.control["t0"]] = t0 - (t1 - t0) * j  # t~ = t0 + dur * tau, tau in [j, j + 1]
         if L.uc.stop > L.uc.start:
             U[L.uc] = self.spec.u_sig.piece(t0 * sc.t, t1 * sc.t).tolist()
+            if self.hold_in_piece:  # a sampled controller's held force joins the input's piece
+                U[L.uc.start + 1] += self.st["uhold"]
         if L.rc.stop > L.rc.start:
             U[L.rc] = self.spec.r_sig.piece(t0 * sc.t, t1 * sc.t).tolist()
         if "uhold" in L.control:
@@ -162,13 +166,13 @@ class Run:
 
     def _net_force(self) -> float:
         """Normalised net force ``u~ - F~`` on the mass in the current state."""
-        st, sc = self.st, self.sc
+        st, sc, fb = self.st, self.sc, self.fb
         t_si = st["t"] * sc.t
         u = float(self.system.u(t_si)) if self.system.forced else 0.0
         if self.spec.fb == "continuous":
             e = float(self.fb.reference(t_si)) - st["x"] * sc.x
             u += float(self.fb.C[0] @ st["xc"] + self.fb.D[0, 0] * e)
-        elif self.spec.fb == "sampled":
+        elif fb is not None and fb.sampled:
             u += st["uhold"]
         return u / sc.F - st["F"]
 

@@ -38,6 +38,7 @@ from typing import Any, Optional, Union
 
 import numpy as np
 
+from prefriction.signals import Constant, compiled_form
 from prefriction.simulation.feedback import LinearFeedback
 from prefriction.simulation.run import N_DENSE, Run
 from prefriction.simulation.plant import Layout, PlantSpec
@@ -54,6 +55,7 @@ METHODS = ("erk",)
 
 _K = 2  # reversals recorded per integrator call (register length; forced or dense runs)
 _MIN_ORDER = 2  # continuous controllers are padded to this order (one plant for P, PD, PID)
+_ZERO = Constant(0.0)  # the input of a sampled loop without an input force (the hold is added)
 _CAL = 0.1  # calibration of the run-time tolerance eps: global error over 50 reversals ~ 0.7 rtol
 _DENSE_STEP = 2.0 * math.pi / 64.0  # normalised spacing of dense=True samples (64 per small cycle)
 
@@ -236,9 +238,13 @@ def simulate(
     times_si = _dense_times(dense, t_end_si) if want_dense and not isinstance(dense, bool) else None
     if want_dense and fb_kind == "sampled":
         raise ValueError("dense samples are not available with a sampled controller: its samples are at k Ts")
+    u_plant, fb_plant = system.u, fb_kind
+    if fb_kind == "sampled" and compiled_form(system.u if system.forced else _ZERO).key == ("PiecewiseLinear",):
+        # the held force joins the input's piecewise-linear pieces: the plant of an open loop
+        u_plant, fb_plant = (system.u if system.forced else _ZERO), "none"
     spec = PlantSpec.of(
-        model, system.u, feedback.reference if fb_kind == "continuous" else None,
-        fb=fb_kind, n_c=n_c, energy=want_dense, K=_K, n_out=N_DENSE if want_dense else 1,
+        model, u_plant, feedback.reference if fb_kind == "continuous" else None,
+        fb=fb_plant, n_c=n_c, energy=want_dense, K=_K, n_out=N_DENSE if want_dense else 1,
         method=method, compact=True,
     )
     L = Layout(spec)
@@ -418,7 +424,7 @@ def _samples_si(run: Run, samples: list, u_hist: list, times_si: Optional[np.nda
     if run.spec.energy:
         extra["E_f"] = np.array(S[4]) * sc.E
     if system.forced or feedback is not None:
-        if run.spec.fb == "sampled":
+        if feedback is not None and feedback.sampled:
             extra["u"] = np.array(u_hist)
         else:
             uu = np.asarray(system.u(ts), dtype=float) if system.forced else np.zeros_like(ts)
