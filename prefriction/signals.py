@@ -119,6 +119,16 @@ class _NumpyOps:
     fmin = staticmethod(np.minimum)
 
 
+class _MathOps:  # scalar floats: the fast path of Signal.__call__ (loops evaluate per sample)
+    sin = staticmethod(math.sin)
+    fmax = staticmethod(max)
+    fmin = staticmethod(min)
+
+    @staticmethod
+    def where(c: bool, a: float, b: float) -> float:
+        return a if c else b
+
+
 class _CasadiOps:
     sin = staticmethod(ca.sin)
     where = staticmethod(ca.if_else)
@@ -283,6 +293,8 @@ class Signal(ABC):
         float or numpy.ndarray
             The value(s), shaped like ``t`` (a float for a scalar ``t``).
         """
+        if isinstance(t, float) and self.n_piece == 0:  # one time: no numpy broadcasting (~30 us)
+            return float(self._expr(t, self.params().tolist(), (), _MathOps))
         return self.expr(t, self.params())
 
     def breaks(self) -> np.ndarray:
@@ -885,6 +897,8 @@ class Traced(Signal):
             return value if isinstance(value, ca.SX) else ca.SX(value)
         if ops is _CasadiOps:
             return self._f(t)
+        if ops is _MathOps:
+            return float(self._f(t))
         flat = t.reshape(1, -1)
         return np.asarray(self._f(flat), dtype=float).reshape(t.shape) if flat.size else np.zeros(t.shape)
 
