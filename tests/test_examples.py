@@ -164,7 +164,7 @@ def test_beyond_map_error_table_matches_mpmath(outdir):
         # printed (3.13), sigma/Fc = 10 1/m, Fc = 1 N
         yp = mp_potential(am) / (1 - mp.mpf(1) / 10 * (1 + am) ** mp.mpf("-0.6"))
         assert rows[a][5] == pytest.approx(float(yp / ye - 1), abs=1e-10)
-    # DESIGN.md: 0.15 % at a = 1, 5 % at 0.6, 12 % at 0.2, -> 17 % (factor 5/6)
+    # docs/mathematics.md#erratum-3-13: 0.15 % at a = 1, 5 % at 0.6, 12 % at 0.2, -> 17 % (factor 5/6)
     assert rows[1.0][3] == pytest.approx(0.0015, abs=0.0001)
     assert rows[0.6][3] == pytest.approx(-0.05, abs=0.001)
     assert rows[0.2][3] == pytest.approx(-0.12, abs=0.002)

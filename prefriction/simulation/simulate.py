@@ -172,7 +172,7 @@ def simulate(
         CasADi integrator plugin; one of :data:`METHODS`. Only ``"erk"`` is exposed: it passes
         every case of ``prefriction bench``. (``"rosenbrock"`` works with the same events but is
         5-10 times slower on these non-stiff problems; ``cvodes``/``idas`` events and
-        ``collocation`` fail, DESIGN.md section 3.)
+        ``collocation`` fail: docs/simulator.md, why only erk.)
     dense : bool or array_like, default False
         ``False``: reversal table only (no dense output is computed). ``True``: samples every
         ``2 pi / 64`` normalised time units (64 per small oscillation). An array: samples at
