@@ -21,7 +21,7 @@ def test_reversal_table_matches_exact(case: Case, tol: float) -> None:
     ref = exact_reversals(case.system, case.v0, 50, x0=0.0, F0=case.F0)
     res = pf.simulate(case.system, case.v0, F0=case.F0, reversals=50, rtol=tol)
     tab = res.reversals
-    assert res.status == "reversals" and len(tab) == 50
+    assert res.status == 1 and res.success and len(tab) == 50
     err = reversal_error(case, tab.t, tab.x, tab.F, ref)
     assert err <= 10 * tol, f"{case.name}: max relative error {err:.3e} > 10 * {tol:g}"
     # energies of the table follow from the same forces: (3.9)-type potential and (2.10)
@@ -81,10 +81,10 @@ def test_t_end_stops_between_reversals() -> None:
     ref = exact_reversals(sys_, 1.0, 30)
     t_end = 0.5 * (ref.t[9] + ref.t[10])
     res = pf.simulate(sys_, 1.0, t_end=t_end)
-    assert res.status == "t_end"
+    assert res.status == 0 and res.success and "t_end" in res.message
     assert len(res.reversals) == 10
     res2 = pf.simulate(sys_, 1.0, t_end=t_end, reversals=5)
-    assert res2.status == "reversals" and len(res2.reversals) == 5
+    assert res2.status == 1 and len(res2.reversals) == 5
 
 
 def test_dense_samples_and_integrated_power() -> None:
@@ -126,3 +126,16 @@ def test_sparse_dense_samples_with_many_reversals_between() -> None:
     assert len(res.reversals) == 56
     assert reversal_error(case, res.reversals.t, res.reversals.x, res.reversals.F, ref) <= 1e-7
     np.testing.assert_allclose(res.E_k + res.E_f, 0.5 * case.mass * case.v0**2, rtol=1e-10, atol=0)
+
+
+def test_result_reads_like_scipys_and_prints_compactly():
+    sys_ = pf.Oscillator(pf.Dahl(1e4, 1.0))
+    res = pf.simulate(sys_, 1.0, t_end=0.01, dense=True)
+    assert res.success and res.status == 0 and res.message == "reached t_end = 0.01 s"
+    assert res.t[-1] == 0.01  # dense samples reach t_end
+    ref = pf.exact_reversals(sys_, 0.005, 3)
+    res = pf.simulate(sys_, 0.005, reversals=3)
+    assert res.status == 1 and f"reached 3 reversals at t = {ref.t[-1]:.6g}"[:30] in res.message
+    text = repr(res)
+    assert text.startswith("SimulationResult(3 reversals, status 1") and len(text) < 200
+    assert "reversals: 3" in res.summary() and "[" not in res.summary()  # no arrays printed

@@ -199,5 +199,5 @@ def test_no_force_on_a_mass_at_rest_keeps_it_at_rest() -> None:
     u = 0 as samples (t, 0): the same all-zero force, on the structure of the other sampled inputs."""
     res = pf.simulate(pf.Oscillator(pf.Dahl(1e6, 1.0), u=(np.array([0.0, 1e-3]), np.zeros(2))), 0.0, t_end=1e-3,
                       dense=True)
-    assert res.status == "t_end" and len(res.reversals) == 0 and res.reversals.E_0 == 0.0
+    assert res.status == 0 and len(res.reversals) == 0 and res.reversals.E_0 == 0.0
     assert np.all(res.x == 0.0) and np.all(res.v == 0.0) and np.all(res.F == 0.0)

@@ -46,6 +46,7 @@ from prefriction.simulation.force_scale import applied_force_scale
 from prefriction._validation import check_count, check_finite, check_positive
 from prefriction.models import Oscillator, check_oscillator
 from prefriction.reversals import ReversalTable
+from prefriction.simulation.result import RunStats, SimulationResult
 from prefriction.units import Scales
 
 __all__ = ["METHODS", "RunStats", "SimulationResult", "simulate"]
@@ -58,72 +59,6 @@ _MIN_ORDER = 2  # continuous controllers are padded to this order (one plant for
 _ZERO = Constant(0.0)  # the input of a sampled loop without an input force (the hold is added)
 _CAL = 0.1  # calibration of the run-time tolerance eps: global error over 50 reversals ~ 0.7 rtol
 _DENSE_STEP = 2.0 * math.pi / 64.0  # normalised spacing of dense=True samples (64 per small cycle)
-
-
-@dataclass(frozen=True)
-class RunStats:
-    """Run statistics of one :func:`simulate` call.
-
-    Attributes
-    ----------
-    wall_time : float
-        Wall time of the integration loop [s], without building or compiling the integrator.
-    setup_time : float
-        Wall time spent building, compiling or loading the integrator [s] (0 when reused).
-    calls : int
-        Number of integrator calls.
-    steps : int or None
-        Number of accepted integrator steps (None for compiled code, which keeps no statistics).
-    jit : str
-        ``"compiled"``, ``"cached"`` (compiled code loaded from disk or memory) or ``"interpreted"``.
-    """
-
-    wall_time: float
-    setup_time: float
-    calls: int
-    steps: Optional[int]
-    jit: str
-
-
-@dataclass(frozen=True, eq=False)
-class SimulationResult:
-    """Result of :func:`simulate`, in SI units.
-
-    Attributes
-    ----------
-    reversals : ReversalTable
-        States at the velocity reversals, in the form of :func:`prefriction.exact_reversals`.
-        For a forced system ``E_d[k] = E_p[k-1] + W_u[k] - E_p[k]``.
-    status : str
-        ``"reversals"`` (stopped at the requested number of reversals) or ``"t_end"``.
-    stats : RunStats
-        Wall time, integrator calls and steps.
-    work_input : numpy.ndarray
-        Work of the external and feedback forces [J] over each half-cycle ending at a reversal
-        (zeros for the unforced system).
-    t, x, v, F : numpy.ndarray or None
-        Samples [s, m, m/s, N] at the requested times (``dense``); None if not requested.
-    E_k, E_f : numpy.ndarray or None
-        Kinetic energy ``m v^2 / 2`` [J] and the work of the friction force
-        ``E_f = int_0^t F v dt`` [J] by integrated power (2.8), at the sample times.
-    u : numpy.ndarray or None
-        Total applied force (input plus feedback) [N] at the sample times.
-    xc : numpy.ndarray or None
-        Controller states at the sample times, shape ``(len(t), n)`` (feedback only).
-    """
-
-    reversals: ReversalTable
-    status: str
-    stats: RunStats
-    work_input: np.ndarray
-    t: Optional[np.ndarray] = None
-    x: Optional[np.ndarray] = None
-    v: Optional[np.ndarray] = None
-    F: Optional[np.ndarray] = None
-    E_k: Optional[np.ndarray] = None
-    E_f: Optional[np.ndarray] = None
-    u: Optional[np.ndarray] = None
-    xc: Optional[np.ndarray] = None
 
 
 def simulate(
@@ -275,13 +210,16 @@ def simulate(
     else:
         samples = []
         run.advance(t_end_n, n_target)
-    status = "reversals" if len(run.rev) >= n_target else "t_end"
+    if len(run.rev) >= n_target:
+        status, message = 1, f"reached {int(n_target)} reversals at t = {run.rev[int(n_target) - 1][0] * sc.t:.9g} s"
+    else:
+        status, message = 0, f"reached t_end = {t_end_si:.9g} s"
     wall = time.perf_counter() - start
 
     table, W_r = _reversal_table(run.rev[: int(min(len(run.rev), n_target))], system, s0, v0, F0)
     stats = RunStats(wall_time=wall, setup_time=run.setup_time, calls=run.calls, steps=run.steps, jit=run.mode)
     extra = _samples_si(run, samples, u_hist, times_si, n_user) if samples else {}
-    return SimulationResult(reversals=table, status=status, stats=stats, work_input=W_r, **extra)
+    return SimulationResult(reversals=table, status=status, message=message, stats=stats, work_input=W_r, **extra)
 
 
 def _dense_times(dense: Any, t_end: float) -> np.ndarray:
@@ -365,6 +303,8 @@ def _dense_loop(run: Run, times: Optional[np.ndarray], t_end: float, n_target: f
     while not stopped and t0 <= t_end:
         block = t0 + _DENSE_STEP * np.arange(0, 256)
         block = block[block <= t_end]
+        if block.size and block[-1] < t_end < block[-1] + _DENSE_STEP:
+            block = np.append(block, t_end)  # the last sample is at t_end
         if block.size == 0:
             break
         got, stopped = run.dense(block, t_end, n_target)

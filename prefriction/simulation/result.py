@@ -1,0 +1,108 @@
+"""Results of :func:`prefriction.simulate`: run statistics and the simulation result."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Optional
+
+import numpy as np
+
+from prefriction.reversals import ReversalTable
+
+__all__ = ["RunStats", "SimulationResult"]
+
+
+@dataclass(frozen=True)
+class RunStats:
+    """Run statistics of one :func:`simulate` call.
+
+    Attributes
+    ----------
+    wall_time : float
+        Wall time of the integration loop [s], without building or compiling the integrator.
+    setup_time : float
+        Wall time spent building, compiling or loading the integrator [s] (0 when reused).
+    calls : int
+        Number of integrator calls.
+    steps : int or None
+        Number of accepted integrator steps (None for compiled code, which keeps no statistics).
+    jit : str
+        ``"compiled"``, ``"cached"`` (compiled code loaded from disk or memory) or ``"interpreted"``.
+    """
+
+    wall_time: float
+    setup_time: float
+    calls: int
+    steps: Optional[int]
+    jit: str
+
+
+@dataclass(frozen=True, eq=False)
+class SimulationResult:
+    """Result of :func:`simulate`, in SI units.
+
+    Attributes
+    ----------
+    reversals : ReversalTable
+        States at the velocity reversals, in the form of :func:`prefriction.exact_reversals`.
+        For a forced system ``E_d[k] = E_p[k-1] + W_u[k] - E_p[k]``.
+    status : int
+        As scipy's ``OdeResult``: ``0`` the run reached ``t_end``, ``1`` a termination event:
+        the requested number of reversals. (A failure raises :class:`prefriction.SolverError`.)
+    message : str
+        What ended the run, in words.
+    stats : RunStats
+        Wall time, integrator calls and steps.
+    work_input : numpy.ndarray
+        Work of the external and feedback forces [J] over each half-cycle ending at a reversal
+        (zeros for the unforced system).
+    t, x, v, F : numpy.ndarray or None
+        Samples [s, m, m/s, N] at the requested times (``dense``); None if not requested.
+    E_k, E_f : numpy.ndarray or None
+        Kinetic energy ``m v^2 / 2`` [J] and the work of the friction force
+        ``E_f = int_0^t F v dt`` [J] by integrated power (2.8), at the sample times.
+    u : numpy.ndarray or None
+        Total applied force (input plus feedback) [N] at the sample times.
+    xc : numpy.ndarray or None
+        Controller states at the sample times, shape ``(len(t), n)`` (feedback only).
+    """
+
+    reversals: ReversalTable
+    status: int
+    message: str
+    stats: RunStats
+    work_input: np.ndarray
+    t: Optional[np.ndarray] = None
+    x: Optional[np.ndarray] = None
+    v: Optional[np.ndarray] = None
+    F: Optional[np.ndarray] = None
+    E_k: Optional[np.ndarray] = None
+    E_f: Optional[np.ndarray] = None
+    u: Optional[np.ndarray] = None
+    xc: Optional[np.ndarray] = None
+
+
+    @property
+    def success(self) -> bool:
+        """True: a result is only returned for a run that reached its end (as ``OdeResult.success``)."""
+        return self.status >= 0
+
+    def summary(self) -> str:
+        """A few lines: what ended the run, the reversals, the samples and the run statistics."""
+        tab = self.reversals
+        lines = [f"simulation: {self.message} (status {self.status})",
+                 f"reversals: {len(tab)}" + (f", last at t = {tab.t[-1]:.9g} s, x = {tab.x[-1]:.6g} m, "
+                                              f"F = {tab.F[-1]:.6g} N" if len(tab) else "")]
+        if self.t is not None:
+            lines.append(f"samples: {len(self.t)} in [{self.t[0]:.6g}, {self.t[-1]:.6g}] s")
+        st = self.stats
+        lines.append(f"run: {st.wall_time * 1e3:.3g} ms in {st.calls} integrator calls ({st.jit}), "
+                     f"setup {st.setup_time:.3g} s")
+        return "\n".join(lines)
+
+    def __repr__(self) -> str:
+        samples = "" if self.t is None else f", {len(self.t)} samples"
+        return (f"SimulationResult({len(self.reversals)} reversals{samples}, status {self.status}: "
+                f"{self.message}, {self.stats.wall_time * 1e3:.3g} ms, jit {self.stats.jit})")
+
+    __str__ = summary
