@@ -108,7 +108,7 @@ class _Viscous(FrictionModel):
 @pytest.mark.parametrize(
     ("call", "message"),
     [
-        (lambda s: pf.exact_reversals(s, 0.1, 3), "exact_reversals is Dahl-only"),
+        (lambda s: pf.exact_reversals(s, 0.1, 3), "exact_reversals has an exact reference for Dahl and MaxwellSlip only"),
         (lambda s: pf.energy.total_energy([0.0, 1.0], [0.1, 0.1], [0.0, 0.0], system=s),
          "the energy analysis needs a rate-independent friction model"),
     ],

@@ -112,7 +112,7 @@ def test_one_structure_for_every_gamma_and_tolerance():
 
 def test_dahl_only_functions_say_so():
     system = pf.Oscillator(ElasticPlastic(1.0, 1.0))
-    with pytest.raises(TypeError, match="exact_reversals is Dahl-only"):
+    with pytest.raises(TypeError, match="exact_reversals has an exact reference for Dahl and MaxwellSlip only"):
         pf.exact_reversals(system, 0.1, 3)
 
 

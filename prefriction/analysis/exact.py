@@ -37,7 +37,7 @@ from prefriction.analysis.branch import (
     potential_of_log_gap,
 )
 from prefriction._validation import check_count, check_finite
-from prefriction.models import Oscillator, check_dahl_oscillator
+from prefriction.models import Dahl, Oscillator, check_dahl_oscillator
 from prefriction.reversals import ReversalTable
 from prefriction.units import Scales
 
@@ -62,7 +62,9 @@ def exact_reversals(system: Oscillator, v0: float, n: int, *, x0: float = 0.0, F
     Parameters
     ----------
     system : Oscillator
-        Unforced oscillator (``system.u is None``) with :class:`prefriction.Dahl` friction.
+        Unforced oscillator (``system.u is None``) with :class:`prefriction.Dahl` friction, or
+        with :class:`prefriction.MaxwellSlip` friction (closed-form event sequence,
+        :func:`prefriction.analysis.maxwell_slip_exact.maxwell_slip_reversals`).
     v0 : float
         Initial velocity [m/s].
     n : int
@@ -97,6 +99,17 @@ def exact_reversals(system: Oscillator, v0: float, n: int, *, x0: float = 0.0, F
     >>> [round(float(F), 7) for F in table.F]  # the map 1 -> 0.5936243 -> ...
     [0.5936243, -0.4239535, 0.3300787]
     """
+    from prefriction.models.maxwell_slip import MaxwellSlip
+
+    if isinstance(system, Oscillator) and isinstance(system.friction, MaxwellSlip):
+        from prefriction.analysis.maxwell_slip_exact import maxwell_slip_reversals
+
+        return maxwell_slip_reversals(system, v0, n, x0=x0, F0=F0)
+    if isinstance(system, Oscillator) and not isinstance(system.friction, Dahl):
+        raise TypeError(
+            f"exact_reversals has an exact reference for Dahl and MaxwellSlip only, got "
+            f"{system.friction!r} of type {type(system.friction).__name__}; use prefriction.simulate"
+        )
     check_dahl_oscillator(system, "exact_reversals")
     if system.u is not None:
         raise ValueError(

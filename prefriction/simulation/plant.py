@@ -404,7 +404,7 @@ def _options(spec: PlantSpec, trans: ca.Function) -> dict:
     first step of a single-output call."""
     opts = {
         "transition": trans,
-        "max_events": spec.n_out * (4 * spec.K + 16),
+        "max_events": spec.n_out * (4 * spec.K + 16 + (spec.K + 1) * spec.model.n_events),
         # events to round-off (defaults 1e-6 and 3 are far too loose: tau spans a whole call)
         "event_tol": 1e-15,
         "max_event_iter": 40,
