@@ -83,7 +83,7 @@ def _contract(model: FrictionModel, rng: np.random.Generator) -> None:
     zl, ml = [z[i] for i in range(nz)], [m[i] for i in range(nm)]
 
     def outputs(mod: FrictionModel, zz: list, mm: list, vv: Any, ss: Any, qq: Any) -> list:
-        ev = list(mod.events(zz, mm, ss, qq))
+        ev = list(mod.events(zz, mm, vv, ss, qq))
         assert len(ev) == mod.n_events, "events() must return n_events indicators"
         out = [mod.force(zz, mm, vv, ss, qq)] + list(mod.rate(zz, mm, vv, ss, qq)) + ev
         zr, mr = mod.reverse(zz, mm, -ss, qq, 1e-9)
@@ -141,7 +141,7 @@ def reference_reversals(model: FrictionModel, v0: float, n: int, *, rtol: float 
         evs = [rev, zero_force]
         for k in range(model.n_events):
             def ev(_t: float, y: np.ndarray, k: int = k, s: float = s, mm: list = mm) -> float:
-                return model.events(y[2:2 + nz].tolist(), mm, s, q)[k]
+                return model.events(y[2:2 + nz].tolist(), mm, y[1], s, q)[k]
             ev.terminal, ev.direction = True, -1.0
             evs.append(ev)
         sol = solve_ivp(rhs, (t, t + 1e4), y, method="DOP853", rtol=rtol, atol=1e-14, events=evs, dense_output=False)

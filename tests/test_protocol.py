@@ -54,7 +54,7 @@ class ElasticPlastic(FrictionModel):
     def force(self, z, m, v, s, q):
         return z[0]
 
-    def events(self, z, m, s, q):
+    def events(self, z, m, v, s, q):
         ind = 1.0 - s * z[0]
         if isinstance(ind, ca.SX):
             return [ca.if_else(m[0] > 0.5, 1.0, ind)]

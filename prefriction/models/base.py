@@ -160,7 +160,7 @@ class FrictionModel(ABC):
     def force(self, z: Sequence[Any], m: Sequence[Any], v: Any, s: Any, q: Any) -> Any:
         """Normalised friction force ``F~``."""
 
-    def events(self, z: Sequence[Any], m: Sequence[Any], s: Any, q: Any) -> list[Any]:
+    def events(self, z: Sequence[Any], m: Sequence[Any], v: Any, s: Any, q: Any) -> list[Any]:
         """In-branch event indicators: positive before the event, the event where one turns negative.
 
         An indicator that must not fire (e.g. its element already slips) returns a positive

@@ -169,7 +169,7 @@ class Dahl(FrictionModel):
             return s * force_of_p(z0, q[0])
         return -s * (math.expm1(-z0) if type(z0) is float else ca.expm1(-z0))
 
-    def events(self, z: Sequence[Any], m: Sequence[Any], s: Any, q: Any) -> list[Any]:
+    def events(self, z: Sequence[Any], m: Sequence[Any], v: Any, s: Any, q: Any) -> list[Any]:
         if not self.saturates:
             return []
         ind = 1.0 - (1.0 - q[0]) * z[0]

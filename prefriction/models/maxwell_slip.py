@@ -371,7 +371,7 @@ class MaxwellSlip(FrictionModel):
         n = self.n_elements
         return 1.0 - s * (z[j] + q[j] * z[n]) / q[n + j]
 
-    def events(self, z: Sequence[Any], m: Sequence[Any], s: Any, q: Any) -> list[Any]:
+    def events(self, z: Sequence[Any], m: Sequence[Any], v: Any, s: Any, q: Any) -> list[Any]:
         sym = _symbolic(z, m, s, q)
         out = []
         for i in range(self.n_elements):

@@ -286,7 +286,7 @@ def build_integrator(spec: PlantSpec) -> ca.Function:
     # indicators in units of the amplitude (vh is scaled by 1/eps); forced: offset so that a
     # branch starting at v = 0 has a positive indicator (EPS_START)
     zero = [ca.if_else(run_m > 0.5, s * st["vh"] * p["eps"] + (EPS_START if spec.forced else 0.0), 1.0)]
-    zero += [ca.if_else(run_m > 0.5, ind, 1.0) for ind in model.events(z, m, s, q)]
+    zero += [ca.if_else(run_m > 0.5, ind, 1.0) for ind in model.events(z, m, v, s, q)]
     amp = p["Av"] / p["eps"]  # the amplitude of the motion
     if spec.forced:
         zero.append(ca.if_else(run * rest > 0.5, EPS_REST * amp - ca.fabs(acc), 1.0))
@@ -377,7 +377,7 @@ def _build_compact(spec: PlantSpec) -> ca.Function:
     for i, dz in enumerate(model.rate(z, m, v, s, q)):
         ode[L.state[f"z{i}"]] = run * dz / p["AF"]
     zero = [ca.if_else(moving, s * st["vh"] * p["eps"], 1.0)]
-    zero += [ca.if_else(moving, ind, 1.0) for ind in model.events(z, m, s, q)]
+    zero += [ca.if_else(moving, ind, 1.0) for ind in model.events(z, m, v, s, q)]
     dae = {"x": X, "p": P, "u": U, "t": tau, "ode": ode, "zero": ca.vertcat(*zero)}
     idx = ca.SX.sym("index")
     post = ca.SX(X)
