@@ -58,3 +58,17 @@ def test_bench_help_and_bad_option(capsys) -> None:
     except SystemExit as exc:
         assert exc.code == 0
     assert "--stability" in capsys.readouterr().out
+
+
+def test_models_bench_quick(tmp_path, capsys) -> None:
+    """``prefriction bench --models --quick``: Maxwell-slip against its closed form and scipy."""
+    code = cli_main(["bench", "--models", "--quick", "--out", str(tmp_path)])
+    out = capsys.readouterr().out
+    assert code in (0, 1)
+    assert "MaxwellSlip N=3" in out and "scipy DOP853 +events" in out
+    targets = [line for line in out.splitlines() if line.startswith("target models/")]
+    assert len(targets) == 2 and "accuracy" in targets[0] and "PASS" in targets[0]
+    with (tmp_path / "models.csv").open() as fh:
+        rows = list(csv.DictReader(fh))
+    sim = [r for r in rows if r["solver"] == "simulate[erk]"]
+    assert len(sim) == 2 and all(float(r["max_rel_error"]) <= 10 * float(r["tol"]) for r in sim)

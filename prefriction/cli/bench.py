@@ -455,6 +455,28 @@ def targets(rows: list[Row], stab: list[StabilityRow], t50: float, tlong: float,
     return lines
 
 
+def _models_main(out: Path, quick: bool) -> int:
+    """``--models``: the table, ``models.csv`` and the target lines; 0 if every target passes."""
+    from prefriction.cli import bench_models as bm
+
+    start = time.perf_counter()
+    cases = bm.model_cases()
+    rows = bm.run(cases[:1] if quick else cases, ladder=bm.LADDER[:2] if quick else bm.LADDER,
+                  peers=bm.PEERS[:1] if quick else bm.PEERS, budget=0.05 if quick else 0.3)
+    print("Friction models: error over the first reversals against the reference, warm run time\n")
+    print(bm.table(rows))
+    lines = bm.targets(rows)
+    print()
+    print("\n".join(lines))
+    out.mkdir(parents=True, exist_ok=True)
+    with (out / "models.csv").open("w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["case", "solver", "tol", "max_rel_error", "warm_run_s"])
+        w.writerows([r.case, r.solver, r.tol, r.error, r.seconds] for r in rows)
+    print(f"\nwrote {out / 'models.csv'} ({time.perf_counter() - start:.0f} s)")
+    return 0 if all("PASS" in line for line in lines) else 1
+
+
 def main(argv: Optional[list[str]] = None) -> int:
     """Command line entry point of ``prefriction bench``; returns 0 if every target passes."""
     ap = argparse.ArgumentParser(prog="prefriction bench", description=__doc__.split("\n\n")[0])
@@ -467,11 +489,16 @@ def main(argv: Optional[list[str]] = None) -> int:
     ap.add_argument("--sweep", action="store_true",
                     help="parameter sweeps instead: compiles and end-to-end time of cold and warm sweeps "
                          "against scipy DOP853 (prefriction.cli.bench_sweep; uses --out, --quick)")
+    ap.add_argument("--models", action="store_true",
+                    help="the other friction models instead (Maxwell-slip, LuGre, GMS): error against run "
+                         "time against scipy with event restarts (prefriction.cli.bench_models; uses --out, --quick)")
     args = ap.parse_args(argv)
     if args.sweep:
         from prefriction.cli.bench_sweep import main as sweep_main
 
         return sweep_main(["--out", args.out] + (["--quick"] if args.quick else []))
+    if args.models:
+        return _models_main(Path(args.out), args.quick)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     ladder = QUICK_LADDER if args.quick else LADDER

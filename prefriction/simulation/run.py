@@ -321,10 +321,12 @@ class Run:
             else:  # vh eps = -s (1 + tau) at a reversal: record it, start the branch of direction -s
                 t = t + (t1 - t) * (-sv - 1.0)  # t0 + dur tau, as the integrator's time
                 v = 0.0
-                rev.append((t, x, float(force(z, m, 0.0, s, q)), 0.0))
                 n += 1
                 s = -s
                 z, m = reverse(z, m, s, q, snap)
+                # the force after the model's reset: an event within snap of the reversal is taken
+                # as coinciding with it (the reset puts its state on the switching surface)
+                rev.append((t, x, float(force(z, m, 0.0, s, q)), 0.0))
                 grow = 1.0
         self.calls += calls
         st.update(x=x, v=v, z=z, m=m, s=s, t=t, F=float(force(z, m, v, s, q)))

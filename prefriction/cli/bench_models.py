@@ -1,0 +1,183 @@
+"""``prefriction bench --models``: error against run time for every friction model beside Dahl.
+
+For each model case (an unforced oscillator, normalised initial speed ``v0~``, ``n`` reversals)
+it measures, in one run, the maximum relative error of the reversal times, positions and forces
+against the model's reference and the warm run time, for :func:`prefriction.simulate` over the
+tolerances 1e-4..1e-10 and for scipy ``solve_ivp`` (DOP853, LSODA, Radau) restarted at every
+reversal and every model event (:func:`prefriction.testing.reference_reversals`, the same
+equations evaluated in Python). The reference is the closed form where there is one
+(:class:`prefriction.MaxwellSlip`: the event-by-event solution) and otherwise scipy Radau at
+rtol 1e-12 with restarts.
+
+Targets, printed as PASS/FAIL: every model within 10x rtol over the ladder; at the loosest
+tolerance where ``simulate`` reaches error <= 1e-7, at least 10x faster than the fastest scipy
+method that reaches the same error in the same run.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+from dataclasses import dataclass
+from typing import Callable, Optional
+
+import numpy as np
+
+from prefriction.models import FrictionModel, MaxwellSlip, Oscillator
+from prefriction.simulation.simulate import simulate
+from prefriction.testing import reference_reversals
+from prefriction.units import Scales
+
+__all__ = ["LADDER", "ModelCase", "ModelRow", "model_cases", "run"]
+
+LADDER = (1e-4, 1e-6, 1e-8, 1e-10)
+PEERS = ("DOP853", "LSODA", "Radau")
+TARGET_ERROR = 1e-7
+
+
+@dataclass(frozen=True)
+class ModelCase:
+    """One model case: the model, its normalised initial speed and the number of reversals."""
+
+    name: str
+    model: FrictionModel
+    v0: float
+    n: int
+    exact: Optional[Callable[[Oscillator, float, int], np.ndarray]] = None
+    """Closed-form reversal rows ``(t~, x~, F~)``; None: scipy Radau at rtol 1e-12."""
+
+
+@dataclass(frozen=True)
+class ModelRow:
+    """One measured point: case, solver, tolerance, max relative error, warm run time [s]."""
+
+    case: str
+    solver: str
+    tol: float
+    error: float
+    seconds: float
+
+
+def _maxwell_exact(system: Oscillator, v0: float, n: int) -> np.ndarray:
+    from prefriction.analysis.maxwell_slip_exact import maxwell_slip_reversals
+
+    sc = Scales.of(system)
+    tab = maxwell_slip_reversals(system, v0 * sc.v, n)
+    return np.column_stack([tab.t / sc.t, tab.x / sc.x, tab.F / sc.F])
+
+
+def model_cases() -> list[ModelCase]:
+    """The benchmarked cases: Maxwell-slip (3 elements, and a stiff-element variant), and
+    LuGre and generalised Maxwell-slip where those models exist."""
+    cases = [
+        ModelCase("MaxwellSlip N=3", MaxwellSlip([3e4, 3e4, 4e4], [0.15, 0.35, 0.5]), 1.5, 20, _maxwell_exact),
+        ModelCase("MaxwellSlip N=8, k 1e2..1e9", MaxwellSlip(np.geomspace(1e2, 1e9, 8), np.full(8, 0.125)),
+                  1.2, 20, _maxwell_exact),
+    ]
+    import prefriction
+
+    if hasattr(prefriction, "LuGre"):
+        lugre = prefriction.LuGre(1e5, math.sqrt(1e5), 0.4, 1.0, 1.5, 1e-3)
+        cases.append(ModelCase("LuGre (1995 Table I)", lugre, 1.0, 6))
+    if hasattr(prefriction, "GMS"):
+        cases.append(ModelCase("GMS N=3", prefriction.GMS.example(), 1.0, 8))
+    return cases
+
+
+def _error(rows: np.ndarray, ref: np.ndarray) -> float:
+    """Max relative error of reversal times, positions (relative to max(|x|, 1)) and forces."""
+    if len(rows) < len(ref):
+        return math.inf
+    rows = rows[: len(ref)]
+    et = np.abs(rows[:, 0] - ref[:, 0]) / np.abs(ref[:, 0])
+    ex = np.abs(rows[:, 1] - ref[:, 1]) / np.maximum(np.abs(ref[:, 1]), 1.0)
+    eF = np.abs(rows[:, 2] - ref[:, 2]) / np.maximum(np.abs(ref[:, 2]), 1e-300)
+    return float(max(et.max(), ex.max(), eF.max()))
+
+
+def _timed(fn: Callable[[], np.ndarray], budget: float) -> tuple[np.ndarray, float]:
+    """Result and minimum wall time over repeated calls within ``budget`` seconds (>= 1 call)."""
+    best, spent, out = math.inf, 0.0, None
+    while out is None or (spent < budget and best < 0.05):
+        t0 = time.perf_counter()
+        out = fn()
+        dt = time.perf_counter() - t0
+        best, spent = min(best, dt), spent + dt
+    return out, best
+
+
+def run(cases: list[ModelCase], ladder: tuple[float, ...] = LADDER, peers: tuple[str, ...] = PEERS,
+        budget: float = 0.3) -> list[ModelRow]:
+    """Measure every case: simulate and the scipy peers over ``ladder``; progress on stderr."""
+    rows: list[ModelRow] = []
+    for k, case in enumerate(cases, 1):
+        print(f"  ... models [{k}/{len(cases)}]: {case.name}", file=sys.stderr, flush=True)
+        system = Oscillator(case.model, mass=1.0)
+        sc = Scales.of(system)
+        if case.exact is not None:
+            ref = case.exact(system, case.v0, case.n)
+        else:
+            ref = reference_reversals(case.model, case.v0, case.n, rtol=1e-12, method="Radau")[0]
+        simulate(system, case.v0 * sc.v, reversals=case.n, rtol=1e-6)  # compile outside the timing
+
+        for tol in ladder:
+            def sim(tol: float = tol) -> np.ndarray:
+                tab = simulate(system, case.v0 * sc.v, reversals=case.n, rtol=tol).reversals
+                return np.column_stack([tab.t / sc.t, tab.x / sc.x, tab.F / sc.F])
+
+            got, sec = _timed(sim, budget)
+            rows.append(ModelRow(case.name, "simulate[erk]", tol, _error(got, ref), sec))
+        for method in peers:
+            for tol in ladder:
+                def peer(tol: float = tol, method: str = method) -> np.ndarray:
+                    return reference_reversals(case.model, case.v0, case.n, rtol=tol, method=method)[0]
+
+                try:
+                    got, sec = _timed(peer, 0.0)
+                    err = _error(got, ref)
+                except (RuntimeError, ValueError) as exc:  # a peer that fails is reported, not fatal
+                    print(f"  ... {method} at {tol:g} failed: {exc}", file=sys.stderr)
+                    got, sec, err = None, math.nan, math.inf
+                rows.append(ModelRow(case.name, f"scipy {method} +events", tol, err, sec))
+                if sec > 5.0:  # tighter tolerances would only take longer
+                    break
+    return rows
+
+
+def table(rows: list[ModelRow]) -> str:
+    """The rows as a text table."""
+    head = f"{'case':<30} {'solver':<20} {'tol':>7} {'max rel error':>14} {'err/tol':>9} {'warm run [s]':>13}"
+    out = [head, "-" * len(head)]
+    for r in rows:
+        out.append(f"{r.case:<30} {r.solver:<20} {r.tol:7.0e} {r.error:14.3e} {r.error / r.tol:9.2f} {r.seconds:13.5f}")
+    return "\n".join(out)
+
+
+def targets(rows: list[ModelRow]) -> list[str]:
+    """PASS/FAIL lines: error within 10x rtol for every model; >= 10x faster than scipy at matched error."""
+    lines = []
+    for case in dict.fromkeys(r.case for r in rows):
+        mine = [r for r in rows if r.case == case and r.solver.startswith("simulate")]
+        worst = max(r.error / r.tol for r in mine)
+        lines.append(f"target models/accuracy ({case}: error within 10x rtol, rtol "
+                     f"{mine[0].tol:g}..{mine[-1].tol:g}): {'PASS' if worst <= 10 else 'FAIL'}  "
+                     f"(worst err/tol {worst:.2f})")
+        ok = [r for r in mine if r.error <= TARGET_ERROR]
+        if not ok:
+            lines.append(f"target models/speed ({case}): FAIL  (simulate never reached {TARGET_ERROR:g})")
+            continue
+        best = min(ok, key=lambda r: r.seconds)
+        peers = [r for r in rows if r.case == case and not r.solver.startswith("simulate")
+                 and r.error <= max(best.error, TARGET_ERROR)]
+        if not peers:
+            lines.append(f"target models/speed ({case}: >= 10x the fastest scipy at error <= "
+                         f"{max(best.error, TARGET_ERROR):.1e}): PASS  (no scipy method reached it)")
+            continue
+        peer = min(peers, key=lambda r: r.seconds)
+        ratio = peer.seconds / best.seconds
+        lines.append(f"target models/speed ({case}: >= 10x the fastest scipy at the same error): "
+                     f"{'PASS' if ratio >= 10 else 'FAIL'}  ratio {ratio:.1f}x (simulate {best.seconds * 1e3:.2f} ms "
+                     f"at tol {best.tol:g}, err {best.error:.1e}; {peer.solver} {peer.seconds * 1e3:.1f} ms at "
+                     f"tol {peer.tol:g}, err {peer.error:.1e})")
+    return lines
