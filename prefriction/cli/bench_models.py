@@ -81,7 +81,8 @@ def model_cases() -> list[ModelCase]:
         lugre = prefriction.LuGre(1e5, math.sqrt(1e5), 0.4, 1.0, 1.5, 1e-3)
         cases.append(ModelCase("LuGre (1995 Table I)", lugre, 1.0, 6))
     if hasattr(prefriction, "GMS"):
-        cases.append(ModelCase("GMS N=3", prefriction.GMS.example(), 1.0, 8))
+        gms = prefriction.GMS([3e4, 2e4, 5e4], [0.2, 0.3, 0.5], Fc=1.0, Fs=1.5, vs=1e-2, C=2e3)
+        cases.append(ModelCase("GMS N=3", gms, 1.5, 12))
     return cases
 
 

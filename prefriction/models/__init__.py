@@ -3,13 +3,15 @@
 - :class:`FrictionModel` (``base.py``): the contract every model implements (``docs/models.md``);
 - :class:`Dahl` (``dahl.py``): the Dahl model (3.2) of the paper;
 - :class:`MaxwellSlip` (``maxwell_slip.py``): N elasto-plastic elements (Iwan; Lampaert et al.);
+- :class:`GMS` (``gms.py``): the generalised Maxwell-slip model (Al-Bender et al. 2005);
 - :class:`Oscillator` (``oscillator.py``): mass, friction model and input force.
 """
 
 from prefriction.models.base import FrictionModel, Parameter
 from prefriction.models.dahl import Dahl
+from prefriction.models.gms import GMS
 from prefriction.models.maxwell_slip import MaxwellSlip
 from prefriction.models.oscillator import Oscillator, check_dahl_oscillator, check_oscillator
 
-__all__ = ["Dahl", "FrictionModel", "MaxwellSlip", "Oscillator", "Parameter", "check_dahl_oscillator",
+__all__ = ["Dahl", "FrictionModel", "GMS", "MaxwellSlip", "Oscillator", "Parameter", "check_dahl_oscillator",
            "check_oscillator"]

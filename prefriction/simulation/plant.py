@@ -296,8 +296,6 @@ def build_integrator(spec: PlantSpec) -> ca.Function:
     idx = ca.SX.sym("index")
     reg = X[L.reg:]
     W = p["AE"] * st["Wh"] if spec.forced else None
-    entry = [t_n, x, F] + ([W] if spec.forced else [])
-    shifted = ca.vertcat(*entry, reg[: -L.reg_width])
 
     def with_(changes: dict, base: ca.SX = X) -> ca.SX:
         out = ca.SX(base)
@@ -314,8 +312,12 @@ def build_integrator(spec: PlantSpec) -> ca.Function:
         return ch
 
     def reversal(new_s: Any, extra: dict) -> ca.SX:
-        ch = {"reg": shifted, "n": st["n"] + 1, "s": new_s}
-        ch.update(model_changes(*model.reverse(z, m, new_s, q, p["snap"])))
+        zn, mn = model.reverse(z, m, new_s, q, p["snap"])
+        # the register records the force after the model's reset (an event within snap of the
+        # reversal coincides with it), as the unforced loop does
+        entry = [t_n, x, model.force(zn, mn, 0.0, new_s, q)] + ([W] if spec.forced else [])
+        ch = {"reg": ca.vertcat(*entry, reg[: -L.reg_width]), "n": st["n"] + 1, "s": new_s}
+        ch.update(model_changes(zn, mn))
         if spec.forced:
             ch["Wh"] = 0.0
         ch.update(extra)

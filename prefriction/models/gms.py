@@ -1,0 +1,425 @@
+"""Generalised Maxwell-slip (GMS) friction: N elements with a Stribeck curve, through the protocol.
+
+F. Al-Bender, V. Lampaert and J. Swevers, "The generalized Maxwell-slip model: a novel model
+for friction simulation and compensation", IEEE Transactions on Automatic Control 50(11),
+1883-1887, 2005 (doi:10.1109/TAC.2005.858676). It generalises :class:`prefriction.MaxwellSlip`
+(constant slip forces) with a velocity-dependent slip force ``alpha_i S(v)`` and a rate law for
+the slipping elements; it is rate-dependent, so its numbers in normalised units depend on the
+mass (:meth:`GMS.runtime_params_for`). See :class:`GMS` and ``docs/models.md#other-models``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import cached_property
+from typing import TYPE_CHECKING, Any, ClassVar, Hashable, Sequence
+
+import casadi as ca
+import numpy as np
+
+from prefriction.models.base import FrictionModel, Parameter
+from prefriction.models.maxwell_slip import MAX_ELEMENTS, TIE, _positive_array, _symbolic, _Virgin
+
+if TYPE_CHECKING:  # units imports the models
+    from prefriction.units import Scales
+
+__all__ = ["GMS", "ALPHA_SUM_TOL"]
+
+ALPHA_SUM_TOL = 1e-9
+"""Allowed deviation of ``sum(alpha)`` from 1."""
+
+
+def _nonnegative_array(name: str, value: Any, n: int, unit: str) -> np.ndarray:
+    """``value`` as a read-only 1-D float array of ``n`` finite entries >= 0, or raise
+    ``TypeError``/``ValueError`` naming ``name``, the offending value and the allowed range."""
+    allowed = f"a 1-D array of {n} finite numbers >= 0 [{unit}] (one per element)"
+    if isinstance(value, (str, bytes, dict)):
+        raise TypeError(f"{name} must be {allowed} or None, got {value!r} of type {type(value).__name__}")
+    try:
+        raw = np.asarray(value)
+    except Exception as exc:  # ragged nested sequences and the like
+        raise TypeError(f"{name} must be {allowed} or None, got {value!r}") from exc
+    if raw.dtype == bool or not (np.issubdtype(raw.dtype, np.integer) or np.issubdtype(raw.dtype, np.floating)):
+        raise TypeError(f"{name} must be {allowed} or None, got {value!r} (dtype {raw.dtype})")
+    arr = np.array(raw, dtype=float)
+    if arr.ndim != 1 or arr.size != n:
+        raise ValueError(f"{name} must be {allowed}, got an array of shape {arr.shape}")
+    bad = ~(np.isfinite(arr) & (arr >= 0.0))
+    if np.any(bad):
+        i = int(np.flatnonzero(bad)[0])
+        raise ValueError(f"{name}[{i}] must be finite and >= 0, got {float(arr[i])!r} "
+                         f"(allowed range: 0 <= {name}[i] < inf [{unit}])")
+    arr.flags.writeable = False
+    return arr
+
+
+def _exp(x: Any) -> Any:
+    """``exp`` of a float or a CasADi symbol."""
+    return ca.exp(x) if isinstance(x, (ca.SX, ca.MX)) else math.exp(x)
+
+
+def _pow(x: Any, y: Any) -> Any:
+    """``x ** y`` for ``x >= 0`` (0 at ``x = 0``), of floats or CasADi symbols; ``inf`` instead of
+    ``OverflowError``. On symbols the power sits in ``if_else(x > 0, ...)``: the derivative of
+    ``x ** y`` with respect to ``y`` is ``log(x) x^y``, NaN at ``x = 0``, and CasADi's event
+    location differentiates the indicators (a NaN there stops the integrator at ``v = 0``)."""
+    if isinstance(x, (ca.SX, ca.MX)) or isinstance(y, (ca.SX, ca.MX)):
+        return ca.if_else(x > 0.0, x ** y, 0.0)
+    x = float(x)
+    if x <= 0.0:
+        return 0.0
+    try:
+        return x ** float(y)
+    except OverflowError:
+        return math.inf
+
+
+@dataclass(frozen=True, eq=False)
+class GMS(FrictionModel):
+    """Generalised Maxwell-slip friction (Al-Bender, Lampaert and Swevers 2005).
+
+    F. Al-Bender, V. Lampaert, J. Swevers, "The generalized Maxwell-slip model: a novel model
+    for friction simulation and compensation", IEEE Transactions on Automatic Control 50(11),
+    1883-1887, 2005.
+
+    ``N`` elements in parallel. Element ``i`` is a spring ``k_i`` (deflection ``d_i``, force
+    ``F_i = k_i d_i``) whose slip force is the fraction ``alpha_i`` of the Stribeck curve
+
+        ``S(v) = Fc + (Fs - Fc) exp(-|v / vs|^delta)``   (a magnitude, ``S > 0``).
+
+    On a branch of direction ``s = sign(v)``:
+
+    - **sticking**: ``F_i' = k_i v`` (``d_i' = v``), until ``s F_i`` reaches ``alpha_i S(v)``
+      (a slip event);
+    - **slipping**: ``F_i' = s C (1 - s F_i / (alpha_i S(v)))``, i.e. ``F_i`` relaxes towards
+      ``s alpha_i S(v)`` at the rate ``C / (alpha_i S(v))``, until the velocity reverses;
+      then every element sticks again.
+
+    The friction force is ``F = sum_i (F_i + sigma_i d_i') + sigma2 v`` with the micro-damping
+    ``sigma_i`` (argument ``damping``, default 0) acting on the element deflection rates
+    ``d_i' = F_i' / k_i``. In steady sliding every element slips at ``s alpha_i S(v)``:
+    ``F = sign(v) S(v) + sigma2 v`` (:meth:`steady_force`).
+
+    **The slipping law as written here.** It is quoted from the paper as ``dF_i/dt = sgn(v) C
+    (1 - F_i / (alpha_i s(v)))`` with the steady-sliding curve ``s(v)``, which is odd in ``v``
+    (``s(v) = sgn(v) S(v)``, so that ``F_i -> alpha_i s(v)`` in steady sliding); with the
+    magnitude ``S`` that is ``s C (1 - s F_i / (alpha_i S))``, the form used here. (With a
+    positive ``S`` and without the inner ``s``, ``F_i = +alpha_i S`` would be the target in
+    both directions, an unstable one for ``v < 0``.) ``C`` is the attraction rate of the element
+    *forces*, so its unit is N/s (``sgn(v) C`` is the initial slope ``F_i'`` of an element that
+    slips far below its curve); formulations in element deflections ``d_i' = sgn(v) C' (1 -
+    k_i d_i / (alpha_i s(v)))`` have ``C' = C / k_i`` [m/s] instead. The Stribeck curve with
+    the shape exponent ``delta`` (2 by default, the Gaussian form) is the usual one of GMS.
+
+    Parameters
+    ----------
+    k : array_like
+        Element stiffnesses ``k_i`` [N/m]: 1-D, 1 to 64 entries, each finite and > 0.
+    alpha : array_like
+        Element fractions ``alpha_i`` of the Stribeck force [-]: as many entries as ``k``, each
+        finite and > 0, summing to 1 (within 1e-9).
+    Fc : float
+        Coulomb force [N], ``0 < Fc < inf``: the force unit of the normalised units.
+    Fs : float
+        Static (break-away) force [N], ``Fc <= Fs < inf``.
+    vs : float
+        Stribeck velocity [m/s], ``0 < vs < inf``.
+    C : float
+        Attraction rate of slipping elements [N/s], ``0 < C < inf``.
+    sigma2 : float, default 0.0
+        Viscous coefficient [N s/m], ``0 <= sigma2 < inf``.
+    damping : array_like or None, default None
+        Micro-damping ``sigma_i`` of the elements [N s/m]: ``N`` entries, each finite and
+        >= 0; ``None`` is zeros. (Named ``damping``, not ``sigma``: ``sigma`` is the protocol's
+        reference stiffness ``sum k_i``.)
+    delta : float, default 2.0
+        Stribeck shape exponent [-], ``0 < delta < inf``.
+
+    Raises
+    ------
+    TypeError
+        If an argument is not a real number or an array of real numbers.
+    ValueError
+        If a value lies outside its range (the message names the argument, the value and the
+        allowed range), the arrays' lengths differ, or ``alpha`` does not sum to 1.
+
+    Notes
+    -----
+    Normalised units (``docs/models.md``): ``sigma = sum k_i`` (the rest stiffness: every
+    element sticks after a reversal) and ``Fc``. With the velocity unit ``V = Fc / sqrt(m
+    sigma)`` (it holds the mass ``m``) the run-time numbers are (:meth:`runtime_params_for`)::
+
+        q = (kappa_1..N, alpha_1..N, mu_1..N, Fs/Fc - 1, V/vs, delta/2, C~, sigma2~)
+
+    with ``kappa_i = k_i / sigma``, ``mu_i = sigma_i V / (Fc kappa_i)``, ``C~ = C / (sigma V)``
+    (``C`` times the time unit ``sqrt(m / sigma)`` over ``Fc``) and ``sigma2~ = sigma2 V /
+    Fc``. The structure is ``N`` alone: one compiled plant serves every GMS with ``N``
+    elements, whatever its numbers or mass.
+
+    Protocol: states ``z_i = F_i / Fc`` and the retrace guard ``r`` of
+    :class:`prefriction.MaxwellSlip` (``r' = 2 max(-s v~, 0)``, zero on every branch); flags
+    ``m_i`` (element ``i`` slips). With ``S~(v~) = 1 + (Fs/Fc - 1) exp(-((v~ V/vs)^2)^(delta/2))``::
+
+        z_i' = (1 - m_i) kappa_i v~ + m_i C~ (s - z_i / (alpha_i S~)),
+        F~   = sum_i (z_i + mu_i z_i') + sigma2~ v~.
+
+    One event per element, indicator ``1 - s (z_i + kappa_i r) / (alpha_i S~(v~))`` while it
+    sticks (``+1`` while it slips); it depends on the velocity, which ``events`` receives. The
+    event sets ``m_i = 1`` and keeps ``z_i`` (``on_event`` does not receive the velocity, and
+    the event is located to round-off: ``z_i = s alpha_i S~`` there); a sticking element that
+    reaches its limit at the same instant (normalised force ``s z_j / alpha_j`` within
+    :data:`~prefriction.models.maxwell_slip.TIE` of the firing element's) slips with it. A
+    reversal keeps every ``z_i``, clears the flags and the guard; a sticking element within
+    ``snap`` of its limit at the reversal (``S~(0) = Fs/Fc``) is put on it.
+
+    ``initial_state(f0, s)`` is the state on the virgin curve of the Maxwell-slip model with
+    slip forces ``alpha_i Fc`` (elements at their limit slip if they move along ``f0``): below
+    ``alpha_i S(v)`` for every velocity, so no indicator starts negative, and ``|f0| <= 1``
+    (``|F0| <= Fc``) is always reachable.
+
+    ``F0`` of :func:`prefriction.simulate` is the elastic force ``sum F_i`` at the start. With
+    micro-damping the force jumps at a slip (``sigma_i d_i'`` changes from ``sigma_i v`` to
+    ``sigma_i F_i' / k_i``) and at a reversal (a slipping element's ``F_i'`` does not vanish at
+    ``v = 0``; after the reversal it sticks); the reversal table of unforced runs records the
+    force after the model's reset, that of forced runs the force before it. Rate-dependent
+    (``rate_independent = False``): the energy analysis refuses the model and the table's
+    ``E_p`` is NaN.
+
+    With ``Fs = Fc`` and no damping (``damping``, ``sigma2`` zero) the model *is*
+    :class:`prefriction.MaxwellSlip` with ``W_i = alpha_i Fc`` for every ``C`` and ``vs``: a
+    slipping element starts on its equilibrium ``s alpha_i Fc`` and stays there.
+
+    Examples
+    --------
+    >>> import prefriction as pf
+    >>> m = pf.GMS(k=[6e4, 3e4, 1e4], alpha=[0.2, 0.3, 0.5], Fc=1.0, Fs=1.5, vs=1e-3, C=2e3)
+    >>> m.sigma, m.Fc, m.n_states, m.structure_key()
+    (100000.0, 1.0, 4, ('GMS', 3))
+    >>> float(m.stribeck(0.0)), round(float(m.stribeck(1e-3)), 6)  # Fs, Fc + 0.5/e [N]
+    (1.5, 1.18394)
+    """
+
+    k: Any
+    alpha: Any
+    Fc: float
+    Fs: float
+    vs: float
+    C: float
+    sigma2: float = 0.0
+    damping: Any = None
+    delta: float = 2.0
+
+    parameters: ClassVar[tuple[Parameter, ...]] = (
+        Parameter("k", "N/m", 0.0, math.inf, low_open=True),
+        Parameter("alpha", "-", 0.0, 1.0, low_open=True),
+        Parameter("Fc", "N", 0.0, math.inf, low_open=True),
+        Parameter("Fs", "N", 0.0, math.inf, low_open=True),
+        Parameter("vs", "m/s", 0.0, math.inf, low_open=True),
+        Parameter("C", "N/s", 0.0, math.inf, low_open=True),
+        Parameter("sigma2", "N s/m", 0.0, math.inf),
+        Parameter("damping", "N s/m", 0.0, math.inf),
+        Parameter("delta", "-", 0.0, math.inf, low_open=True),
+    )
+    rate_independent: ClassVar[bool] = False
+
+    def __post_init__(self) -> None:
+        self._validate()
+
+    def _validate(self) -> None:
+        """Check the arrays elementwise and their lengths, the scalars against their ranges,
+        ``sum(alpha) = 1`` and ``Fs >= Fc``."""
+        k = _positive_array("k", self.k, "N/m")
+        alpha = _positive_array("alpha", self.alpha, "-")
+        if alpha.size != k.size:
+            raise ValueError(f"k and alpha must have the same length (one entry per element), "
+                             f"got {k.size} and {alpha.size}")
+        total = math.fsum(alpha.tolist())
+        if not abs(total - 1.0) <= ALPHA_SUM_TOL:
+            raise ValueError(f"alpha must sum to 1 (the elements' fractions of the Stribeck force; allowed: "
+                             f"|sum(alpha) - 1| <= {ALPHA_SUM_TOL:g}), got sum {total!r} from {alpha.tolist()!r}")
+        object.__setattr__(self, "k", k)
+        object.__setattr__(self, "alpha", alpha)
+        for par in self.parameters:
+            if par.name not in ("k", "alpha", "damping"):
+                object.__setattr__(self, par.name, par.check(getattr(self, par.name)))
+        damping = np.zeros(k.size) if self.damping is None else self.damping
+        damping = _nonnegative_array("damping", damping, k.size, "N s/m")
+        damping.flags.writeable = False
+        object.__setattr__(self, "damping", damping)
+        if not self.Fs >= self.Fc:
+            raise ValueError(f"Fs must be a finite number in [Fc, inf) = [{self.Fc!r}, inf) [N] (the static "
+                             f"force is at least the Coulomb force Fc), got {self.Fs!r}")
+
+    def __eq__(self, other: object) -> bool:
+        if type(other) is not type(self):
+            return NotImplemented
+        return all(np.array_equal(getattr(self, f), getattr(other, f)) for f in _FIELDS)
+
+    def __hash__(self) -> int:
+        return hash((type(self).__qualname__,) + tuple(
+            tuple(v.tolist()) if isinstance(v, np.ndarray) else v for v in (getattr(self, f) for f in _FIELDS)))
+
+    def __reduce__(self) -> tuple:
+        # rebuilt (and re-validated) from the numbers: the arrays come back read-only
+        return (type(self), tuple(v.tolist() if isinstance(v, np.ndarray) else v
+                                  for v in (getattr(self, f) for f in _FIELDS)))
+
+    # --- normalisation ---------------------------------------------------------------------
+    @property
+    def n_elements(self) -> int:
+        """Number of elements ``N``."""
+        return int(self.k.size)
+
+    @property
+    def sigma(self) -> float:  # type: ignore[override]
+        """Rest stiffness ``sum k_i`` [N/m]."""
+        return math.fsum(self.k.tolist())
+
+    def stribeck(self, v: Any) -> np.ndarray:
+        """Stribeck curve ``S(v) = Fc + (Fs - Fc) exp(-|v / vs|^delta)`` [N] (a magnitude) at the
+        velocities ``v`` [m/s] (numpy)."""
+        v = np.asarray(v, dtype=float)
+        return self.Fc + (self.Fs - self.Fc) * np.exp(-np.abs(v / self.vs) ** self.delta)
+
+    def steady_force(self, v: Any) -> np.ndarray:
+        """Friction force [N] in steady sliding at the constant velocity ``v`` [m/s] (numpy):
+        ``sign(v) S(v) + sigma2 v`` (every element slipping at ``sign(v) alpha_i S(v)``)."""
+        v = np.asarray(v, dtype=float)
+        return np.sign(v) * self.stribeck(v) + self.sigma2 * v
+
+    # --- structure and numbers ------------------------------------------------------------
+    @property
+    def n_states(self) -> int:
+        """``N`` element forces and the retrace guard ``r``."""
+        return self.n_elements + 1
+
+    @property
+    def n_flags(self) -> int:
+        return self.n_elements
+
+    @property
+    def n_events(self) -> int:
+        return self.n_elements
+
+    def structure_key(self) -> Hashable:
+        return ("GMS", self.n_elements)
+
+    def runtime_params_for(self, scales: "Scales") -> np.ndarray:
+        """``q = (kappa_i, alpha_i, mu_i, Fs/Fc - 1, V/vs, delta/2, C/(sigma V), sigma2 V/Fc)``
+        with the velocity unit ``V = scales.v = Fc / sqrt(m sigma)`` of the system (class notes)."""
+        V, sig, Fc = scales.v, self.sigma, self.Fc
+        kappa = self.k / sig
+        mu = self.damping * V / Fc / kappa
+        tail = [self.Fs / Fc - 1.0, V / self.vs, 0.5 * self.delta, self.C / (sig * V), self.sigma2 * V / Fc]
+        return np.concatenate((kappa, self.alpha, mu, tail))
+
+    def runtime_params(self) -> np.ndarray:
+        """The numbers :meth:`runtime_params_for` gives for a unit mass (``m = 1 kg``)."""
+        return self.runtime_params_for(_UnitMass(self.Fc / math.sqrt(self.sigma)))
+
+    @cached_property
+    def _virgin(self) -> _Virgin:
+        return _Virgin(self.k / self.sigma, np.array(self.alpha, dtype=float))
+
+    # --- dynamics -------------------------------------------------------------------------
+    def _S(self, v: Any, q: Any) -> Any:
+        """Normalised Stribeck curve ``S~(v~) = 1 + (Fs/Fc - 1) exp(-((v~ V/vs)^2)^(delta/2))``."""
+        n = self.n_elements
+        r = v * q[3 * n + 1]
+        return 1.0 + q[3 * n] * _exp(-_pow(r * r, q[3 * n + 2]))
+
+    def initial_state(self, f0: float, s: float) -> tuple[list[float], list[float]]:
+        """The state on the virgin curve of the Maxwell-slip model with slip forces ``alpha_i Fc``
+        with normalised force ``f0`` (``|f0| <= 1``); elements at their limit slip if ``s`` is
+        the direction of ``f0``."""
+        if not abs(f0) <= 1.0 + 1e-12:
+            raise ValueError(f"f0 must lie in [-1, 1] (F0 within [-Fc, Fc]), got {f0!r}")
+        n = self.n_elements
+        if f0 == 0.0:
+            return [0.0] * (n + 1), [0.0] * n
+        kappa, w = self.k / self.sigma, self.alpha
+        v = self._virgin
+        a = min(abs(f0), 1.0)
+        j = int(v.segment_of_force(np.array(a)))
+        y = float(v.inverse(np.array(a)))
+        order = np.argsort(w / kappa, kind="stable")
+        at_limit = np.zeros(n, dtype=bool)
+        at_limit[order[:j]] = True  # segment j: the j smallest slip deflections are at their limit
+        sg = 1.0 if f0 > 0 else -1.0
+        z = [sg * float(w[i]) if at_limit[i] else sg * float(kappa[i]) * y for i in range(n)]
+        m = [1.0 if (at_limit[i] and s * sg > 0) else 0.0 for i in range(n)]
+        return z + [0.0], m
+
+    def rate(self, z: Sequence[Any], m: Sequence[Any], v: Any, s: Any, q: Any) -> list[Any]:
+        n = self.n_elements
+        S = self._S(v, q)
+        C = q[3 * n + 3]
+        out = [(1.0 - m[i]) * (q[i] * v) + m[i] * (C * (s - z[i] / (q[n + i] * S))) for i in range(n)]
+        back = -2.0 * s * v  # > 0 only past a reversal inside a trial step of the integrator
+        back = ca.fmax(back, 0.0) if _symbolic(back) else max(back, 0.0)
+        return out + [back]
+
+    def force(self, z: Sequence[Any], m: Sequence[Any], v: Any, s: Any, q: Any) -> Any:
+        n = self.n_elements
+        dz = self.rate(z, m, v, s, q)
+        total = z[0] + q[2 * n] * dz[0]
+        for i in range(1, n):
+            total = total + z[i] + q[2 * n + i] * dz[i]
+        return total + q[3 * n + 4] * v
+
+    def _indicator(self, j: int, z: Sequence[Any], v: Any, s: Any, q: Any) -> Any:
+        """Slip indicator of element ``j``: ``1 - s (z_j + kappa_j r) / (alpha_j S~(v))``."""
+        n = self.n_elements
+        return 1.0 - s * (z[j] + q[j] * z[n]) / (q[n + j] * self._S(v, q))
+
+    def events(self, z: Sequence[Any], m: Sequence[Any], v: Any, s: Any, q: Any) -> list[Any]:
+        sym = _symbolic(z, m, v, s, q)
+        out = []
+        for i in range(self.n_elements):
+            ind = self._indicator(i, z, v, s, q)
+            out.append(ca.if_else(m[i] > 0.5, 1.0, ind) if sym else (1.0 if m[i] > 0.5 else ind))
+        return out
+
+    def on_event(self, k: int, z: Sequence[Any], m: Sequence[Any], s: Any, q: Any) -> tuple[list[Any], list[Any]]:
+        n = self.n_elements
+        sym = _symbolic(z, m, s, q)
+        mn = list(m)
+        mn[k] = 1.0 + 0.0 * q[n + k]
+        # the firing element is at its limit: s (z_k + kappa_k r) / alpha_k = S~(v). A sticking
+        # element j at the same normalised force (within TIE) reaches its limit at this instant
+        gk = s * (z[k] + q[k] * z[n]) * (1.0 - TIE)
+        for j in range(n):
+            if j == k:
+                continue
+            hit = s * (z[j] + q[j] * z[n]) * q[n + k] >= gk * q[n + j]
+            if sym:
+                mn[j] = ca.if_else(ca.logic_and(m[j] < 0.5, hit), 1.0, m[j])
+            elif m[j] < 0.5 and hit:
+                mn[j] = 1.0
+        return list(z), mn
+
+    def reverse(self, z: Sequence[Any], m: Sequence[Any], s_new: Any, q: Any, snap: Any) -> tuple[list[Any], list[Any]]:
+        n = self.n_elements
+        s_old = -s_new
+        sym = _symbolic(z, m, s_new, q, snap)
+        S0 = 1.0 + q[3 * n]  # S~ at v = 0: Fs / Fc
+        zn = []
+        for j in range(n):
+            lim = q[n + j] * S0
+            near = 1.0 - s_old * z[j] / lim < snap  # a sticking element at its limit at the reversal
+            if sym:
+                zn.append(ca.if_else(ca.logic_and(m[j] < 0.5, near), s_old * lim, z[j]))
+            else:
+                zn.append(s_old * float(lim) if (m[j] < 0.5 and near) else z[j])
+        return zn + [0.0 * z[n]], [0.0] * n
+
+
+_FIELDS = ("k", "alpha", "Fc", "Fs", "vs", "C", "sigma2", "damping", "delta")
+
+
+@dataclass(frozen=True)
+class _UnitMass:
+    """The velocity unit of a unit-mass system (all :meth:`GMS.runtime_params_for` reads)."""
+
+    v: float
