@@ -7,6 +7,7 @@ from typing import Optional
 
 import numpy as np
 
+from prefriction.simulation.compact import advance_compact
 from prefriction.simulation.integrator import INTEGRATOR_FAILED, BufferedIntegrator, integrator
 from prefriction.simulation.feedback import LinearFeedback
 from prefriction.simulation.plant import EPS_REST, Layout, PlantSpec
@@ -249,89 +250,6 @@ class Run:
         """The model's state just after a reversal into ``s_new`` (floats)."""
         return self.model.reverse(z, m, s_new, self.q, self.snap)
 
-    def _advance_compact(self, t_target: float, n_target: float) -> bool:
-        """:meth:`advance` for the compact unforced model (``spec.stops_at_reversal``): each call
-        runs to the next reversal (or ``t_target``); the new branch starts here, in Python.
-        Local variables only (``self.st`` is written at the end or before an error)."""
-        call, L, model, eps = self.f1, self.L, self.model, self.eps
-        q = self.q.tolist()  # floats: the model's numeric fast paths
-        # memoryviews of the call's buffers: item assignment costs ~25 ns, not ~70 ns (numpy)
-        X0, P, U = memoryview(call.X0), memoryview(call.P), memoryview(call.U.reshape(-1))
-        out, trigger, buf = memoryview(call.out), call.trigger, call.buf
-        compiled = self.mode != "interpreted"
-        ix = L.state
-        iv, ixh = ix["vh"], ix.get("xh")
-        iz = [ix[f"z{i}"] for i in range(L.nz)]
-        im = [ix[f"m{i}"] for i in range(L.nm)]
-        tracks = ixh is None
-        force, travel, reverse, snap = model.force, model.travel, model.reverse, self.snap
-        P[:] = self.P0  # eps and the model's numbers q
-        st, rev = self.st, self.rev
-        x, v, z, m, s, t = st["x"], st["v"], st["z"], st["m"], st["s"], st["t"]
-        grow = 1.0
-        calls = 0
-        t_stop = t_target * (1 - 1e-15) if t_target < math.inf else math.inf
-        n = len(rev)
-        while n < n_target and t < t_stop:
-            F = float(force(z, m, v, s, q))
-            if n >= 2:  # the next half-cycle about as long as the last one, with a margin
-                chunk = 2.0 * (rev[-1][0] - rev[-2][0]) * grow
-            else:  # F rises over a distance ~1 (time ~1/|v|): the first step must not skip it;
-                # quadrupled while no reversal comes (a gross slide: the scales follow the speed)
-                chunk = 2.0 * math.pi / max(1.0, abs(v)) * grow
-            t1 = min(t_target, t + chunk)
-            A = max(math.hypot(v, F), 1e-300)
-            Ax = max(A, 0.5 * A * A, min(abs(x), 1.0)) * eps
-            AF = min(A, 1.0) * eps
-            Av = A * eps
-            P[0], P[1], P[2], P[3] = Ax, Av, AF, s
-            X0[iv] = v / Av
-            for i, k in enumerate(iz):
-                X0[k] = z[i] / AF
-            for i, k in enumerate(im):
-                X0[k] = m[i]
-            if not tracks:
-                X0[ixh] = 0.0
-            U[0], U[1] = t1 - t, t
-            calls += 1
-            why = INTEGRATOR_FAILED
-            # a failed compiled call returns before writing its result: the NaN stays (asking
-            # the buffer for the return code costs ~0.6 us; the interpreted call is asked)
-            out[0] = math.nan
-            try:
-                trigger()
-                ok = compiled or buf.ret() == 0
-            except RuntimeError as exc:
-                ok, why = False, str(exc).strip().splitlines()[-1]
-            c = out.tolist()
-            if not (ok and math.isfinite(math.fsum(c))):
-                self.calls += calls
-                st.update(x=x, v=v, z=z, m=m, s=s, t=t, F=F)
-                raise self._failure(why)
-            if self.steps is not None:
-                self._count_steps(call)
-            z1 = [AF * c[k] for k in iz]
-            x = x + travel(z, z1, s, q) if tracks else x + Ax * c[ixh]
-            z, m = z1, [c[k] for k in im]
-            sv = s * c[iv] * eps
-            if sv > -0.5:  # no reversal: vh is the velocity
-                v = Av * c[iv]
-                t = t1
-                grow *= 4.0
-            else:  # vh eps = -s (1 + tau) at a reversal: record it, start the branch of direction -s
-                t = t + (t1 - t) * (-sv - 1.0)  # t0 + dur tau, as the integrator's time
-                v = 0.0
-                n += 1
-                s = -s
-                z, m = reverse(z, m, s, q, snap)
-                # the force after the model's reset: an event within snap of the reversal is taken
-                # as coinciding with it (the reset puts its state on the switching surface)
-                rev.append((t, x, float(force(z, m, 0.0, s, q)), 0.0))
-                grow = 1.0
-        self.calls += calls
-        st.update(x=x, v=v, z=z, m=m, s=s, t=t, F=float(force(z, m, v, s, q)))
-        return n >= n_target
-
     def _count_steps(self, call: BufferedIntegrator) -> None:
         """Add the steps of the last call (interpreted integrator only; else ``steps`` = None)."""
         try:  # statistics exist for the interpreted integrator only (memory 1: the buffer's)
@@ -342,7 +260,7 @@ class Run:
     def advance(self, t_target: float, n_target: float) -> bool:
         """Integrate to normalised time ``t_target`` or ``n_target`` reversals; True if the latter."""
         if self.spec.stops_at_reversal:
-            return self._advance_compact(t_target, n_target)
+            return advance_compact(self, t_target, n_target)
         grow = 1.0
         while True:
             if len(self.rev) >= n_target:
@@ -382,39 +300,3 @@ class Run:
         """Current state as a sample (t~, x~, v~, F~, E_f~, xc)."""
         st = self.st
         return (st["t"], st["x"], st["v"], st["F"], st["Ef"], np.array(st["xc"], dtype=float))
-
-    def dense(self, times: np.ndarray, t_end: float, n_target: float) -> tuple[list, bool]:
-        """Integrate through the sorted normalised ``times``; returns the samples and the stop flag."""
-        samples = []
-        # breaks up to the last requested time only: the caller continues from there
-        last = min(t_end, float(times[-1]))
-        grid = np.union1d(times, self.breaks[(self.breaks > self.st["t"]) & (self.breaks < last)])
-        is_sample = np.isin(grid, times)
-        i = 0
-        if grid.size and grid[0] <= self.st["t"]:
-            samples.append(self.sample())
-            i = 1
-        while i < grid.size:
-            if len(self.rev) >= n_target:
-                return samples, True
-            pts = list(grid[i:i + N_DENSE])
-            m = len(pts)
-            nstop = min(n_target, 1e18)
-            xf, a = self._call(self.f1, self.L, pts, nstop)
-            used = m
-            for j in range(m):
-                out = self._unpack(self.L, xf[:, j], a, len(self.rev), nstop)
-                if out["overflow"]:  # more than K reversals between two outputs: redo that piece
-                    if self.advance(pts[j], n_target):
-                        return samples, True
-                    used = j + 1
-                    if is_sample[i + j]:
-                        samples.append(self.sample())
-                    break
-                self._accept(out, pts[j])
-                if out["frozen"]:
-                    return samples, True
-                if is_sample[i + j]:
-                    samples.append(self.sample())
-            i += used
-        return samples, False

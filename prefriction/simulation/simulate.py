@@ -40,6 +40,7 @@ import numpy as np
 
 from prefriction.signals import Constant, compiled_form
 from prefriction.simulation.feedback import LinearFeedback
+from prefriction.simulation.dense import dense_loop
 from prefriction.simulation.run import N_DENSE, Run
 from prefriction.simulation.plant import Layout, PlantSpec
 from prefriction.simulation.force_scale import applied_force_scale
@@ -58,7 +59,6 @@ _K = 2  # reversals recorded per integrator call (register length; forced or den
 _MIN_ORDER = 2  # continuous controllers are padded to this order (one plant for P, PD, PID)
 _ZERO = Constant(0.0)  # the input of a sampled loop without an input force (the hold is added)
 _CAL = 0.1  # calibration of the run-time tolerance eps: global error over 50 reversals ~ 0.7 rtol
-_DENSE_STEP = 2.0 * math.pi / 64.0  # normalised spacing of dense=True samples (64 per small cycle)
 
 
 def simulate(
@@ -206,7 +206,7 @@ def simulate(
     if fb_kind == "sampled":
         samples, u_hist = _sampled_loop(run, xc0, t_end_n, n_target)
     elif want_dense:
-        samples = _dense_loop(run, None if times_si is None else times_si / sc.t, t_end_n, n_target)
+        samples = dense_loop(run, None if times_si is None else times_si / sc.t, t_end_n, n_target)
     else:
         samples = []
         run.advance(t_end_n, n_target)
@@ -289,30 +289,6 @@ def _sampled_loop(run: Run, xc0: np.ndarray, t_end: float, n_target: float) -> t
     return samples, u_hist
 
 
-def _dense_loop(run: Run, times: Optional[np.ndarray], t_end: float, n_target: float) -> list:
-    """Samples at the normalised ``times`` (every ``_DENSE_STEP`` if None), integrating up to the
-    normalised time ``t_end`` or ``n_target`` reversals."""
-    if times is not None:
-        samples, stopped = run.dense(times, t_end, n_target)
-        if not stopped:
-            run.advance(t_end, n_target)
-        return samples
-    samples: list = []
-    stopped = False
-    t0 = 0.0
-    while not stopped and t0 <= t_end:
-        block = t0 + _DENSE_STEP * np.arange(0, 256)
-        block = block[block <= t_end]
-        if block.size and block[-1] < t_end < block[-1] + _DENSE_STEP:
-            block = np.append(block, t_end)  # the last sample is at t_end
-        if block.size == 0:
-            break
-        got, stopped = run.dense(block, t_end, n_target)
-        samples.extend(got)
-        t0 = block[-1] + _DENSE_STEP
-    return samples
-
-
 def _reversal_table(rev: list, system: Oscillator, s0: float, v0: float, F0: float) -> tuple[ReversalTable, np.ndarray]:
     """The reversals ``(t~, x~, F~, W~)`` as a :class:`ReversalTable` in SI, and the input's work
     over each half-cycle [J]; ``E_p`` is the branch potential (3.9), ``E_d`` the balance (2.10)."""
@@ -351,7 +327,7 @@ def _padded(fb: LinearFeedback, order: int) -> LinearFeedback:
 
 def _samples_si(run: Run, samples: list, u_hist: list, times_si: Optional[np.ndarray], n_user: int) -> dict:
     """The samples ``(t~, x~, v~, F~, E_f~, xc)`` of ``run`` as the SI fields of :class:`SimulationResult`;
-    ``times_si`` are the requested sample times [s] (None: every ``_DENSE_STEP``)."""
+    ``times_si`` are the requested sample times [s] (None: every ``DENSE_STEP``)."""
     system, feedback, sc = run.system, run.fb, run.sc
     S = list(zip(*samples))
     ts = np.array(S[0]) * sc.t
