@@ -45,25 +45,28 @@ class ModelCheck:
 
 
 def _sibling(model: FrictionModel) -> FrictionModel:
-    """Another instance of the same structure with other numbers (each declared parameter
-    moved by a few per cent inside its range), or ``model`` itself if there is none."""
+    """Another instance of the same structure with other numbers: every float or float-array
+    field moved by 3 % where the model accepts it (e.g. not GMS's fractions, which must sum to
+    1), or ``model`` itself if nothing can move."""
     import dataclasses
 
     if not dataclasses.is_dataclass(model):
         return model
     changes = {}
-    for par in model.parameters:
-        value = getattr(model, par.name)
-        if not isinstance(value, float):
+    for field in dataclasses.fields(model):
+        value = getattr(model, field.name)
+        if isinstance(value, float):
+            moved: Any = value * 1.03 if value != 0.0 else 0.03
+        elif isinstance(value, np.ndarray) and value.dtype.kind == "f" and value.size:
+            moved = value * 1.03
+        else:
             continue
-        for factor in (1.03, 0.97):
-            moved = value * factor if value != 0.0 else 0.03
-            try:
-                par.check(moved)
-            except ValueError:
-                continue
-            changes[par.name] = moved
-            break
+        try:
+            trial = dataclasses.replace(model, **{field.name: moved})
+        except (TypeError, ValueError):
+            continue
+        if trial.structure_key() == model.structure_key():
+            changes[field.name] = moved
     try:
         other = dataclasses.replace(model, **changes)
     except (TypeError, ValueError):
@@ -175,7 +178,8 @@ def check_model(model: FrictionModel, *, v0: float = 1.5, reversals: int = 12, r
 
     1. The symbolic functions (from a symbolic ``q``; ``force``, ``rate``, ``events``,
        ``on_event``, ``reverse``) equal the numeric ones of another instance of the same
-       structure (parameters moved by 3 %): the plant compiled once serves every instance.
+       structure (float and array parameters moved by 3 %): the plant compiled once serves
+       every instance.
     2. :func:`prefriction.simulate` finds the same reversals (count, times, positions, forces)
        as an independent scipy reference, within ``tol_factor * rtol``: no reversal missed.
     3. Rate-independent models: energy balance at every reversal (the potential energy ``E_p``
