@@ -3,7 +3,7 @@
 Public API, re-exported from private modules:
 
 - models (:mod:`prefriction.models`): :class:`FrictionModel` (the protocol), :class:`Dahl`,
-  :class:`MaxwellSlip`, :class:`GMS`, :class:`Oscillator`, :class:`Parameter`
+  :class:`MaxwellSlip`, :class:`GMS`, :class:`LuGre`, :class:`Oscillator`, :class:`Parameter`
 - input signals: :mod:`prefriction.signals` (``Constant``, ``Step``, ``Ramp``, ``Sine``,
   ``Chirp``, ``Samples`` and sums; compiled once per kind)
 - analytics: :mod:`prefriction.dahl` (exact and approximate reversal maps, energies; Dahl only)
@@ -16,7 +16,7 @@ Public API, re-exported from private modules:
 from __future__ import annotations
 
 from prefriction.errors import PrefrictionError, SolverError
-from prefriction.models import GMS, Dahl, FrictionModel, MaxwellSlip, Oscillator, Parameter
+from prefriction.models import GMS, Dahl, FrictionModel, LuGre, MaxwellSlip, Oscillator, Parameter
 from prefriction.reversals import ReversalTable
 from prefriction.units import Scales
 from prefriction.simulation.simulate import SimulationResult, simulate
@@ -31,6 +31,7 @@ __all__ = [
     "FrictionModel",
     "GMS",
     "LinearFeedback",
+    "LuGre",
     "MaxwellSlip",
     "Oscillator",
     "Parameter",

@@ -3,6 +3,7 @@
 - :class:`FrictionModel` (``base.py``): the contract every model implements (``docs/models.md``);
 - :class:`Dahl` (``dahl.py``): the Dahl model (3.2) of the paper;
 - :class:`MaxwellSlip` (``maxwell_slip.py``): N elasto-plastic elements (Iwan; Lampaert et al.);
+- :class:`LuGre` (``lugre.py``): the LuGre model (Canudas de Wit et al. 1995);
 - :class:`GMS` (``gms.py``): the generalised Maxwell-slip model (Al-Bender et al. 2005);
 - :class:`Oscillator` (``oscillator.py``): mass, friction model and input force.
 """
@@ -10,8 +11,9 @@
 from prefriction.models.base import FrictionModel, Parameter
 from prefriction.models.dahl import Dahl
 from prefriction.models.gms import GMS
+from prefriction.models.lugre import LuGre
 from prefriction.models.maxwell_slip import MaxwellSlip
 from prefriction.models.oscillator import Oscillator, check_dahl_oscillator, check_oscillator
 
-__all__ = ["Dahl", "FrictionModel", "GMS", "MaxwellSlip", "Oscillator", "Parameter", "check_dahl_oscillator",
+__all__ = ["Dahl", "FrictionModel", "GMS", "LuGre", "MaxwellSlip", "Oscillator", "Parameter", "check_dahl_oscillator",
            "check_oscillator"]
