@@ -19,7 +19,7 @@ import casadi as ca
 import numpy as np
 
 from prefriction.models.base import FrictionModel, Parameter
-from prefriction.models.maxwell_slip import MAX_ELEMENTS, TIE, _positive_array, _symbolic, _Virgin
+from prefriction.models.maxwell_slip import TIE, _positive_array, _symbolic, _Virgin
 
 if TYPE_CHECKING:  # units imports the models
     from prefriction.units import Scales

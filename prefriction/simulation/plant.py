@@ -60,7 +60,6 @@ third less than with the register of two reversals (2 states instead of 11).
 from __future__ import annotations
 
 import contextlib
-import math
 import os
 import sys
 import tempfile
@@ -68,7 +67,6 @@ from dataclasses import dataclass, field
 from typing import Any, Callable, Hashable, Iterator
 
 import casadi as ca
-import numpy as np
 
 from prefriction.models.base import FrictionModel
 

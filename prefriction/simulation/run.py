@@ -151,7 +151,7 @@ class Run:
     # --- one call -----------------------------------------------------------------------
     def _controls(self, t0: float, t1: float, j: int) -> list[float]:
         """Controls of the output interval [t0, t1] (normalised times)."""
-        L, sc, sys, fb = self.L, self.sc, self.system, self.fb
+        L, sc = self.L, self.sc
         U = [0.0] * L.nu
         U[L.control["dur"]] = t1 - t0
         U[L.control["t0"]] = t0 - (t1 - t0) * j  # t~ = t0 + dur * tau, tau in [j, j + 1]
@@ -188,7 +188,7 @@ class Run:
         if new_s != st["s"]:  # leaves backwards: a reversal at this instant
             self.rev.append((st["t"], st["x"], st["F"], st["W"]))
             st["W"] = 0.0
-            st["z"], st["m"] = self._reverse(st["z"], st["m"], new_s)
+            st["z"], st["m"] = self.model.reverse(st["z"], st["m"], new_s, self.q, self.snap)
             st["s"] = new_s
         st["rest"] = 0.0
 
@@ -246,10 +246,6 @@ class Run:
         self.st["t"] = t if out["t"] is None else out["t"]
 
     # --- loops --------------------------------------------------------------------------
-    def _reverse(self, z: list, m: list, s_new: float) -> tuple[list, list]:
-        """The model's state just after a reversal into ``s_new`` (floats)."""
-        return self.model.reverse(z, m, s_new, self.q, self.snap)
-
     def _count_steps(self, call: BufferedIntegrator) -> None:
         """Add the steps of the last call (interpreted integrator only; else ``steps`` = None)."""
         try:  # statistics exist for the interpreted integrator only (memory 1: the buffer's)
