@@ -213,17 +213,21 @@ def test_presliding_ramps_against_reference(ex):
 
 
 def test_presliding_with_holds_against_reference(ex):
-    """Experiment 1 as in the paper (5-s holds at +-0.95 Fs). At rest under a constant force the
-    simulator keeps finding reversals at the level of its integration error (its rest test,
-    ``EPS_TOUCH`` = 1e-14 of the amplitude, lies below that error), and the asymmetric LuGre
-    stiffness near ``0.95 g`` turns them into a creep of ~1e-11 m per hold: 50 rtol of the
-    45-um motion, hence the looser bound here."""
+    """Experiment 1 as in the paper (5-s holds at +-0.95 Fs): within 10 rtol of the reference.
+    In the holds the mass comes to rest; the simulator's rest test (net force below ``EPS_TOUCH``
+    times the tolerance times the amplitude, the error level of the net force) finds that rest
+    instead of reversals at the level of its integration error (there were 306 such reversals,
+    and a creep of 50 rtol, when the test sat at 1e-14 of the amplitude, below that error)."""
     d = ex.presliding(hold=True, n=1201)
     tu, uu = ex.presliding_input(hold=True)
     Y, F, revs = radau(lambda t, y: float(np.interp(t, tu, uu)), float(tu[-1]), d["t"], breaks=tuple(tu),
                        scale=(5e-5, 3e-5))
     e = errors(d["x"], d["v"], d["F"], Y, F)
-    assert e[0] <= 100 * RTOL and e[1] <= 10 * RTOL and e[2] <= 10 * RTOL, e
+    assert max(e) <= 10 * RTOL, e
+    # the reversals of the ramps, and at most the few damped ones at the start of each hold
+    # that the reference (rest below 1e-12 Fc) also finds
+    n = len(d["result"].reversals.t)
+    assert 2 <= n <= len(revs), (n, len(revs))
 
 
 def test_friction_lag_against_reference(ex):

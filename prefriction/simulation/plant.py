@@ -72,10 +72,12 @@ from prefriction.models.base import FrictionModel
 
 __all__ = ["EPS_TOUCH", "EPS_REST", "Layout", "PlantSpec", "build_integrator"]
 
-EPS_TOUCH = 1e-14
-"""Net force (relative to the call's amplitude scale) below which a zero velocity is rest."""
-EPS_REST = 1e-12
-"""Net force (relative to the call's amplitude scale) above which a resting mass moves again."""
+EPS_TOUCH = 10.0
+"""Net force, in units of the call's velocity scale ``Av = eps A`` (the tolerance times the
+amplitude: the integrator's error level of the net force), below which a zero velocity is rest."""
+EPS_REST = 30.0
+"""Net force, in units of ``Av = eps A``, above which a resting mass moves again (a hysteresis
+above :data:`EPS_TOUCH`, so that a mass just put to rest does not leave at once)."""
 EPS_START = 1e-13
 """Offset of the forced reversal indicator ``s v / Av + EPS_START``: a branch that starts at
 ``v = 0`` starts with a positive indicator, so a velocity that turns against ``s`` before it
@@ -285,9 +287,8 @@ def build_integrator(spec: PlantSpec) -> ca.Function:
     # branch starting at v = 0 has a positive indicator (EPS_START)
     zero = [ca.if_else(run_m > 0.5, s * st["vh"] * p["eps"] + (EPS_START if spec.forced else 0.0), 1.0)]
     zero += [ca.if_else(run_m > 0.5, ind, 1.0) for ind in model.events(z, m, v, s, q)]
-    amp = p["Av"] / p["eps"]  # the amplitude of the motion
-    if spec.forced:
-        zero.append(ca.if_else(run * rest > 0.5, EPS_REST * amp - ca.fabs(acc), 1.0))
+    if spec.forced:  # rest thresholds at the error level of the net force: eps times the amplitude
+        zero.append(ca.if_else(run * rest > 0.5, EPS_REST * p["Av"] - ca.fabs(acc), 1.0))
     dae = {"x": X, "p": P, "u": U, "t": tau, "ode": ode, "zero": ca.vertcat(*zero)}
 
     # transition: the state just after an event
@@ -323,7 +324,7 @@ def build_integrator(spec: PlantSpec) -> ca.Function:
 
     sa = s * acc
     if spec.forced:  # zero velocity: reversal, touch (velocity keeps its sign) or rest
-        eps = EPS_TOUCH * amp
+        eps = EPS_TOUCH * p["Av"]
         posts = [ca.if_else(sa < -eps, reversal(-s, {}),
                             ca.if_else(sa > eps, X, with_({"rest": 1.0, "vh": 0.0})))]
     else:

@@ -181,7 +181,7 @@ class Run:
         """End a rest at the start of a call if the net force no longer vanishes (the input or the
         held force jumped at a sample time; inside a call the rest-exit event does this)."""
         acc = self._net_force()
-        if abs(acc) <= EPS_REST * self._scales()["Av"]:
+        if abs(acc) <= EPS_REST * self.eps * self._scales()["Av"]:
             return
         st = self.st
         new_s = 1.0 if acc > 0 else -1.0
