@@ -75,16 +75,16 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
             "balance": float(np.max(np.abs(E_k + E_f - E_k0)) / E_k0),
         }
         floor = 1e-7 * E_k0
-        ax.semilogy(t, np.maximum(E_k, floor), color=color, lw=1.2, label=r"$E_k = m\dot x^2/2$")
+        ax.semilogy(t, np.maximum(E_k, floor), color=color, lw=1.2, label=r"kinetic $E_k = m\dot x^2/2$")
         ax.semilogy(t, np.maximum(np.abs(E_f_half), floor), color="k", lw=0.7, ls="--",
-                    label=r"$|E_f|$, power integrated from the last reversal (2.8)")
-        ax.plot(t_peak, E_p_rev[: len(t_peak)], "o", color=COLORS[3], ms=3.5, mfc="none",
+                    label=r"$|E_f|$: restoring-force work (2.8) since the last reversal")
+        ax.plot(t_peak, E_p_rev[: len(t_peak)], "o", color="k", ms=4, mfc="none",
                 label=r"$E_p$ (3.9) of the preceding reversal")
-        ax.set_ylim(1e-6 * E_k0, 300 * E_k0)
+        ax.set_ylim(1e-6 * E_k0, 1e4 * E_k0)
         ax.set_ylabel("energy [J]")
-        ax.set_title(rf"$\sigma/F_c$ = {ratio:g} m$^{{-1}}$: {len(rev.t)} reversals", fontsize=10)
+        ax.set_title(rf"$\sigma/F_c$ = {ratio:g} m$^{{-1}}$: {len(rev.t)} reversals in {t_end:g} s", fontsize=10)
         ax.grid(True, which="both", alpha=0.3)
-    axes[0, 0].legend(loc="upper right", ncol=3, fontsize=7.5)
+        ax.legend(loc="upper right", ncol=3, fontsize=7.5)
     axes[-1, 0].set_xlabel("time $t$ [s]")
     axes[-1, 0].set_xlim(0.0, t_end)
     fig.suptitle("Fig. 7: energy time series of the simulated oscillator (2.1) with (3.4)")
