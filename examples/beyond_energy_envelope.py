@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from prefriction import Dahl, Oscillator, exact_reversals, simulate
-from prefriction.plotting import COLORS, add_note, new_figure, save
+from prefriction.plotting import COLORS, add_note, new_mosaic, save
 
 MASS = 1.0  # [kg]
 FC = 1.0  # [N]
@@ -46,7 +46,9 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
     """
     n_exact = 300 if quick else N_EXACT
     t_sim = 2.0 if quick else T_SIM
-    fig, axes = new_figure(1, 2, size=(11.5, 4.6))
+    fig, axes = new_mosaic("AB;AC", size=(12.0, 6.0))
+    ax_e, ax_n, ax_h = axes["A"], axes["B"], axes["C"]
+    ax_h.sharex(ax_n)
     exact, sim = {}, {}
     for color, ratio in zip(COLORS, RATIOS):
         sigma = ratio * FC
@@ -58,32 +60,32 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
         exact[ratio] = {"t": np.asarray(ref.t), "E_p": np.asarray(ref.E_p),
                         "n2E": n**2 * np.asarray(ref.E_p) * sigma / FC**2, "half": half}
         sim[ratio] = {"t": np.asarray(run.t), "E_p": np.asarray(run.E_p)}
-        ax = axes[0, 0]
-        ax.loglog(ref.t, ref.E_p, color=color, lw=1.5, label=rf"exact, $\sigma/F_c$ = {ratio:g} m$^{{-1}}$")
-        ax.loglog(run.t, run.E_p, "o", color=color, ms=3, mfc="none")
+        label = rf"$\sigma/F_c$ = {ratio:g} m$^{{-1}}$"
+        ax_e.loglog(ref.t, ref.E_p, color=color, lw=1.5, label=f"exact, {label}")
+        ax_e.loglog(run.t, run.E_p, "o", color=color, ms=3, mfc="none")
         tt = np.geomspace(ref.t[0], ref.t[-1], 50)
-        ax.loglog(tt, law(tt, sigma), "--", color="k", lw=1.0)
-        ax = axes[0, 1]
-        ax.semilogx(n, exact[ratio]["n2E"], color=color, lw=1.5,
-                    label=rf"$n^2 E_p \sigma/F_c^2$, $\sigma/F_c$ = {ratio:g} m$^{{-1}}$")
-        ax.semilogx(n[1:], half, color=color, lw=1.0, ls="-.")
-    ax = axes[0, 0]
-    ax.plot([], [], "ko", ms=3, mfc="none", label="simulated (Fig. 7 runs)")
-    ax.plot([], [], "k--", lw=1.0, label=r"$9\pi^2 m F_c^2/(8\sigma^2 t^2)$")
-    ax.set_xlabel("time of the reversal $t_n$ [s]")
-    ax.set_ylabel(r"potential energy at the reversal $E_p$ [J]")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(loc="lower left", fontsize=8)
-    ax.set_title(r"reversal energies against the $t^{-2}$ law")
-    ax = axes[0, 1]
-    ax.axhline(9.0 / 8.0, color="k", ls="--", lw=1.0, label="9/8")
-    ax.axhline(1.0, color="0.4", ls=":", lw=1.0, label=r"1 (dash-dot: half-cycle / $\pi\sqrt{m/\sigma}$)")
-    ax.set_ylim(0.0, 1.6)
-    ax.set_xlabel("reversal number $n$ [-]")
-    ax.set_ylabel("normalised value [-]")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(loc="lower right", fontsize=8)
-    ax.set_title("the two ingredients of the law")
+        ax_e.loglog(tt, law(tt, sigma), "--", color="k", lw=1.0)
+        ax_n.semilogx(n, exact[ratio]["n2E"], color=color, lw=1.5, label=label)
+        ax_h.loglog(n[1:], half - 1.0, color=color, lw=1.5, label=label)
+    ax_e.plot([], [], "ko", ms=3, mfc="none", label="simulated (the runs of Fig. 7)")
+    ax_e.plot([], [], "k--", lw=1.0, label=r"$9\pi^2 m F_c^2/(8\sigma^2 t^2)$")
+    ax_e.set_xlabel("time of the reversal $t_n$ [s]")
+    ax_e.set_ylabel(r"potential energy at the reversal $E_p$ [J]")
+    ax_e.grid(True, which="both", alpha=0.3)
+    ax_e.legend(loc="lower left", fontsize=8)
+    ax_e.set_title(r"(a) reversal energies against the $t^{-2}$ law", fontsize=11)
+    ax_n.axhline(9.0 / 8.0, color="k", ls="--", lw=1.0, label="limit 9/8")
+    ax_n.set_ylim(0.0, 1.25)
+    ax_n.set_ylabel(r"$n^2 E_p\,\sigma/F_c^2$ [-]")
+    ax_n.grid(True, which="both", alpha=0.3)
+    ax_n.legend(loc="lower right", fontsize=8)
+    ax_n.set_title(r"(b) energy against reversal number: $E_p \to 9F_c^2/(8\sigma n^2)$", fontsize=11)
+    ax_n.tick_params(labelbottom=False)
+    ax_h.set_xlabel("reversal number $n$ [-]")
+    ax_h.set_ylabel(r"$T_n/(\pi\sqrt{m/\sigma}) - 1$ [-]")
+    ax_h.grid(True, which="both", alpha=0.3)
+    ax_h.legend(loc="lower left", fontsize=8)
+    ax_h.set_title(r"(c) half-cycle duration $T_n \to \pi\sqrt{m/\sigma}$ (linear spring)", fontsize=11)
     add_note(fig, f"m = {MASS:g} kg, Fc = {FC:g} N, x(0) = 0, F(0) = 0, v(0) = {V0:g} m/s (as in Fig. 7); "
                   f"exact reference over {n_exact:,} reversals.")
     png = save(fig, outdir, "beyond_energy_envelope.png")

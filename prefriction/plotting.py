@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import Union
 
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 PathLike = Union[str, Path]
@@ -46,6 +47,26 @@ def new_figure(
     fig = Figure(figsize=size, layout="constrained")
     axes = fig.subplots(nrows, ncols, sharex=sharex, sharey=sharey, squeeze=False)
     return fig, axes
+
+
+def new_mosaic(layout: str, *, size: tuple[float, float] = (7.0, 4.5)) -> tuple[Figure, dict[str, Axes]]:
+    """Create a constrained-layout figure with axes laid out by a mosaic string.
+
+    Parameters
+    ----------
+    layout : str
+        Rows separated by ``;``, one letter per cell, e.g. ``"AB;AC"`` (``A`` spans two rows).
+    size : (float, float)
+        Width and height [inch].
+
+    Returns
+    -------
+    fig : matplotlib.figure.Figure
+    axes : dict
+        Letter -> Axes.
+    """
+    fig = Figure(figsize=size, layout="constrained")
+    return fig, fig.subplot_mosaic(layout)
 
 
 def add_note(fig: Figure, text: str, *, lines: int = 1) -> None:
