@@ -1,76 +1,315 @@
-"""Dense output of a run: samples at requested times, integrated through the dense plant."""
+"""Dense output of a run: samples at requested times, integrated through the dense plant.
+
+The samples go into a :class:`SampleBuffer`: one preallocated float column per quantity, grown
+in place (``ndarray.resize``) to an estimate of the final count and trimmed in place at the end,
+so a run's memory stays close to the arrays it returns (no Python float or tuple per sample).
+Outputs of one integrator call (:data:`~prefriction.simulation.run.N_DENSE` of them) are
+converted together; only the columns with a reversal and the last one go through the run's
+per-column bookkeeping.
+"""
 
 from __future__ import annotations
 
-from typing import Optional
+import math
+from typing import TYPE_CHECKING, Iterator, Optional, Sequence
 
 import numpy as np
 
-from prefriction.simulation.run import N_DENSE, Run
+from prefriction.simulation.run import N_DENSE
 
-__all__ = ["DENSE_STEP", "dense", "dense_loop"]
+if TYPE_CHECKING:
+    from prefriction.simulation.run import Run
+
+__all__ = ["DENSE_STEP", "SampleBuffer", "dense", "dense_loop", "samples_si"]
 
 DENSE_STEP = 2.0 * np.pi / 64.0
 """Normalised spacing of ``dense=True`` samples (64 per small cycle)."""
 
+_BLOCK = 4096  # requested times integrated per pass (bounds the temporaries of the time grid)
+_MIN_CAPACITY = 1024
+_GROWTH = 1.25  # least growth of a full buffer (the estimate of the final count usually decides)
 
-def dense(self: Run, times: np.ndarray, t_end: float, n_target: float) -> tuple[list, bool]:
-    """Integrate ``self`` (a :class:`~prefriction.simulation.run.Run`) through the sorted
-    normalised ``times``; returns the samples and the stop flag."""
-    samples = []
+
+class SampleBuffer:
+    """Samples ``(t~, x~, v~, F~, E_f~, xc)`` of a run (normalised units) in growable columns.
+
+    Parameters
+    ----------
+    width : int
+        Number of controller states ``xc`` per sample (0 without a controller).
+    capacity : int, optional
+        Initial capacity (samples).
+
+    Notes
+    -----
+    Each column is one contiguous float array that grows in place; :meth:`columns` trims
+    them in place and hands them out, after which the buffer is empty.
+    """
+
+    def __init__(self, width: int, capacity: int = _MIN_CAPACITY) -> None:
+        self.width = int(width)
+        self.n = 0
+        cap = max(int(capacity), 1)
+        self._cols = [np.empty(cap) for _ in range(5)]  # t, x, v, F, E_f
+        self._xc = np.empty((cap, self.width))
+
+    @property
+    def capacity(self) -> int:
+        """Samples the columns hold before they grow."""
+        return len(self._cols[0])
+
+    def __len__(self) -> int:
+        return self.n
+
+    def __repr__(self) -> str:
+        return f"SampleBuffer({self.n} samples, capacity {self.capacity}, {self.width} controller states)"
+
+    def reserve(self, total: int) -> None:
+        """Grow every column in place to hold at least ``total`` samples."""
+        if total <= self.capacity:
+            return
+        total = int(total)
+        for col in self._cols:
+            col.resize(total, refcheck=False)  # realloc: the first n entries are kept
+        self._xc.resize((total, self.width), refcheck=False)
+
+    def _room(self, k: int) -> None:
+        """Make room for ``k`` more samples (at least :data:`_GROWTH` times the capacity)."""
+        if self.n + k > self.capacity:
+            self.reserve(max(self.n + k, math.ceil(_GROWTH * self.capacity)))
+
+    def append(self, sample: Sequence) -> None:
+        """Add one sample ``(t~, x~, v~, F~, E_f~, xc)`` (as returned by ``Run.sample``)."""
+        self._room(1)
+        i = self.n
+        for col, value in zip(self._cols, sample[:5]):
+            col[i] = value
+        if self.width:
+            self._xc[i] = sample[5]
+        self.n = i + 1
+
+    def extend(self, t: np.ndarray, x: np.ndarray, v: np.ndarray, F: np.ndarray, Ef: np.ndarray,
+               xc: Optional[np.ndarray]) -> None:
+        """Add ``len(t)`` samples; ``Ef`` may be a scalar, ``xc`` has shape ``(len(t), width)`` or
+        ``(width,)`` (the same for every sample); ``F`` may be a list."""
+        k = len(t)
+        self._room(k)
+        i, j = self.n, self.n + k
+        for col, values in zip(self._cols, (t, x, v, F, Ef)):
+            col[i:j] = values
+        if self.width:
+            self._xc[i:j] = xc
+        self.n = j
+
+    def __iter__(self) -> Iterator[tuple]:
+        """The samples one by one as tuples ``(t~, x~, v~, F~, E_f~, xc)``."""
+        t, x, v, F, Ef = (col[: self.n].tolist() for col in self._cols)
+        for i in range(self.n):
+            yield t[i], x[i], v[i], F[i], Ef[i], self._xc[i].copy()
+
+    def columns(self) -> tuple[np.ndarray, ...]:
+        """The columns ``t~, x~, v~, F~, E_f~`` (length ``n``) and ``xc`` (``(n, width)``),
+        trimmed in place; the buffer is empty afterwards."""
+        n = self.n
+        for col in self._cols:
+            col.resize(n, refcheck=False)
+        self._xc.resize((n, self.width), refcheck=False)
+        out = (*self._cols, self._xc)
+        self.__init__(self.width, 1)
+        return out
+
+
+def dense(run: "Run", times: np.ndarray, t_end: float, n_target: float, buf: SampleBuffer) -> bool:
+    """Integrate ``run`` through the sorted normalised ``times``, adding a sample at each to
+    ``buf``; True if the run stopped (``n_target`` reversals or a frozen state)."""
     # breaks up to the last requested time only: the caller continues from there
     last = min(t_end, float(times[-1]))
-    grid = np.union1d(times, self.breaks[(self.breaks > self.st["t"]) & (self.breaks < last)])
-    is_sample = np.isin(grid, times)
+    b = run.breaks
+    grid = np.union1d(times, b[(b > run.st["t"]) & (b < last)]) if b.size else np.asarray(times, dtype=float)
+    is_sample = np.isin(grid, times) if b.size else np.ones(grid.size, dtype=bool)
     i = 0
-    if grid.size and grid[0] <= self.st["t"]:
-        samples.append(self.sample())
+    if grid.size and grid[0] <= run.st["t"]:
+        buf.append(run.sample())
         i = 1
+    n_key = run.L.state["n"]
+    nstop = min(n_target, 1e18)
     while i < grid.size:
-        if len(self.rev) >= n_target:
-            return samples, True
-        pts = list(grid[i:i + N_DENSE])
+        if len(run.rev) >= n_target:
+            return True
+        pts = grid[i:i + N_DENSE]
         m = len(pts)
-        nstop = min(n_target, 1e18)
-        xf, a = self._call(self.f1, self.L, pts, nstop)
-        used = m
-        for j in range(m):
-            out = self._unpack(self.L, xf[:, j], a, len(self.rev), nstop)
-            if out["overflow"]:  # more than K reversals between two outputs: redo that piece
-                if self.advance(pts[j], n_target):
-                    return samples, True
-                used = j + 1
-                if is_sample[i + j]:
-                    samples.append(self.sample())
-                break
-            self._accept(out, pts[j])
-            if out["frozen"]:
-                return samples, True
-            if is_sample[i + j]:
-                samples.append(self.sample())
+        n0 = len(run.rev)
+        xf, a = run._call(run.f1, run.L, pts.tolist(), nstop)
+        cols = xf[:, :m]
+        n_col = np.floor(cols[n_key] + 0.5)
+        total = n_col[-1] - n0
+        new = np.diff(n_col, prepend=n0) if total > 0 else None  # reversals per column
+        if n_col[-1] >= nstop or (total > run.spec.K and new.max() > run.spec.K):  # stop or register
+            # overflow: column by column
+            used, stopped = _columns_one_by_one(run, cols, pts, is_sample[i:i + m], a, n_target, nstop, buf)
+            if stopped:
+                return True
+        else:
+            _columns_together(run, cols, pts, is_sample[i:i + m], a, new, nstop, buf)
+            used = m
         i += used
-    return samples, False
+    return False
 
 
-def dense_loop(run: Run, times: Optional[np.ndarray], t_end: float, n_target: float) -> list:
+def _columns_together(run: "Run", cols: np.ndarray, pts: np.ndarray, is_sample: np.ndarray, a: dict,
+                      new: Optional[np.ndarray], nstop: float, buf: SampleBuffer) -> None:
+    """Take the outputs ``cols`` of one call (no stop, no register overflow): reversals of the
+    columns that have some, the run's state from the last column, samples in one block."""
+    L = run.L
+    if new is not None:
+        for j in np.flatnonzero(new[:-1]):
+            run.rev.extend(run._unpack(L, cols[:, j], a, len(run.rev), nstop)["new"])
+    run._accept(run._unpack(L, cols[:, -1], a, len(run.rev), nstop), float(pts[-1]))
+    if is_sample.all():
+        sel: "slice | np.ndarray" = slice(None)
+    else:
+        sel = np.flatnonzero(is_sample)
+        if sel.size == 0:
+            return
+    c = cols[:, sel]
+    ix = L.state
+    x = a["xref"] + a["Ax"] * c[0]
+    v = a["Av"] * c[1]
+    z = (a["AF"] * c[2:2 + L.nz]).T.tolist()
+    mm = c[[ix[f"m{k}"] for k in range(L.nm)]].T.tolist()
+    s = c[ix["s"]].tolist()
+    force, q = run.model.force, run.q
+    F = [float(force(zj, mj, vj, sj, q)) for zj, mj, vj, sj in zip(z, mm, v.tolist(), s)]
+    Ef = a["Efref"] + a["AE"] * c[ix["Eh"]] if "Eh" in ix else 0.0
+    if not buf.width:
+        xc = None
+    elif run.spec.fb == "continuous":
+        xc = (c[L.xc] * run.S[:, None]).T
+    else:
+        xc = np.asarray(run.st["xc"], dtype=float)  # held: the same for every sample
+    buf.extend(pts[sel], x, v, F, Ef, xc)
+
+
+def _columns_one_by_one(run: "Run", cols: np.ndarray, pts: np.ndarray, is_sample: np.ndarray, a: dict,
+                        n_target: float, nstop: float, buf: SampleBuffer) -> tuple[int, bool]:
+    """Take the outputs of one call column by column (the run stops in it, or more than ``K``
+    reversals fell between two outputs: that piece is integrated again by ``advance``).
+    Returns the number of outputs used and whether the run stopped."""
+    L = run.L
+    for j in range(cols.shape[1]):
+        out = run._unpack(L, cols[:, j], a, len(run.rev), nstop)
+        t = float(pts[j])
+        if out["overflow"]:
+            if run.advance(t, n_target):
+                return j + 1, True
+            if is_sample[j]:
+                buf.append(run.sample())
+            return j + 1, False
+        run._accept(out, t)
+        if out["frozen"]:
+            return j + 1, True
+        if is_sample[j]:
+            buf.append(run.sample())
+    return cols.shape[1], False
+
+
+def _estimate(run: "Run", buf: SampleBuffer, t_end: float, n_target: float) -> float:
+    """Estimated final number of samples: by the time left to ``t_end`` and by the mean duration
+    of the last (up to 64) half-cycles times the reversals still to come."""
+    t_now = run.st["t"]
+    est = len(buf) + max(t_end - t_now, 0.0) / DENSE_STEP + 2.0
+    rev = run.rev
+    k = min(len(rev), 64)
+    if k >= 2 and math.isfinite(n_target):
+        per_rev = (rev[-1][0] - rev[-k][0]) / (k - 1)
+        t_last = rev[-1][0] + max(n_target - len(rev), 0.0) * per_rev  # of the n_target-th reversal
+        est = min(est, len(buf) + max(t_last - t_now, 0.0) / DENSE_STEP + 2.0)
+    return est
+
+
+def dense_loop(run: "Run", times: Optional[np.ndarray], t_end: float, n_target: float) -> SampleBuffer:
     """Samples at the normalised ``times`` (every ``DENSE_STEP`` if None), integrating up to the
     normalised time ``t_end`` or ``n_target`` reversals."""
+    buf = SampleBuffer(len(run.st["xc"]))
     if times is not None:
-        samples, stopped = dense(run, times, t_end, n_target)
-        if not stopped:
-            run.advance(t_end, n_target)
-        return samples
-    samples: list = []
-    stopped = False
-    t0 = 0.0
-    while not stopped and t0 <= t_end:
-        block = t0 + DENSE_STEP * np.arange(0, 256)
+        buf.reserve(len(times))  # the user's array bounds the count
+        for k in range(0, len(times), _BLOCK):
+            if dense(run, times[k:k + _BLOCK], t_end, n_target, buf):
+                return buf
+        run.advance(t_end, n_target)
+        return buf
+    k0 = 0  # index of the next sample: t~ = k DENSE_STEP
+    while True:
+        block = DENSE_STEP * np.arange(k0, k0 + _BLOCK, dtype=float)
         block = block[block <= t_end]
         if block.size and block[-1] < t_end < block[-1] + DENSE_STEP:
             block = np.append(block, t_end)  # the last sample is at t_end
         if block.size == 0:
-            break
-        got, stopped = dense(run, block, t_end, n_target)
-        samples.extend(got)
-        t0 = block[-1] + DENSE_STEP
-    return samples
+            return buf
+        if len(buf) + block.size > buf.capacity:  # grow to the estimated final count (2 % margin),
+            # at most doubling: an estimate made early (gross sliding) may be far off
+            est = 1.02 * _estimate(run, buf, t_end, n_target) + 2 * N_DENSE
+            buf.reserve(max(len(buf) + block.size, int(min(est, 2 * buf.capacity))))
+        if dense(run, block, t_end, n_target, buf):
+            return buf
+        k0 += _BLOCK
+
+
+def samples_si(run: "Run", samples: "SampleBuffer | Sequence[tuple]", u_hist: Sequence[float],
+               times_si: Optional[np.ndarray], n_user: int) -> dict:
+    """The samples of ``run`` as the SI fields of :class:`~prefriction.simulation.result.SimulationResult`.
+
+    The columns of a :class:`SampleBuffer` are converted in place (the buffer is emptied), so
+    the memory stays that of the returned arrays.
+
+    Parameters
+    ----------
+    run : Run
+        The finished run (its system, feedback, scales and plant).
+    samples : SampleBuffer or sequence of tuple
+        Samples ``(t~, x~, v~, F~, E_f~, xc)`` in normalised units.
+    u_hist : sequence of float
+        Total applied force [N] at the samples of a sampled loop (empty otherwise).
+    times_si : numpy.ndarray or None
+        The requested sample times [s] (None: every ``DENSE_STEP``).
+    n_user : int
+        Controller states of the user's feedback (the padded ones are dropped).
+
+    Returns
+    -------
+    dict
+        ``t, x, v, F, E_k`` [s, m, m/s, N, J] and, where defined, ``E_f`` [J], ``u`` [N], ``xc``.
+    """
+    system, feedback, sc = run.system, run.fb, run.sc
+    if not isinstance(samples, SampleBuffer):
+        buf = SampleBuffer(len(samples[0][5]) if len(samples) else 0, max(len(samples), 1))
+        for sample in samples:
+            buf.append(sample)
+        samples = buf
+    t, x, v, F, Ef, xc = samples.columns()
+    n = len(t)
+    if run.spec.energy and times_si is not None:
+        t = times_si[:n].copy()  # the requested times exactly (no unit round trip)
+    else:
+        t *= sc.t
+    x *= sc.x
+    v *= sc.v
+    F *= sc.F
+    E_k = np.square(v)
+    E_k *= 0.5 * system.mass
+    extra = {"t": t, "x": x, "v": v, "F": F, "E_k": E_k}
+    if run.spec.energy:
+        Ef *= sc.E
+        extra["E_f"] = Ef
+    if system.forced or feedback is not None:
+        if feedback is not None and feedback.sampled:
+            extra["u"] = np.array(u_hist, dtype=float)
+        else:
+            u = np.asarray(system.u(t), dtype=float) if system.forced else np.zeros(n)
+            if feedback is not None:
+                e = np.asarray(feedback.reference(t), dtype=float) - x
+                u = u + (xc @ feedback.C[0] if run.spec.n_c else 0.0) + feedback.D[0, 0] * e
+            extra["u"] = u
+    if feedback is not None:
+        extra["xc"] = xc[:, :n_user]
+    return extra
