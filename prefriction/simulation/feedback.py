@@ -22,6 +22,7 @@ D = [[kp + kd/tau]]`` (a filtered derivative); a pure gain ``kp`` is ``A, B, C``
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Any, Callable, Optional, Union
 
@@ -30,6 +31,42 @@ import numpy as np
 from prefriction._validation import check_positive
 
 Reference = Union[float, Callable[[Any], Any], tuple]
+
+MAX_SAMPLES = 10_000_000
+"""Largest number of sample instants of a sampled loop: each keeps about ten numbers of output
+(about 1 GB at the limit) and costs microseconds (a minute at the limit); more would exhaust the
+memory or appear to hang. Split a longer run, or sample less often."""
+
+
+def sample_count(t_end: float, Ts: float, periods: float) -> int:
+    """Number of sample instants ``min(k Ts, t_end)``, ``k = 0, 1, ...`` up to the first one at
+    ``t_end`` (within a relative 1e-12), in any one time unit for ``t_end`` and ``Ts``.
+
+    Parameters
+    ----------
+    t_end, Ts : float
+        End time and sample period (same unit).
+    periods : float
+        ``t_end / Ts`` in SI, for the message.
+
+    Raises
+    ------
+    ValueError
+        If there would be more than :data:`MAX_SAMPLES` instants.
+    """
+    if not periods < MAX_SAMPLES - 1:
+        raise ValueError(
+            f"t_end / Ts = {periods:.6g} sample periods: at most {MAX_SAMPLES - 1} are allowed (MAX_SAMPLES = "
+            f"{MAX_SAMPLES} sample instants; more would exhaust the memory or run for hours); increase Ts or "
+            "split the run"
+        )
+    stop = t_end * (1 - 1e-12)
+    k = max(int(math.ceil(stop / Ts)), 0)
+    while k > 0 and (k - 1) * Ts >= stop:
+        k -= 1
+    while k * Ts < stop:
+        k += 1
+    return k + 1
 
 
 def _as_matrix(name: str, value: Any, shape: tuple[int, int]) -> np.ndarray:

@@ -1,0 +1,195 @@
+"""The sampled-data loop as one compiled CasADi Function: many samples per call.
+
+One sample period ``[t_k, t_{k+1}]`` of the loop (docs/controllers.md#compiled-loop):
+
+1. the error ``e_k = r_k - x(t_k)`` [m] and the controller output ``v_k = C xc_k + D e_k`` [N];
+   the applied force ``u_k = clip(v_k, -u_max, u_max)``, held over the period (zero-order hold);
+2. the controller update ``xc_{k+1} = A xc_k + B e_k + Ts k_aw (u_k - v_k)`` (back-calculation
+   anti-windup; ``k_aw = 0`` and ``u_max = 1e300`` give the linear law);
+3. a mass at rest whose net force ``u_k + d(t_k) - F`` leaves the rest threshold starts to move
+   (a reversal at ``t_k`` if it leaves backwards), exactly as
+   :meth:`prefriction.simulation.run.Run._leave_rest`;
+4. the plant of :func:`prefriction.simulation.plant.build_integrator` (the forced register
+   model with a piecewise-linear input, the held force added to its piece) integrated over the
+   period, every reversal located inside it, unless the mass rests and stays at rest (the
+   integrator is then skipped: ``casadi.Function.conditional`` evaluates only the branch taken).
+
+:func:`loop_function` repeats this with ``Function.mapaccum`` over ``block`` samples. Every
+number is a run-time input: the controller matrices, ``u_max``, ``k_aw``, ``Ts``, the reference
+samples, the model's numbers and the tolerance; the structure is the plant's, the controller
+order and the block length.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import casadi as ca
+
+from prefriction.simulation.plant import EPS_REST, Layout, PlantSpec, build_integrator
+
+__all__ = ["LoopLayout", "LoopSpec", "loop_function"]
+
+NSTOP = 2.0
+"""Reversals after which the plant stops within one period (its register length ``K``): a
+period with more reversals is finished by the Python loop (:mod:`.runner`)."""
+
+
+@dataclass(frozen=True)
+class LoopSpec:
+    """Structure of a compiled loop: the plant's structure, the controller order, the block length."""
+
+    plant: PlantSpec
+    n_c: int
+    block: int
+
+
+class LoopLayout:
+    """Index map of the loop state ``S``, the per-sample inputs ``w``, the parameters and the records."""
+
+    def __init__(self, spec: LoopSpec) -> None:
+        L = Layout(spec.plant)
+        self.plant = L
+        nz, nm, n = L.nz, L.nm, spec.n_c
+        names = ["x", "v"] + [f"z{i}" for i in range(nz)] + [f"m{i}" for i in range(nm)]
+        names += ["s", "rest", "W", "Amax"] + [f"xc{i}" for i in range(n)]
+        self.state = {k: i for i, k in enumerate(names)}
+        self.nS = len(names)
+        self.inp = {k: i for i, k in enumerate(["t0", "t1", "r", "active", "tl", "da", "db"])}
+        self.nw = len(self.inp)
+        self.p_plant = slice(0, L.np)
+        o = L.np
+        self.p_A = slice(o, o + n * n)
+        self.p_B = slice(self.p_A.stop, self.p_A.stop + n)
+        self.p_C = slice(self.p_B.stop, self.p_B.stop + n)
+        self.p_kaw = slice(self.p_C.stop, self.p_C.stop + n)
+        rest = ["D", "umax", "Ts", "force_scale"]
+        self.param = {k: self.p_kaw.stop + i for i, k in enumerate(rest)}
+        self.npar = self.p_kaw.stop + len(rest)
+        K = spec.plant.K
+        rec = ["F", "u", "moved", "lr", "lr_t", "lr_x", "lr_F", "lr_W", "n_new"]
+        self.rec = {k: self.nS + i for i, k in enumerate(rec)}
+        self.reg = self.nS + len(rec)
+        self.nrec = self.reg + 4 * K
+
+
+def _step(spec: LoopSpec, LL: LoopLayout) -> ca.Function:
+    """One sample period: ``(S, w, par) -> (S_next, record)`` (record: the state at ``t_k``, the
+    friction force, the applied force, a reversal at ``t_k`` and the plant's register)."""
+    L, model, n = LL.plant, spec.plant.model, spec.n_c
+    S, w, par = ca.SX.sym("S", LL.nS), ca.SX.sym("w", LL.nw), ca.SX.sym("par", LL.npar)
+    st = {k: S[i] for k, i in LL.state.items()}
+    wi = {k: w[i] for k, i in LL.inp.items()}
+    pp = {k: par[i] for k, i in LL.param.items()}
+    P0 = par[LL.p_plant]
+    pl = {k: P0[i] for k, i in L.param.items()}
+    q = P0[L.q]
+    x, v, s, W = st["x"], st["v"], st["s"], st["W"]
+    z = [st[f"z{i}"] for i in range(L.nz)]
+    m = [st[f"m{i}"] for i in range(L.nm)]
+    xc = ca.vertcat(*[st[f"xc{i}"] for i in range(n)]) if n else ca.SX(0, 1)
+    F = model.force(z, m, v, s, q)
+    active = wi["active"] > 0.5
+    # controller (SI): error, raw output, clipped force, update with back-calculation
+    e = wi["r"] - x * pl["xunit"]
+    raw = (ca.dot(par[LL.p_C], xc) if n else 0.0) + pp["D"] * e
+    u = ca.fmin(ca.fmax(raw, -pp["umax"]), pp["umax"])
+    t_si = wi["t0"] * pl["tunit"]
+    u_total = u + wi["da"] + wi["db"] * (t_si - wi["tl"])  # with the oscillator's own input
+    if n:
+        A = ca.reshape(par[LL.p_A], n, n)
+        xc_next = ca.mtimes(A, xc) + par[LL.p_B] * e + pp["Ts"] * par[LL.p_kaw] * (u - raw)
+        xc_next = ca.if_else(active, xc_next, xc)
+    # amplitude scales of the period (Run._scales, forced), first with the state at t_k
+    A0 = ca.hypot(v, F)
+    Amax = ca.fmax(st["Amax"], A0)
+    A_rest = ca.fmax(ca.fmax(ca.fmax(A0, pp["force_scale"]), 0.1 * Amax), 1e-150)
+    # leaving rest at t_k (Run._leave_rest): the net force left the rest threshold
+    acc = u_total / pl["Fc"] - F
+    leaving = ca.logic_and(st["rest"] > 0.5, ca.fabs(acc) > EPS_REST * pl["eps"] * A_rest)
+    new_s = ca.if_else(acc > 0, 1.0, -1.0)
+    back = ca.logic_and(leaving, new_s != s)
+    zr, mr = model.reverse(z, m, new_s, q, pl["snap"])
+    z1 = [ca.if_else(back, zr[i], z[i]) for i in range(L.nz)]
+    m1 = [ca.if_else(back, mr[i], m[i]) for i in range(L.nm)]
+    s1 = ca.if_else(back, new_s, s)
+    W1 = ca.if_else(back, 0.0, W)
+    rest1 = ca.if_else(leaving, 0.0, st["rest"])
+    F1 = model.force(z1, m1, v, s1, q)
+    A1 = ca.hypot(v, F1)
+    Amax = ca.fmax(Amax, A1)
+    A = ca.fmax(ca.fmax(ca.fmax(A1, pp["force_scale"]), 0.1 * Amax), 1e-150)
+    eps = pl["eps"]
+    Ax = ca.fmax(ca.fmax(A, 0.5 * A * A), ca.fmin(ca.fabs(x), 1.0)) * eps
+    Av, AF, AE = A * eps, ca.fmin(A, 1.0) * eps, A * A * eps
+    # the plant's arguments (Run._pack, Run._params, Run._controls)
+    X0 = ca.SX.zeros(L.nx)
+    ix = L.state
+    X0[ix["vh"]] = v / Av
+    for i in range(L.nz):
+        X0[ix[f"z{i}"]] = z1[i] / AF
+    for i in range(L.nm):
+        X0[ix[f"m{i}"]] = m1[i]
+    X0[ix["s"]] = s1
+    X0[ix["rest"]] = rest1
+    X0[ix["Wh"]] = W1 / AE
+    P = ca.SX(P0)
+    for k, val in (("Ax", Ax), ("Av", Av), ("AF", AF), ("AE", AE), ("xref", x), ("Efref", 0.0), ("nstop", NSTOP)):
+        P[L.param[k]] = val
+    U = ca.SX.zeros(L.nu)
+    U[L.control["dur"]] = wi["t1"] - wi["t0"]
+    U[L.control["t0"]] = wi["t0"]
+    U[L.uc.start] = wi["tl"]
+    U[L.uc.start + 1] = wi["da"] + u
+    U[L.uc.start + 2] = wi["db"]
+    # skip the integrator: padding, the last sample, or a mass that rests and stays at rest
+    skip = ca.logic_or(ca.logic_not(active),
+                       ca.logic_and(rest1 > 0.5, wi["db"] == 0.0))
+    pre = ca.Function("pre", [S, w, par], [X0, P, U, skip])
+    # the state after the period, from the plant's state at its end (Run._unpack)
+    Xe = ca.SX.sym("Xe", L.nx)
+    ze = [AF * Xe[ix[f"z{i}"]] for i in range(L.nz)]
+    me = [Xe[ix[f"m{i}"]] for i in range(L.nm)]
+    moved = ca.logic_not(skip)
+    nxt = {"x": x + Ax * Xe[ix["xh"]], "v": Av * Xe[ix["vh"]], "s": Xe[ix["s"]], "rest": Xe[ix["rest"]],
+           "W": AE * Xe[ix["Wh"]]}
+    nxt.update({f"z{i}": ze[i] for i in range(L.nz)})
+    nxt.update({f"m{i}": me[i] for i in range(L.nm)})
+    kept = {"x": x, "v": v, "s": s1, "rest": rest1, "W": W1}
+    kept.update({f"z{i}": z1[i] for i in range(L.nz)})
+    kept.update({f"m{i}": m1[i] for i in range(L.nm)})
+    S_next = ca.SX.zeros(LL.nS)
+    for k, val in nxt.items():
+        S_next[LL.state[k]] = ca.if_else(moved, val, kept[k])
+    S_next[LL.state["Amax"]] = Amax
+    for i in range(n):
+        S_next[LL.state[f"xc{i}"]] = xc_next[i]
+    rec = ca.SX.zeros(LL.nrec)
+    rec[: LL.nS] = S
+    r = LL.rec
+    rec[r["F"]], rec[r["u"]], rec[r["moved"]] = F, u_total, moved
+    rec[r["lr"]], rec[r["lr_t"]], rec[r["lr_x"]], rec[r["lr_F"]], rec[r["lr_W"]] = back, wi["t0"], x, F, W
+    rec[r["n_new"]] = ca.if_else(moved, Xe[ix["n"]], 0.0)
+    rec[LL.reg:] = Xe[L.reg:]
+    post = ca.Function("post", [S, w, par, Xe], [S_next, rec])
+    # glue (MX): the plant runs only in the branch that integrates
+    plant = build_integrator(spec.plant)
+    Xs, Us, Ps = ca.MX.sym("X", L.nx), ca.MX.sym("U", L.nu), ca.MX.sym("P", L.np)
+    run = ca.Function("run", [Xs, Ps, Us], [plant(x0=Xs, p=Ps, u=Us)["xf"]])
+    hold = ca.Function("hold", [Xs, Ps, Us], [Xs])
+    cond = ca.Function.conditional("period", [run], hold)
+    Sm, wm, pm = ca.MX.sym("S", LL.nS), ca.MX.sym("w", LL.nw), ca.MX.sym("par", LL.npar)
+    X0m, Pm, Um, skipm = pre(Sm, wm, pm)
+    Xem = cond(skipm, X0m, Pm, Um)
+    S1, recm = post(Sm, wm, pm, Xem)
+    return ca.Function("loop_step", [Sm, wm, pm], [S1, recm])
+
+
+def loop_function(spec: LoopSpec) -> ca.Function:
+    """``(S0, W, par) -> (S, R)``: ``spec.block`` sample periods; ``W`` holds one column of
+    per-sample inputs per period, ``R`` one record per period, ``S`` the state after each."""
+    LL = LoopLayout(spec)
+    step = _step(spec, LL)
+    name = f"{type(spec.plant.model).__name__.lower()}_loop{spec.n_c}_{spec.block}"
+    return step.mapaccum(name, spec.block, 1)

@@ -1,0 +1,340 @@
+"""Drive the compiled sampled-data loop block by block (Python only between blocks).
+
+:func:`run_sampled` prepares the per-sample inputs (sample times, reference samples) and the
+run-time parameters, calls the compiled block Function of :mod:`.compiled_loop` over
+``BLOCK`` samples at a time through persistent buffers, and assembles the samples and the
+reversal table in SI. A period with more reversals than the plant's register holds
+(``NSTOP``) is finished by :class:`prefriction.simulation.run.Run`, the loop of
+:func:`prefriction.simulate`, and the next block starts after it.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+from dataclasses import dataclass
+from typing import Any, Optional
+
+import casadi as ca
+import numpy as np
+
+from prefriction.errors import SolverError
+from prefriction.models import Oscillator
+from prefriction.signals import Constant
+from prefriction.simulation.compiled import compiled, jit_available
+from prefriction.simulation.feedback import LinearFeedback, sample_count
+from prefriction.simulation.force_scale import applied_force_scale
+from prefriction.simulation.plant import Layout, PlantSpec
+from prefriction.simulation.result import RunStats, SimulationResult
+from prefriction.simulation.run import Run
+from prefriction.simulation.simulate import _CAL, _reversal_table
+from prefriction.units import Scales
+
+from .compiled_loop import NSTOP, LoopLayout, LoopSpec, loop_function
+
+__all__ = ["BLOCK", "LoopStats", "run_sampled"]
+
+BLOCK = 256
+"""Sample periods per compiled call (a structure; the last block of a run is padded)."""
+_MIN_ORDER = 2  # controllers are padded to this order: P, PD and PID loops share one Function
+_K = 2  # the plant's register length, as in prefriction.simulate
+_CACHE: dict = {}
+
+
+@dataclass(frozen=True)
+class LoopStats:
+    """Statistics of one compiled loop run.
+
+    Attributes
+    ----------
+    samples : int
+        Sample instants (periods + 1).
+    blocks : int
+        Calls of the compiled block Function.
+    integrated : int
+        Periods in which the plant was integrated (the others rested: skipped).
+    finished_in_python : int
+        Periods with more than ``NSTOP`` reversals, finished by the Python loop.
+    wall_time, setup_time : float
+        Wall time of the loop and of building, compiling or loading the Function [s].
+    jit : str
+        ``"compiled"``, ``"cached"`` or ``"interpreted"``.
+    """
+
+    samples: int
+    blocks: int
+    integrated: int
+    finished_in_python: int
+    wall_time: float
+    setup_time: float
+    jit: str
+
+
+class _Block:
+    """The compiled block Function of a structure with persistent argument and result buffers."""
+
+    def __init__(self, spec: LoopSpec, jit: bool) -> None:
+        start = time.perf_counter()
+        self.LL = LL = LoopLayout(spec)
+        mapped = loop_function(spec)
+        S0 = ca.MX.sym("S0", LL.nS)
+        W = ca.MX.sym("W", LL.nw, spec.block)
+        par = ca.MX.sym("par", LL.npar)
+        S, R = mapped(S0, W, ca.repmat(par, 1, spec.block))
+        fun = ca.Function(mapped.name(), [S0, W, par], [S[:, -1], R])
+        self.mode = "interpreted"
+        if jit:
+            what = (f"{spec.plant.model_key[2]}, sampled loop, controller of order {spec.n_c}, "
+                    f"{spec.block} samples per call")
+            fun, info = compiled(fun, what)
+            self.mode = info.mode
+        self.fun = fun
+        self.S0 = np.zeros(LL.nS)
+        self.W = np.zeros((spec.block, LL.nw))  # row j = column j of CasADi's column-major W
+        self.par = np.zeros(LL.npar)
+        self.S = np.zeros(LL.nS)
+        self.R = np.zeros((spec.block, LL.nrec))
+        self.buf, self.trigger = fun.buffer()
+        for i, arr in enumerate((self.S0, self.W, self.par)):
+            self.buf.set_arg(i, memoryview(arr.reshape(-1)))
+        self.buf.set_res(0, memoryview(self.S))
+        self.buf.set_res(1, memoryview(self.R.reshape(-1)))
+        self.setup_time = time.perf_counter() - start
+
+
+def _block(spec: LoopSpec, jit: bool) -> tuple[_Block, float, str]:
+    """The block Function of ``spec`` (built once per process and structure), setup time, mode."""
+    jit = jit and jit_available()
+    key = (spec, jit)
+    if key in _CACHE:
+        blk = _CACHE[key]
+        return blk, 0.0, "interpreted" if blk.mode == "interpreted" else "cached"
+    blk = _Block(spec, jit)
+    _CACHE[key] = blk
+    return blk, blk.setup_time, blk.mode
+
+
+def _padded(M: np.ndarray, n: int, shape: tuple[int, int]) -> np.ndarray:
+    out = np.zeros(shape)
+    out[: M.shape[0], : M.shape[1]] = M
+    return out
+
+
+def run_sampled(
+    system: Oscillator, fb: LinearFeedback, t_end: float, *, x0: float, v0: float, F0: float,
+    rtol: float, jit: bool, u_max: Optional[float] = None, k_aw: Optional[np.ndarray] = None,
+    block: int = BLOCK,
+) -> tuple[SimulationResult, LoopStats]:
+    """Run the sampled loop ``fb`` (``fb.Ts`` set) on ``system`` (no input force) up to ``t_end`` [s].
+
+    Parameters
+    ----------
+    system : Oscillator
+        The plant, without an input force (``system.u is None``).
+    fb : LinearFeedback
+        Discrete controller (SI), its reference and initial state.
+    t_end : float
+        End time [s].
+    x0, v0, F0 : float
+        Initial position [m], velocity [m/s], friction force [N].
+    rtol : float
+        Tolerance of the plant, as in :func:`prefriction.simulate`.
+    jit : bool
+        Compile the block Function (cached on disk).
+    u_max : float, optional
+        Force limit [N]; ``None``: no limit.
+    k_aw : numpy.ndarray, optional
+        Back-calculation gains per controller state [1/(N s)] (with ``u_max``).
+    block : int, default BLOCK
+        Sample periods per compiled call.
+
+    Returns
+    -------
+    (SimulationResult, LoopStats)
+        Samples at the sample instants (``t, x, v, F, E_k, u, xc``), the reversal table, and
+        the loop's statistics.
+    """
+    if system.forced:
+        raise ValueError("the compiled sampled loop needs an oscillator without an input force (system.u = None)")
+    model, sc, Fc = system.friction, Scales.of(system), system.friction.Fc
+    n_user = fb.n_states
+    n = max(n_user, _MIN_ORDER)
+    plant = PlantSpec.of(model, Constant(0.0), None, fb="none", n_c=0, energy=False, K=_K, n_out=1,
+                         method="erk", compact=True)
+    spec = LoopSpec(plant, n, block)
+    L = Layout(plant)
+    eps = rtol * _CAL * math.sqrt(L.n_active / L.nx)
+    Ts_n, t_end_n = fb.Ts / sc.t, t_end / sc.t
+    n_s = sample_count(t_end_n, Ts_n, t_end / fb.Ts)
+    tk = np.minimum(np.arange(n_s) * Ts_n, t_end_n)
+    blk, setup, mode = _block(spec, jit)
+    LL = blk.LL
+    # run-time parameters: the plant's constants, the controller (SI, padded), limit, scales
+    par = blk.par
+    par[:] = 0.0
+    P0 = par[LL.p_plant]
+    pl = L.param
+    P0[pl["eps"]], P0[pl["snap"]] = eps, rtol
+    P0[pl["tunit"]], P0[pl["xunit"]], P0[pl["Fc"]] = sc.t, sc.x, sc.F
+    P0[L.q] = model.runtime_params_for(sc)
+    A = _padded(fb.A, n, (n, n))
+    par[LL.p_A] = A.T.ravel()  # column-major, as ca.reshape reads it
+    par[LL.p_B] = _padded(fb.B, n, (n, 1))[:, 0]
+    par[LL.p_C] = _padded(fb.C, n, (1, n))[0]
+    if k_aw is not None:
+        par[LL.p_kaw.start: LL.p_kaw.start + len(k_aw)] = k_aw
+    par[LL.param["D"]] = fb.D[0, 0]
+    par[LL.param["umax"]] = 1e300 if u_max is None else u_max
+    par[LL.param["Ts"]] = fb.Ts
+    par[LL.param["force_scale"]] = applied_force_scale(system, fb, x0, t_end) / Fc
+    # per-sample inputs
+    Wall = np.zeros((n_s + block, LL.nw))
+    ii = LL.inp
+    Wall[:, ii["t0"]] = t_end_n
+    Wall[:, ii["t1"]] = t_end_n
+    Wall[:n_s, ii["t0"]] = tk
+    Wall[: n_s - 1, ii["t1"]] = tk[1:]
+    Wall[: n_s - 1, ii["active"]] = 1.0
+    Wall[:n_s, ii["r"]] = np.asarray(fb.reference(tk * sc.t), dtype=float)
+    xc0 = _padded(fb.xc0.reshape(1, -1), n, (1, n))[0]
+    S, s0 = _initial_state(system, fb, LL, x0, v0, F0, xc0, u_max)
+    recs = np.empty((n_s, LL.nrec))
+    rev: list = []
+    blocks = finished = 0
+    start = time.perf_counter()
+    k = 0
+    while k < n_s:
+        blk.S0[:] = S
+        blk.W[:] = Wall[k: k + block]
+        try:
+            blk.trigger()
+            failed = blk.buf.ret() != 0
+        except RuntimeError as exc:
+            failed, why = True, str(exc).strip().splitlines()[-1]
+        else:
+            why = "the integrator stopped with an error (a step below its minimum, or more steps or events than allowed)"
+        blocks += 1
+        R = blk.R
+        if failed or not np.all(np.isfinite(R)):
+            raise _failure(S, LL, sc, tk[k], tk[min(k + block, n_s - 1)], why)
+        count = min(block, n_s - k)
+        over = np.nonzero(R[:count, LL.rec["n_new"]] >= NSTOP - 0.5)[0]
+        upto = int(over[0]) + 1 if over.size else count
+        recs[k: k + upto] = R[:upto]
+        _collect(rev, R[:upto], LL, _K, skip_last=bool(over.size))
+        if over.size:  # finish this period with the Python loop of prefriction.simulate
+            j = k + upto - 1
+            S = _finish_in_python(system, fb, plant, eps, rtol, jit, R[upto - 1, : LL.nS].copy(), LL, tk, j,
+                                  Wall[j, ii["r"]], par, rev, u_max, bool(R[upto - 1, LL.rec["lr"]] > 0.5))
+            finished += 1
+        else:
+            S = blk.S.copy()
+        k += upto
+    wall = time.perf_counter() - start
+    integrated = int(np.count_nonzero(recs[:, LL.rec["moved"]] > 0.5)) + finished
+    table, W_r = _reversal_table(rev, system, s0, v0, F0)
+    ix = LL.state
+    t = tk * sc.t
+    x, v = recs[:, ix["x"]] * sc.x, recs[:, ix["v"]] * sc.v
+    xc = recs[:, ix["xc0"]: ix["xc0"] + n_user] if n_user else np.zeros((n_s, 0))
+    stats = RunStats(wall_time=wall, setup_time=setup, calls=blocks, steps=None, jit=mode)
+    sim = SimulationResult(
+        reversals=table, status=0, message=f"reached t_end = {t_end:.9g} s", stats=stats, work_input=W_r,
+        t=t, x=x, v=v, F=recs[:, LL.rec["F"]] * sc.F, E_k=0.5 * system.mass * v * v, u=recs[:, LL.rec["u"]],
+        xc=np.array(xc),
+    )
+    return sim, LoopStats(n_s, blocks, integrated, finished, wall, setup, mode)
+
+
+def _initial_state(system: Oscillator, fb: LinearFeedback, LL: LoopLayout, x0: float, v0: float, F0: float,
+                   xc0: np.ndarray, u_max: Optional[float]) -> tuple[np.ndarray, float]:
+    """Loop state at ``t = 0`` and the initial direction (as ``prefriction.simulate`` starts a loop)."""
+    model, sc, Fc = system.friction, Scales.of(system), system.friction.Fc
+    u0 = float(fb.C[0] @ fb.xc0 + fb.D[0, 0] * (float(fb.reference(0.0)) - x0))
+    if u_max is not None:
+        u0 = min(max(u0, -u_max), u_max)
+    acc0 = (u0 - F0) / Fc
+    rest = 0.0
+    if v0 != 0.0:
+        s0 = 1.0 if v0 > 0 else -1.0
+    elif abs(acc0) > 1e-14:
+        s0 = 1.0 if acc0 > 0 else -1.0
+    else:
+        s0, rest = (-1.0 if F0 > 0 else 1.0), 1.0
+    z, m = model.initial_state(F0 / Fc, s0)
+    S = np.zeros(LL.nS)
+    ix = LL.state
+    S[ix["x"]], S[ix["v"]], S[ix["s"]], S[ix["rest"]] = x0 / sc.x, v0 / sc.v, s0, rest
+    for i, zi in enumerate(z):
+        S[ix[f"z{i}"]] = zi
+    for i, mi in enumerate(m):
+        S[ix[f"m{i}"]] = mi
+    S[ix["xc0"]: ix["xc0"] + len(xc0)] = xc0
+    return S, s0
+
+
+def _collect(rev: list, R: np.ndarray, LL: LoopLayout, K: int, *, skip_last: bool) -> None:
+    """Append the reversals recorded in the periods ``R`` (a reversal when leaving rest at ``t_k``,
+    then the plant's register, oldest first); the register of the last period only if not ``skip_last``."""
+    r = LL.rec
+    rows = np.nonzero((R[:, r["lr"]] > 0.5) | (R[:, r["n_new"]] > 0.5))[0]
+    for j in rows:
+        row = R[j]
+        if row[r["lr"]] > 0.5:
+            rev.append((row[r["lr_t"]], row[r["lr_x"]], row[r["lr_F"]], row[r["lr_W"]]))
+        if skip_last and j == len(R) - 1:
+            continue
+        for i in range(min(int(row[r["n_new"]] + 0.5), K) - 1, -1, -1):
+            b = LL.reg + 4 * i
+            rev.append(tuple(row[b: b + 4]))
+
+
+def _finish_in_python(system: Oscillator, fb: LinearFeedback, plant: PlantSpec, eps: float, rtol: float, jit: bool,
+                      S: np.ndarray, LL: LoopLayout, tk: np.ndarray, j: int, r: float, par: np.ndarray,
+                      rev: list, u_max: Optional[float], lr_recorded: bool) -> np.ndarray:
+    """Redo period ``j`` from the state ``S`` at its start with :class:`Run` (any number of
+    reversals); append its reversals (except one at ``t_k``, already recorded); return the state after it."""
+    sc, ix = Scales.of(system), LL.state
+    n = LL.p_B.stop - LL.p_B.start
+    A = par[LL.p_A].reshape(n, n).T
+    B, C = par[LL.p_B], par[LL.p_C]
+    kaw = par[LL.p_kaw]
+    xc = S[ix["xc0"]: ix["xc0"] + n]
+    e = r - S[ix["x"]] * sc.x
+    raw = float(C @ xc + fb.D[0, 0] * e)
+    u = raw if u_max is None else min(max(raw, -u_max), u_max)
+    run = Run(system, plant, fb, eps, jit)
+    run.snap = rtol
+    run.P0 = run._constant_params(run.L)
+    run.force_scale = par[LL.param["force_scale"]]
+    run.A_max = S[ix["Amax"]]
+    z = [S[ix[f"z{i}"]] for i in range(LL.plant.nz)]
+    m = [S[ix[f"m{i}"]] for i in range(LL.plant.nm)]
+    s = S[ix["s"]]
+    F = float(system.friction.force(z, m, S[ix["v"]], s, run.q))
+    run.st = {"x": S[ix["x"]], "v": S[ix["v"]], "F": F, "z": z, "m": m, "t": tk[j], "s": s, "rest": S[ix["rest"]],
+              "W": S[ix["W"]], "Ef": 0.0, "xc": np.zeros(0), "uhold": u}
+    run.advance(tk[j + 1], math.inf)
+    out = S.copy()
+    st = run.st
+    # a reversal at t_k when leaving rest is in the block's record already
+    rev.extend(run.rev[1:] if lr_recorded else run.rev)
+    for key in ("x", "v", "s", "rest", "W"):
+        out[ix[key]] = st[key]
+    for i, zi in enumerate(st["z"]):
+        out[ix[f"z{i}"]] = zi
+    for i, mi in enumerate(st["m"]):
+        out[ix[f"m{i}"]] = mi
+    out[ix["Amax"]] = run.A_max
+    out[ix["xc0"]: ix["xc0"] + n] = A @ xc + B * e + fb.Ts * kaw * (u - raw)
+    return out
+
+
+def _failure(S: np.ndarray, LL: LoopLayout, sc: Scales, ta: float, tb: float, why: str) -> SolverError:
+    ix = LL.state
+    return SolverError(
+        f"the sampled loop failed in the block of periods from t = {ta * sc.t:.9g} s to {tb * sc.t:.9g} s "
+        f"(state at its start: x = {S[ix['x']] * sc.x:.6g} m, v = {S[ix['v']] * sc.v:.6g} m/s, direction "
+        f"{int(S[ix['s']]):+d}): {why}. Try a looser rtol, a shorter sample time Ts, or a stable controller."
+    )
