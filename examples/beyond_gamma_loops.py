@@ -38,9 +38,9 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
         table's ``t_rev``, ``x_rev``, ``F_rev``, ``E_p`` [J], ``E_d`` [J]; ``png``.
     """
     n_rev = 6 if quick else N_REVERSALS
-    fig, axes = new_figure(1, len(GAMMAS), size=(13.0, 4.0), sharey=True)
+    fig, axes = new_figure(2, 2, size=(10.0, 7.5), sharex=True, sharey=True)
     runs: dict[float, dict] = {}
-    for ax, color, gamma in zip(axes[0], COLORS, GAMMAS):
+    for ax, color, gamma in zip(axes.flat, COLORS, GAMMAS):
         system = Oscillator(Dahl(sigma=SIGMA, Fc=FC, gamma=gamma), mass=MASS)
         t_rev = simulate(system, V0, reversals=n_rev).reversals.t
         grid = np.union1d(np.linspace(0.0, t_rev[-1], 600 if quick else 3000), t_rev)
@@ -51,18 +51,18 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
             "x_rev": np.asarray(rev.x), "F_rev": np.asarray(rev.F), "E_p": np.asarray(rev.E_p),
             "E_d": np.asarray(rev.E_d),
         }
-        ax.plot(res.x, res.F, color=color, lw=1.3)
-        ax.plot(rev.x, rev.F, "o", color="k", ms=3)
-        ax.axhline(FC, color="0.6", lw=0.8, ls=":")
+        ax.plot(res.x, res.F, color=color, lw=1.3, label=rf"$\gamma$ = {gamma:g}, simulated")
+        ax.plot(rev.x, rev.F, "o", color="k", ms=3, label="reversals")
+        ax.axhline(FC, color="0.6", lw=0.8, ls=":", label=r"$\pm F_c$")
         ax.axhline(-FC, color="0.6", lw=0.8, ls=":")
-        ax.set_title(rf"$\gamma$ = {gamma:g}: $E_p$ after {n_rev} reversals = {rev.E_p[-1]:.2e} J", fontsize=10)
-        ax.set_xlabel("displacement $x$ [m]")
+        ax.set_title(rf"$\gamma$ = {gamma:g}: $E_p$ = {rev.E_p[-1]:.2e} J after {n_rev} reversals", fontsize=10)
         ax.grid(True, alpha=0.3)
-    axes[0, 0].set_ylabel("friction force $F$ [N]")
-    axes[0, 0].set_ylim(-1.15 * FC, 1.15 * FC)
-    axes[0, 0].plot([], [], "ko", ms=3, label="reversals")
-    axes[0, 0].plot([], [], ":", color="0.6", label=r"$\pm F_c$")
-    axes[0, 0].legend(loc="lower right", fontsize=8)
+        ax.legend(loc="upper left", fontsize=8)
+    for ax in axes[-1]:
+        ax.set_xlabel("displacement $x$ [m]")
+    for ax in axes[:, 0]:
+        ax.set_ylabel("friction force $F$ [N]")
+    axes[0, 0].set_ylim(-1.2 * FC, 1.65 * FC)  # room for the legends above +Fc
     fig.suptitle(r"Force-displacement loops of the oscillator (2.1), Dahl model (3.2), shape factor $\gamma$")
     add_note(fig, f"m = {MASS:g} kg, sigma = {SIGMA:g} N/m, Fc = {FC:g} N, x(0) = 0, F(0) = 0, v(0) = {V0:g} m/s; "
                   f"{n_rev} reversals each (simulated).")
