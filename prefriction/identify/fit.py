@@ -1,0 +1,149 @@
+"""``fit(model, data)``: friction parameters from measurements, with Gauss-Newton uncertainty."""
+
+from __future__ import annotations
+
+import warnings
+from typing import Any, Sequence
+
+import numpy as np
+
+from prefriction._validation import check_count, check_positive
+from prefriction.identify.data import ForceDisplacement, Motion
+from prefriction.identify.parameters import ParameterSpace
+from prefriction.identify.result import FitResult
+from prefriction.identify.statistics import IdentifiabilityWarning, gauss_newton
+from prefriction.models.base import FrictionModel
+
+__all__ = ["fit"]
+
+
+def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequence[str] | None = None,
+        fixed: Sequence[str] | None = None, bounds: dict[str, tuple[float, float]] | None = None,
+        mass0: float | None = None, substeps: int | None = None, max_iter: int = 200, tol: float = 1e-10,
+        identifiability_limit: float = 0.5) -> FitResult:
+    """Fit a friction model's parameters to measured data.
+
+    Parameters
+    ----------
+    model : FrictionModel
+        The model to fit (:class:`prefriction.Dahl`, :class:`prefriction.MaxwellSlip`,
+        :class:`prefriction.LuGre`, ...); its parameter values are the starting values, and fix
+        its structure (Dahl: ``gamma >= 1`` or ``gamma < 1``; Maxwell-slip: the number of elements).
+    data : ForceDisplacement or Motion
+        :class:`ForceDisplacement`: friction force along a prescribed displacement; the model's
+        force along the measured ``x`` is fitted to ``F`` by least squares (trust-region
+        reflective, Jacobian by CasADi). :class:`Motion`: positions of a mass under a known
+        force ``u`` (a free decay for ``u = 0``); fitted by multiple shooting between the
+        velocity reversals (located in the data, refined as free variables) with IPOPT.
+    free : sequence of str, optional
+        Parameters to fit (names of ``type(model).parameters``; ``"stiffness[0]"`` for an
+        array entry; ``"mass"``). Default: every parameter not in ``fixed``.
+    fixed : sequence of str, optional
+        Parameters held at the model's values.
+    bounds : dict, optional
+        ``{name: (low, high)}`` in the parameter's unit, inside the declared range; the start
+        value must lie inside. Default: the declared range, narrowed to keep the model's
+        structure (Dahl ``gamma``).
+    mass0 : float, optional
+        Start value of the mass [kg] when ``data.mass`` is ``None`` (the mass is then fitted).
+    substeps : int, optional
+        Runge-Kutta sub-steps per sample interval (1 to 64); default: chosen from the data and
+        the start values.
+    max_iter : int, default 200
+        Most solver iterations (function evaluations for force-displacement data).
+    tol : float, default 1e-10
+        Solver tolerance (relative).
+    identifiability_limit : float, default 0.5
+        Relative standard error above which a parameter is reported as not identifiable.
+
+    Returns
+    -------
+    FitResult
+        The fitted model, estimates, standard errors, 95 % intervals (Student t), correlation
+        matrix, residuals; ``report()`` and ``plot()``.
+
+    Raises
+    ------
+    TypeError
+        If ``model`` is not a FrictionModel, ``data`` is neither data class, or an argument
+        has the wrong type (unknown keyword arguments included).
+    ValueError
+        For unknown parameter names, bounds outside the declared range, a missing ``mass0``
+        when the mass is free, or a model the data type cannot fit (the message says why).
+    prefriction.SolverError
+        If the solver fails; the message names where and what to try.
+
+    Warns
+    -----
+    IdentifiabilityWarning
+        Naming every parameter the data cannot identify: a relative standard error above
+        ``identifiability_limit`` (e.g. ``Fc`` from loops that never leave pre-sliding), or a
+        parameter that enters only in a combination with others (e.g. the mass, ``sigma`` and
+        ``Fc`` of a free decay).
+
+    Notes
+    -----
+    Standard errors are Gauss-Newton: ``s^2 (J^T J)^-1`` at the optimum with the residual
+    variance ``s^2 = |r|^2 / (n - p)``, nuisance variables (initial state, shooting nodes,
+    reversal times) marginalised; see ``docs/identify.md``.
+    """
+    if not isinstance(model, FrictionModel):
+        raise TypeError(f"model must be a prefriction.FrictionModel (e.g. prefriction.Dahl), got {model!r} "
+                        f"of type {type(model).__name__}")
+    if not isinstance(data, (ForceDisplacement, Motion)):
+        raise TypeError(f"data must be prefriction.identify.ForceDisplacement or Motion, got {type(data).__name__}")
+    if substeps is not None:
+        substeps = check_count("substeps", substeps, 1)
+        if substeps > 64:
+            raise ValueError(f"substeps must be an integer in [1, 64], got {substeps}")
+    max_iter = check_count("max_iter", max_iter, 1)
+    tol = check_positive("tol", tol)
+    limit = check_positive("identifiability_limit", identifiability_limit)
+    if isinstance(data, Motion):
+        return _fit_motion(model, data, free, fixed, bounds, mass0, substeps, max_iter, tol, limit)
+    if mass0 is not None:
+        raise ValueError(f"mass0 = {mass0!r} is for Motion data with a free mass; force-displacement data "
+                         f"involve no mass (allowed: mass0=None)")
+    from prefriction.identify.prescribed import fit_prescribed
+
+    space = ParameterSpace(model, free, fixed, bounds)
+    sol = fit_prescribed(model, data, space, n_sub=substeps, max_iter=max_iter, tol=tol)
+    values = space.values(sol.w[:-1])
+    est = np.array([values[n] for n in space.free])
+    stats = gauss_newton(sol.jacobian, sol.residuals, space.free, est, space.scale, limit=limit)
+    nuisance = {"initial force F0 [N]": float(sol.prediction[0])}
+    return _finish(space, values, est, stats, -sol.residuals, sol.prediction, data, None, nuisance, sol.message)
+
+
+def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bounds: Any, mass0: Any,
+                substeps: int | None, max_iter: int, tol: float, limit: float) -> FitResult:
+    from prefriction.identify.shooting import fit_motion
+
+    if data.mass is None:
+        if mass0 is None:
+            raise ValueError("mass0 must be given when data.mass is None (the mass is fitted and needs a start "
+                             "value [kg], 0 < mass0 < inf)")
+        mass0 = check_positive("mass0", mass0)
+    elif mass0 is not None:
+        raise ValueError(f"mass0 = {mass0!r} is only for a free mass, but data.mass = {data.mass!r} is known "
+                         f"(allowed: mass0=None)")
+    space = ParameterSpace(model, free, fixed, bounds, mass=mass0)
+    sol = fit_motion(model, data, space, n_sub=substeps, max_iter=max_iter, tol=tol)
+    values = space.values(sol.w[: space.n_free])
+    est = np.array([values[n] for n in space.free])
+    stats = gauss_newton(sol.jacobian, sol.residuals, space.free, est, space.scale,
+                         constraints=sol.constraints, limit=limit)
+    mass = values["mass"] if data.mass is None else data.mass
+    return _finish(space, values, est, stats, -sol.residuals, sol.prediction, data, mass, sol.nuisance, sol.message)
+
+
+def _finish(space: ParameterSpace, values: dict, est: np.ndarray, stats: Any, residuals: np.ndarray,
+            fitted: np.ndarray, data: Any, mass: float | None, nuisance: dict, message: str) -> FitResult:
+    fitted_model = space.build(values)
+    for name, why in stats.unidentifiable:
+        warnings.warn(f"the data cannot identify {name}: {why}; its interval is meaningless. Fix it (fixed=[{name!r}]) "
+                      f"or record data that excite it (docs/identify.md#identifiability)",
+                      IdentifiabilityWarning, stacklevel=3)
+    return FitResult(fitted_model, mass, tuple(space.free), tuple(space.units[n] for n in space.free), est,
+                     stats.stderr, stats.low, stats.high, stats.correlation, residuals, fitted, data, stats,
+                     nuisance, message)

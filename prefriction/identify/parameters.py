@@ -1,0 +1,272 @@
+"""The parameter vector of a fit: names, start values, bounds, free and fixed entries.
+
+A model's declared :class:`prefriction.Parameter` objects give the physical parameters. Scalar
+parameters keep their name (``"sigma"``); array parameters (Maxwell-slip) become one entry per
+element (``"stiffness[0]"``). The units of the normalised model (``sigma``, ``Fc``) and its
+run-time numbers ``q`` are rebuilt as CasADi expressions of these entries, so that the fit
+differentiates through them (``docs/models.md#structure``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+from typing import Any, Sequence
+
+import casadi as ca
+import numpy as np
+
+from prefriction.models.base import FrictionModel, Parameter
+
+__all__ = ["ParameterSpace", "symbolic_units"]
+
+_OPEN = 1e-9
+"""Relative margin kept from an open end of a parameter's range (``0 < sigma``)."""
+
+
+@dataclass(frozen=True)
+class _Entry:
+    name: str
+    field: str
+    index: int | None
+    unit: str
+    value: float
+    low: float
+    high: float
+
+
+def _entries(model: FrictionModel) -> list[_Entry]:
+    out = []
+    for par in type(model).parameters:
+        val = getattr(model, par.name)
+        vals = [float(val)] if np.ndim(val) == 0 else np.asarray(val, dtype=float).ravel().tolist()
+        for i, v in enumerate(vals):
+            low, high = _structure_range(model, par, v)
+            name = par.name if np.ndim(val) == 0 else f"{par.name}[{i}]"
+            out.append(_Entry(name, par.name, None if np.ndim(val) == 0 else i, par.unit, v, low, high))
+    return out
+
+
+def _structure_range(model: FrictionModel, par: Parameter, value: float) -> tuple[float, float]:
+    """The declared range of ``par``, open ends kept at a margin, narrowed to the values that keep
+    the start model's structure (Dahl: ``gamma >= 1`` or ``gamma < 1``, ``docs/models.md#structure``)."""
+    from prefriction.models.dahl import Dahl
+
+    low, high = par.low, par.high
+    if par.low_open:
+        low = low + _OPEN * (abs(low) if low != 0.0 else abs(value))
+    if par.high_open:
+        high = high - _OPEN * (abs(high) if high != 0.0 else abs(value))
+    if isinstance(model, Dahl) and par.name == "gamma":
+        low, high = (1.0, high) if value >= 1.0 else (low, 1.0 - _OPEN)
+    return low, high
+
+
+class ParameterSpace:
+    """Which of a model's parameters (and the mass) a fit moves, their start values and bounds.
+
+    Parameters
+    ----------
+    model : FrictionModel
+        The start model (its parameter values are the starting values).
+    free : sequence of str or None
+        Names to fit; ``None`` fits every parameter not in ``fixed``.
+    fixed : sequence of str or None
+        Names held at their start values.
+    bounds : dict or None
+        ``{name: (low, high)}`` in the parameter's unit, inside its declared range.
+    mass : float or None
+        Start value [kg] of a fitted mass (``"mass"`` becomes a free entry); ``None`` if the mass
+        is known or not involved.
+
+    Raises
+    ------
+    ValueError
+        For an unknown name, a name both free and fixed, no free parameter, or bounds outside
+        the declared range or not containing the start value.
+    """
+
+    def __init__(self, model: FrictionModel, free: Sequence[str] | None, fixed: Sequence[str] | None,
+                 bounds: dict | None, mass: float | None = None) -> None:
+        self.model = model
+        entries = _entries(model)
+        if mass is not None:
+            entries.append(_Entry("mass", "mass", None, "kg", float(mass), _OPEN * float(mass), math.inf))
+        self.entries = entries
+        names = [e.name for e in entries]
+        free_l = _names("free", free, names, model)
+        fixed_l = _names("fixed", fixed, names, model)
+        both = sorted(set(free_l or []) & set(fixed_l or []))
+        if both:
+            raise ValueError(f"free and fixed both name {both}: a parameter is either fitted or held")
+        if free_l is None:
+            free_l = [n for n in names if n not in set(fixed_l or [])]
+        if mass is not None and "mass" not in free_l and "mass" not in (fixed_l or []):
+            free_l.append("mass")
+        if not free_l:
+            raise ValueError(f"no parameter left to fit: free = {free!r}, fixed = {fixed!r} (allowed names: {names})")
+        self.free = [n for n in names if n in set(free_l)]
+        self.fixed = [n for n in names if n not in set(self.free)]
+        self.low = {e.name: e.low for e in entries}
+        self.high = {e.name: e.high for e in entries}
+        self.start = {e.name: e.value for e in entries}
+        self.units = {e.name: e.unit for e in entries}
+        for name, lim in (bounds or {}).items():
+            self._set_bound(name, lim, names)
+        for name in self.free:
+            if self.start[name] == 0.0:
+                raise ValueError(f"the start value of {name} is 0: a fitted parameter needs a non-zero start "
+                                 f"value (its scale); give the model a small positive {name}")
+
+    def _set_bound(self, name: str, lim: Any, names: list[str]) -> None:
+        if name not in names:
+            raise ValueError(f"bounds names an unknown parameter {name!r} (allowed: {names})")
+        try:
+            lo, hi = (float(v) for v in lim)
+        except (TypeError, ValueError):
+            raise ValueError(f"bounds[{name!r}] must be a pair (low, high) of numbers, got {lim!r}") from None
+        e_lo, e_hi = self.low[name], self.high[name]
+        if not (e_lo <= lo < hi <= e_hi) or math.isnan(lo) or math.isnan(hi):
+            raise ValueError(f"bounds[{name!r}] = {lim!r} must satisfy {e_lo!r} <= low < high <= {e_hi!r} "
+                             f"[{self.units[name]}] (the declared range)")
+        if not lo <= self.start[name] <= hi:
+            raise ValueError(f"bounds[{name!r}] = {lim!r} must contain the start value {self.start[name]!r}")
+        self.low[name], self.high[name] = lo, hi
+
+    # ------------------------------------------------------------------ vectors
+    @property
+    def n_free(self) -> int:
+        return len(self.free)
+
+    @property
+    def scale(self) -> np.ndarray:
+        """Start values of the free entries: the fit moves ``theta = p / p_start``."""
+        return np.array([self.start[n] for n in self.free])
+
+    def theta_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """Bounds of the scaled free entries ``p / p_start``."""
+        sc = self.scale
+        lo = np.array([self.low[n] for n in self.free]) / sc
+        hi = np.array([self.high[n] for n in self.free]) / sc
+        return np.minimum(lo, hi), np.maximum(lo, hi)
+
+    def fixed_values(self) -> np.ndarray:
+        return np.array([self.start[n] for n in self.fixed])
+
+    def symbols(self, theta: Any, fixed: Any) -> dict[str, Any]:
+        """Physical values by name from the scaled free entries and the fixed values (symbols)."""
+        out = {}
+        for i, n in enumerate(self.free):
+            out[n] = theta[i] * self.start[n]
+        for i, n in enumerate(self.fixed):
+            out[n] = fixed[i]
+        return out
+
+    def values(self, theta: np.ndarray) -> dict[str, float]:
+        """Physical values by name of the scaled free entries ``theta`` (fixed ones at start)."""
+        out = dict(self.start)
+        for i, n in enumerate(self.free):
+            out[n] = float(theta[i]) * self.start[n]
+        return out
+
+    def build(self, values: dict[str, float]) -> FrictionModel:
+        """A model of the start model's class with ``values`` (the constructor validates them).
+
+        Raises
+        ------
+        ValueError
+            If the model rejects the values (e.g. LuGre with ``Fs < Fc``); the message says so.
+        """
+        kwargs: dict[str, Any] = {}
+        for e in self.entries:
+            if e.field == "mass":
+                continue
+            if e.index is None:
+                kwargs[e.field] = values[e.name]
+            else:
+                kwargs.setdefault(e.field, np.array(getattr(self.model, e.field), dtype=float).copy())
+                kwargs[e.field][e.index] = values[e.name]
+        try:
+            return dataclasses.replace(self.model, **kwargs)
+        except ValueError as exc:
+            raise ValueError(f"the fitted values do not make a valid {type(self.model).__name__}: {exc}; "
+                             f"bound the parameters (bounds=...) or fix some (fixed=...)") from exc
+
+
+def _names(arg: str, value: Any, names: list[str], model: FrictionModel) -> list[str] | None:
+    if value is None:
+        return None
+    if isinstance(value, str):
+        value = [value]
+    out = list(value)
+    for n in out:
+        if n not in names:
+            raise ValueError(f"{arg} names an unknown parameter {n!r} of {type(model).__name__} "
+                             f"(allowed: {names})")
+    return out
+
+
+@dataclass(frozen=True)
+class _SymScales:
+    """The velocity unit of a system, as a CasADi expression (what ``runtime_params_for`` reads)."""
+
+    x: Any
+    F: Any
+    t: Any
+    v: Any
+    E: Any
+
+
+def symbolic_units(model: FrictionModel, values: dict[str, Any], mass: Any) -> tuple[Any, Any, Any]:
+    """``(sigma, Fc, q)`` of ``model``'s class as CasADi expressions of the physical ``values``.
+
+    Parameters
+    ----------
+    model : FrictionModel
+        The start model (its class and structure).
+    values : dict
+        Physical values by entry name (CasADi ``SX`` or floats).
+    mass : SX or float
+        Mass [kg] of the system (the velocity unit of rate-dependent models).
+
+    Returns
+    -------
+    (SX, SX, SX)
+        Reference stiffness [N/m], reference force [N] and the column of run-time numbers.
+
+    Raises
+    ------
+    TypeError
+        If the model's ``sigma``, ``Fc`` or ``runtime_params_for`` cannot be evaluated on CasADi
+        symbols (it uses ``math`` functions on its numbers).
+    """
+    from prefriction.models.maxwell_slip import MaxwellSlip
+
+    fields: dict[str, Any] = {}
+    for par in type(model).parameters:
+        val = getattr(model, par.name)
+        if np.ndim(val) == 0:
+            fields[par.name] = values[par.name]
+        else:
+            fields[par.name] = ca.vertcat(*[values[f"{par.name}[{i}]"] for i in range(np.size(val))])
+    if isinstance(model, MaxwellSlip):
+        k, W = fields["stiffness"], fields["slip_force"]
+        sigma, Fc = ca.sum1(k), ca.sum1(W)
+        return sigma, Fc, ca.vertcat(k / sigma, W / Fc)
+    sym = object.__new__(type(model))
+    for f in dataclasses.fields(model):
+        object.__setattr__(sym, f.name, getattr(model, f.name))
+    for name, val in fields.items():
+        object.__setattr__(sym, name, val)
+    try:
+        sigma, Fc = sym.sigma, sym.Fc
+        V = Fc / ca.sqrt(mass * sigma)
+        scales = _SymScales(x=Fc / sigma, F=Fc, t=ca.sqrt(mass / sigma), v=V, E=Fc * Fc / sigma)
+        q = sym.runtime_params_for(scales)
+        q = ca.vertcat(*[q[i] for i in range(len(q))]) if len(q) else ca.SX(0, 1)
+    except Exception as exc:
+        raise TypeError(f"fit cannot express the normalised numbers of {type(model).__name__} through CasADi "
+                        f"symbols ({type(exc).__name__}: {exc}); its sigma, Fc and runtime_params_for must "
+                        f"use arithmetic or casadi functions on the parameters") from exc
+    return sigma, Fc, q

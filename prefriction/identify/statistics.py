@@ -1,0 +1,133 @@
+"""Gauss-Newton statistics of a least-squares fit: standard errors, 95 % intervals, correlation,
+and the parameters the data cannot identify.
+
+At the optimum of ``min |r(w)|^2`` with Jacobian ``J = dr/dw`` (and equality constraints with
+Jacobian ``A``, multiple shooting), the estimates are approximately normal with covariance
+``s^2 N (N^T J^T J N)^-1 N^T``, where ``N`` spans the null space of ``A`` (the identity without
+constraints) and ``s^2 = |r|^2 / (n - p)`` with ``p`` the number of free directions (Bates and
+Watts, *Nonlinear Regression Analysis and Its Applications*, Wiley 1988, ch. 2). The 95 %
+intervals use Student's t quantile with ``n - p`` degrees of freedom.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.linalg import null_space
+from scipy.stats import t as student_t
+
+__all__ = ["IdentifiabilityWarning", "Statistics", "gauss_newton"]
+
+SINGULAR = 1e-10
+"""Eigenvalue of ``N^T J^T J N`` (relative to the largest) below which a direction is undetermined."""
+
+
+class IdentifiabilityWarning(UserWarning):
+    """The data cannot identify a parameter: its relative standard error is huge, or it enters
+    the fit only in a combination with others (a singular information matrix)."""
+
+
+@dataclass(frozen=True)
+class Statistics:
+    """Gauss-Newton statistics of the fitted parameters (physical units).
+
+    Attributes
+    ----------
+    stderr : numpy.ndarray
+        Standard errors (``inf`` along an undetermined direction).
+    low, high : numpy.ndarray
+        95 % confidence intervals (t quantile).
+    correlation : numpy.ndarray
+        Correlation matrix of the estimates (NaN where a standard error is infinite).
+    sigma_hat : float
+        Residual standard deviation ``|r| / sqrt(n - p)``.
+    dof : int
+        Degrees of freedom ``n - p``.
+    condition : float
+        Condition number of the information matrix in relative units (``p / p_start``).
+    unidentifiable : tuple of (str, str)
+        Names of the parameters the data cannot identify, each with the reason.
+    """
+
+    stderr: np.ndarray
+    low: np.ndarray
+    high: np.ndarray
+    correlation: np.ndarray
+    sigma_hat: float
+    dof: int
+    condition: float
+    unidentifiable: tuple[tuple[str, str], ...]
+
+
+def gauss_newton(J: np.ndarray, r: np.ndarray, names: list[str], estimates: np.ndarray, scale: np.ndarray,
+                 *, constraints: np.ndarray | None = None, limit: float = 0.5) -> Statistics:
+    """Statistics of the parameters at the columns ``0..len(names)-1`` of ``J``.
+
+    Parameters
+    ----------
+    J : numpy.ndarray
+        Residual Jacobian with respect to the optimisation vector ``w`` (shape ``(n, n_w)``);
+        its first ``len(names)`` columns are the scaled parameters ``p / scale``, the others
+        nuisance variables (initial state, shooting nodes, reversal times).
+    r : numpy.ndarray
+        Residuals at the optimum.
+    names : list of str
+        Parameter names.
+    estimates : numpy.ndarray
+        Fitted physical values.
+    scale : numpy.ndarray
+        ``p = w * scale`` for the parameter columns.
+    constraints : numpy.ndarray or None
+        Jacobian of the equality constraints with respect to ``w`` (multiple shooting).
+    limit : float, default 0.5
+        Relative standard error above which a parameter is reported as not identifiable.
+
+    Returns
+    -------
+    Statistics
+    """
+    n, nw = J.shape
+    k = len(names)
+    N = np.eye(nw) if constraints is None or constraints.size == 0 else null_space(constraints)
+    p_eff = N.shape[1]
+    dof = n - p_eff
+    if dof < 1:
+        raise ValueError(f"the fit has {p_eff} free directions and only {n} residuals: it needs more samples "
+                         f"than free parameters and nuisance variables")
+    rss = float(r @ r)
+    s2 = rss / dof
+    H = (J @ N).T @ (J @ N)
+    lam, U = np.linalg.eigh(H)
+    top = max(float(lam[-1]), 1e-300)
+    good = lam > SINGULAR * top
+    inv = (U[:, good] / lam[good]) @ U[:, good].T
+    cov_w = s2 * N @ inv @ N.T
+    cov = cov_w[:k, :k] * np.outer(scale, scale)
+    var = np.clip(np.diag(cov).copy(), 0.0, None)
+    reasons: dict[str, str] = {}
+    null_dirs = N @ U[:, ~good]
+    for j in range(null_dirs.shape[1]):
+        comp = null_dirs[:k, j]
+        involved = [names[i] for i in np.flatnonzero(np.abs(comp) > 0.2)]
+        for name in involved:
+            var[names.index(name)] = np.inf
+            others = [o for o in involved if o != name]
+            reasons[name] = ("enters only in a combination with " + ", ".join(others)) if others else \
+                "does not change the fitted signal"
+    se = np.sqrt(var)
+    tq = float(student_t.ppf(0.975, dof))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = cov / np.outer(se, se)
+        rse = se / np.abs(estimates)
+    undetermined = ~np.isfinite(se)
+    corr[undetermined, :] = np.nan
+    corr[:, undetermined] = np.nan
+    corr[~np.isfinite(corr)] = np.nan
+    np.fill_diagonal(corr, 1.0)
+    for i, name in enumerate(names):
+        if name not in reasons and not rse[i] <= limit:
+            reasons[name] = f"relative standard error {100.0 * rse[i]:.3g} % > {100.0 * limit:.3g} %"
+    cond = float(top / max(float(lam[0]), 1e-300 * top)) if lam[0] > 0 else np.inf
+    return Statistics(se, estimates - tq * se, estimates + tq * se, corr, float(np.sqrt(s2)), dof, cond,
+                      tuple((n_, reasons[n_]) for n_ in names if n_ in reasons))
