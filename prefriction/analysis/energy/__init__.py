@@ -15,6 +15,17 @@ Building blocks (model-free unless said otherwise):
 - :func:`dissipation` (2.10), :func:`series` (2.11), :func:`bound_check` (2.12);
 - :func:`analyze_samples`, :func:`analyze_table`: all of it at once, as an :class:`EnergyReport`.
 
+Models: any rate-independent :class:`prefriction.FrictionModel` with a branch energy (Dahl,
+Maxwell-slip); a :class:`prefriction.GMS` with ``Fs = Fc`` and no damping, analysed as the equal
+Maxwell-slip model; and :class:`prefriction.LuGre`, for which :func:`analyze_samples` returns a
+:class:`LuGreEnergyReport` with the stored bristle energy at the reversals and the viscous and
+hysteretic dissipation per half-cycle apart (:func:`bristle_deflection` recovers the
+deflection from the samples; docs/mathematics.md#lugre-energy).
+
+Every public function raises ``TypeError`` or ``ValueError`` naming the argument, its value and
+the allowed range for ``None``, strings, complex numbers, NaN, inf, negative energies, empty or
+mismatched arrays and unsorted times.
+
 Conventions (as in :class:`prefriction.ReversalTable`): reversal ``k`` ends half-cycle ``k - 1`` and starts
 half-cycle ``k``; ``E_p[k]`` is the potential energy at reversal ``k``, i.e. the energy the new
 branch returns as kinetic energy until its force zero crossing; ``E_d[k]`` (this module) is
@@ -24,13 +35,16 @@ half-cycle that *ends* at a reversal instead: ``table.E_d[k + 1]`` is ``E_d[k]``
 
 The functions live in private modules: reversals in samples :mod:`prefriction.analysis.energy.sampled_reversals`,
 energies along samples :mod:`prefriction.analysis.energy.sampled_energy`, energies at reversals
-:mod:`prefriction.analysis.energy.balance`, the report :mod:`prefriction.analysis.energy.report`, argument checks
+:mod:`prefriction.analysis.energy.balance`, the report :mod:`prefriction.analysis.energy.report`, LuGre
+:mod:`prefriction.analysis.energy.lugre` and :mod:`prefriction.analysis.energy.lugre_report`, argument checks
 :mod:`prefriction.analysis.energy.checks`.
 """
 
 from __future__ import annotations
 
 from prefriction.analysis.energy.balance import BoundCheck, bound_check, branch_energy, dissipation, series
+from prefriction.analysis.energy.lugre import bristle_deflection
+from prefriction.analysis.energy.lugre_report import LuGreEnergyReport
 from prefriction.analysis.energy.report import EnergyReport, analyze_samples, analyze_table
 from prefriction.analysis.energy.sampled_energy import integrated_power, kinetic_energy, loop_integral, total_energy, work_integral
 from prefriction.analysis.energy.sampled_reversals import SampledReversals, find_reversals
@@ -38,10 +52,12 @@ from prefriction.analysis.energy.sampled_reversals import SampledReversals, find
 __all__ = [
     "BoundCheck",
     "EnergyReport",
+    "LuGreEnergyReport",
     "SampledReversals",
     "analyze_samples",
     "analyze_table",
     "bound_check",
+    "bristle_deflection",
     "branch_energy",
     "dissipation",
     "find_reversals",

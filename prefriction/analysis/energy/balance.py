@@ -8,7 +8,8 @@ from typing import Any, Optional
 
 import numpy as np
 
-from prefriction.analysis.energy.checks import ROUNDING, check_model
+from prefriction._validation import check_nonnegative
+from prefriction.analysis.energy.checks import ROUNDING, check_model, first_bad, real_array, value_array
 from prefriction.models import FrictionModel
 
 
@@ -26,7 +27,7 @@ def branch_energy(F: Any, direction: Any, *, friction: FrictionModel) -> np.ndar
     Parameters
     ----------
     F : array_like
-        Friction forces [N], ``|F| <= Fc``.
+        Friction forces [N], ``|F| <= Fc``, at least one.
     direction : array_like
         Direction of motion on the branch, +1 or -1 (broadcast against ``F``).
     friction : FrictionModel
@@ -35,19 +36,42 @@ def branch_energy(F: Any, direction: Any, *, friction: FrictionModel) -> np.ndar
     Returns
     -------
     numpy.ndarray
-        Stored energy [J], >= 0.
+        Stored energy [J], >= 0, finite.
+
+    Raises
+    ------
+    ValueError
+        ``|F| > Fc``, NaN, a direction other than +-1, or a force at the saturation force in
+        the direction of motion for a model whose energy is unbounded there (Dahl with
+        ``gamma >= 1``: ``H_gamma(1) = inf``; in deep gross sliding the force rounds to ``Fc``).
+    TypeError
+        Non-real ``F`` or ``direction``, or a model the analysis does not cover.
     """
     friction = check_model(friction)
-    F = np.asarray(F, dtype=float)
-    s = np.asarray(direction, dtype=float)
+    F = real_array("F", F, what="a number or an array of real numbers")
+    s = real_array("direction", direction, what="+1 or -1 or an array of them")
+    if F.size == 0:
+        raise ValueError(f"F must hold at least 1 value, got an empty array of shape {F.shape}")
     if not np.all(np.abs(s) == 1.0):
         bad = s[np.abs(s) != 1.0].flat[0]
         raise ValueError(f"direction must be +1 or -1 (every entry), got {float(bad)!r}")
+    try:
+        F, s = np.broadcast_arrays(F, s)
+    except ValueError:
+        raise ValueError(f"direction has shape {s.shape}, which does not broadcast against F of shape {F.shape}") from None
     Fc = friction.Fc
-    if np.any(~(np.abs(F) <= Fc * (1.0 + ROUNDING))):
-        bad = F[~(np.abs(F) <= Fc * (1.0 + ROUNDING))].flat[0]
-        raise ValueError(f"F must lie in [-Fc, Fc] = [{-Fc!r}, {Fc!r}] (every entry), got {float(bad)!r}")
-    return (Fc * Fc / friction.sigma) * friction.branch_energy_of_force(np.clip(F / Fc, -1.0, 1.0), s)
+    first_bad("F", F, ~(np.abs(F) <= Fc * (1.0 + ROUNDING)), f"finite and in [-Fc, Fc] = [{-Fc!r}, {Fc!r}]")
+    E = (Fc * Fc / friction.sigma) * friction.branch_energy_of_force(np.clip(F / Fc, -1.0, 1.0), s)
+    infinite = ~np.isfinite(E)
+    if np.any(infinite):
+        i = np.unravel_index(int(np.flatnonzero(infinite)[0]), E.shape)
+        raise ValueError(
+            f"the branch energy is infinite at F{list(i) if E.ndim else ''} = {float(F[i])!r} N in direction "
+            f"{int(s[i]):+d}: the force has reached (or rounded to) the saturation force s Fc, where this model "
+            f"({type(friction).__name__}) stores unbounded energy and the force no longer determines it; "
+            "allowed: s F < Fc on the loading side (deep gross sliding cannot be analysed from the force)"
+        )
+    return E
 
 
 def dissipation(E_p: Any, *, input_work: Any = None) -> np.ndarray:
@@ -59,23 +83,29 @@ def dissipation(E_p: Any, *, input_work: Any = None) -> np.ndarray:
     Parameters
     ----------
     E_p : array_like
-        Potential energy at consecutive reversals [J], length n >= 1.
+        Potential energy at consecutive reversals [J], length n >= 1, each finite and >= 0.
     input_work : array_like, optional
-        Work of the external force in each half-cycle [J], length n - 1.
+        Work of the external force in each half-cycle [J], length n - 1, finite (either sign).
+
+    Raises
+    ------
+    TypeError
+        ``None``, strings, complex or other non-real entries (naming the argument).
+    ValueError
+        NaN, inf or a negative ``E_p``, an empty ``E_p``, or ``input_work`` of the wrong length.
 
     Returns
     -------
     numpy.ndarray
         Length n - 1.
     """
-    E_p = np.asarray(E_p, dtype=float)
-    if E_p.ndim != 1:
-        raise ValueError(f"E_p must be a 1-D array, got shape {E_p.shape}")
+    E_p = value_array("E_p", E_p, nonnegative=True)
+    E_p = np.atleast_1d(E_p)
     E_d = E_p[:-1] - E_p[1:]
     if input_work is not None:
-        w = np.asarray(input_work, dtype=float)
+        w = np.atleast_1d(value_array("input_work", input_work, min_size=0))
         if w.shape != E_d.shape:
-            raise ValueError(f"input_work has shape {w.shape}, expected {E_d.shape} (one value per half-cycle)")
+            raise ValueError(f"input_work has {w.size} values, expected len(E_p) - 1 = {E_d.size} (one per half-cycle)")
         E_d = E_d + w
     return E_d
 
@@ -91,21 +121,25 @@ def series(E_p: Any, E_d: Any) -> tuple[np.ndarray, np.ndarray]:
     Parameters
     ----------
     E_p : array_like
-        Potential energy at the reversals [J], length n.
+        Potential energy at the reversals [J], length n >= 1, each finite and >= 0.
     E_d : array_like
-        Dissipation per half-cycle [J], length n - 1 (``E_d[k]`` from reversal k to k + 1).
+        Dissipation per half-cycle [J], length n - 1 (``E_d[k]`` from reversal k to k + 1),
+        finite (negative under forcing, see the module notes).
 
     Returns
     -------
     (numpy.ndarray, numpy.ndarray)
         Partial sums ``S`` and remainders ``R``, each of length n [J].
     """
-    E_p = np.asarray(E_p, dtype=float)
-    E_d = np.asarray(E_d, dtype=float)
-    if E_d.shape != (E_p.size - 1,) or E_p.ndim != 1:
-        raise ValueError(f"E_d must have length len(E_p) - 1 = {E_p.size - 1}, got shape {E_d.shape}")
+    E_p = np.atleast_1d(value_array("E_p", E_p, nonnegative=True))
+    E_d = np.atleast_1d(value_array("E_d", E_d, min_size=0))
+    if E_d.shape != (E_p.size - 1,):
+        raise ValueError(f"E_d must hold len(E_p) - 1 = {E_p.size - 1} values, got {E_d.size} (shape {E_d.shape})")
     S = np.concatenate((np.cumsum(E_d[::-1])[::-1], [0.0]))
     return S, E_p - S
+
+
+DEFAULT_LABEL = "(2.12) E_p <= Fc^2/(2 k_min)"
 
 
 @dataclass(frozen=True)
@@ -142,6 +176,9 @@ class BoundCheck:
         velocity is not bounded by (2.12) (gross sliding), so it is reported, not checked.
     initial_ratio : float or None
         ``E_0 / bound``; > 1 means the first excursion starts in gross sliding.
+    bound_label : str
+        Which bound: (2.12) for rate-independent models; for LuGre the bristle bound
+        ``E_p <= Fs^2 / (2 sigma0)`` (``|z| <= Fs / sigma0``, Canudas de Wit et al. 1995).
     """
 
     bound: float
@@ -156,16 +193,20 @@ class BoundCheck:
     holds_sharp: bool
     E_0: Optional[float]
     initial_ratio: Optional[float]
+    bound_label: str = DEFAULT_LABEL
 
     def format(self) -> str:
         """Readable summary of the check, one line per bound."""
         lines = [
-            f"(2.12) E_p <= Fc^2/(2 k_min) = {self.bound:.6e} J: "
+            f"{self.bound_label} = {self.bound:.6e} J: "
             f"{'holds' if self.holds else 'VIOLATED'}{'' if self.strict or not self.holds else ' (with equality)'}, "
             f"max E_p = {self.max_E_p:.6e} J at reversal {self.index + 1}, ratio {self.ratio:.6f}, margin {self.margin:.3e} J",
-            f"sharp bound (Fc^2/sigma) H_gamma(-1) = {self.bound_sharp:.6e} J: "
-            f"{'holds' if self.holds_sharp else 'VIOLATED'}, ratio {self.ratio_sharp:.6f}",
         ]
+        if self.bound_label == DEFAULT_LABEL:
+            lines.append(
+                f"sharp bound (Fc^2/sigma) H_gamma(-1) = {self.bound_sharp:.6e} J: "
+                f"{'holds' if self.holds_sharp else 'VIOLATED'}, ratio {self.ratio_sharp:.6f}"
+            )
         if self.E_0 is not None:
             note = "gross sliding in the first excursion, not covered by (2.12)" if self.initial_ratio > 1 else "within the bound"
             lines.append(f"initial energy E_0 = {self.E_0:.6e} J = {self.initial_ratio:.4g} x bound ({note})")
@@ -183,20 +224,28 @@ def bound_check(E_p: Any, *, friction: FrictionModel, E_0: Optional[float] = Non
     Parameters
     ----------
     E_p : float or array_like
-        Potential energy at the reversals [J], length >= 1.
+        Potential energy at the reversals [J], length >= 1, each finite and >= 0.
     friction : FrictionModel
         The (rate-independent) friction model; ``k_min`` is its least unloading stiffness.
     E_0 : float, optional
-        Energy of the initial state [J]; reported (ratio to the bound), never checked.
+        Energy of the initial state [J], finite and >= 0; reported (ratio to the bound),
+        never checked.
+
+    Raises
+    ------
+    TypeError
+        ``E_p`` or ``E_0`` not real numbers (``None`` is allowed for ``E_0`` only), or
+        ``friction`` not a rate-independent model.
+    ValueError
+        NaN, inf, negative or empty ``E_p``; NaN, inf or negative ``E_0``.
 
     Returns
     -------
     BoundCheck
     """
     friction = check_model(friction)
-    E_p = np.atleast_1d(np.asarray(E_p, dtype=float))
-    if E_p.ndim != 1 or E_p.size < 1:
-        raise ValueError(f"E_p must be a number or a non-empty 1-D array, got shape {E_p.shape}")
+    E_p = np.atleast_1d(value_array("E_p", E_p, nonnegative=True))
+    E_0 = None if E_0 is None else check_nonnegative("E_0", E_0)
     scale = friction.Fc**2 / friction.sigma
     bound = 0.5 * friction.Fc**2 / friction.k_min
     sharp = scale * float(friction.branch_energy_of_force(np.array([-1.0]), 1.0)[0])

@@ -3,15 +3,18 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Optional
+from typing import Any, Optional, Union
 
 import numpy as np
 
 from prefriction.analysis.energy.balance import BoundCheck, bound_check, branch_energy, dissipation, series
-from prefriction.analysis.energy.checks import ROUNDING, check_dahl_system, check_method, check_samples
+from prefriction.analysis.energy.checks import ROUNDING, check_method, check_samples, check_system, value_array
 from prefriction.analysis.energy.sampled_energy import cumulative, kinetic_energy
 from prefriction.analysis.energy.sampled_reversals import SampledReversals, find_reversals
-from prefriction.models import Oscillator
+from prefriction.analysis.energy.lugre import lugre_bound
+from prefriction.analysis.energy.lugre_report import LuGreEnergyReport, analyze_lugre_samples, lugre_table_energy
+from prefriction._validation import check_finite
+from prefriction.models import FrictionModel, LuGre, Oscillator
 from prefriction.reversals import ReversalTable
 
 
@@ -83,6 +86,15 @@ class EnergyReport:
         """True if ``E_p`` strictly decreases from reversal to reversal (clockwise hysteresis)."""
         return bool(np.all(np.diff(self.E_p) < 0.0))
 
+    def __repr__(self) -> str:
+        last = f", E_p[-1]={self.E_p[-1]:.4g} J" if len(self) else ""
+        return (f"EnergyReport({self.source}: {len(self)} reversals, E_0={self.E_0:.4g} J{last}, "
+                f"residual (2.10)={self.residual_2_10:.2g}, bound {'holds' if self.bound.holds else 'VIOLATED'})")
+
+    def summary(self) -> str:
+        """The closing lines of :meth:`format`: balances, checks and the bound, without the table."""
+        return self.format(max_rows=0).split("\n\n", 1)[1]
+
     def format(self, max_rows: int = 20) -> str:
         """Return the report as a readable text table and summary (at most ``max_rows`` rows)."""
         head = (
@@ -90,7 +102,7 @@ class EnergyReport:
             f"{'E_d(i) [J]':>12} {'sum E_d(n>=i)':>13} {'E_p/bound':>10}"
         )
         n = len(self)
-        half = max(1, max_rows // 2)
+        half = max_rows // 2
         idx = list(range(n)) if n <= max_rows else list(range(half)) + list(range(n - half, n))
         lines = [f"Energy at reversals ({self.source}); E_d(i): half-cycle from reversal i to i+1", head, "-" * len(head)]
         prev = -1
@@ -157,8 +169,15 @@ def _peak_kinetic(t: np.ndarray, ek: np.ndarray, rev: SampledReversals) -> np.nd
 
 def analyze_samples(
     t: Any, x: Any, v: Any, F: Any, *, system: Oscillator, method: str = "trapezoid"
-) -> EnergyReport:
-    """Energy analysis of a sampled trajectory of a Dahl oscillator (2.1), in SI units.
+) -> Union[EnergyReport, LuGreEnergyReport]:
+    """Energy analysis of a sampled trajectory of an oscillator (2.1), in SI units.
+
+    Rate-independent models (Dahl, Maxwell-slip, elastic-plastic elements, GMS with ``Fs = Fc``
+    and no damping, analysed as the equal Maxwell-slip model) give an :class:`EnergyReport`.
+    A :class:`prefriction.LuGre` model gives a :class:`LuGreEnergyReport`: the stored bristle
+    energy at the reversals and the viscous and hysteretic dissipation per half-cycle, apart
+    (docs/mathematics.md#lugre-energy); ``F[0]`` must then be the friction force at ``t[0]``
+    with the initial velocity.
 
     Detects the reversals (:func:`find_reversals`), evaluates the potential energy at each
     (:func:`branch_energy`, (3.9) for ``gamma = 1``), the dissipation per half-cycle (2.10)
@@ -178,13 +197,13 @@ def analyze_samples(
     F : array_like
         Friction forces [N], length N, ``|F| <= Fc``.
     system : Oscillator
-        The oscillator that produced the samples (mass, Dahl friction, input ``u``).
+        The oscillator that produced the samples (mass, friction model, input ``u``).
     method : {"trapezoid", "simpson"}
-        Quadrature of the input's work (forced systems only).
+        Quadrature of the input's work (forced systems) and of LuGre's dissipation powers.
 
     Returns
     -------
-    EnergyReport
+    EnergyReport or LuGreEnergyReport
 
     Raises
     ------
@@ -192,11 +211,14 @@ def analyze_samples(
         Invalid arrays (see :func:`find_reversals`), no reversal in the samples, or
         ``|F| > Fc``.
     TypeError
-        ``system`` is not an Oscillator with a Dahl friction model.
+        ``system`` is not an Oscillator, or its model is rate-dependent other than LuGre
+        (a GMS with ``Fs > Fc`` or damping).
     """
-    friction, mass = check_dahl_system(system)
+    friction, mass = check_system(system, lugre=True)
     method = check_method(method)
     t, x, v, F = check_samples(t=t, x=x, v=v, F=F)
+    if isinstance(friction, LuGre):
+        return analyze_lugre_samples(t, x, v, F, system=system, u=_input_power(system, t, np.ones_like(t)), method=method)
     over = np.abs(F) > friction.Fc * (1.0 + ROUNDING)
     if np.any(over):
         i = int(np.flatnonzero(over)[0])
@@ -244,20 +266,37 @@ def analyze_samples(
     )
 
 
-def analyze_table(table: ReversalTable, *, system: Oscillator) -> EnergyReport:
+def analyze_table(
+    table: ReversalTable, *, system: Oscillator, F0: float = 0.0, work_input: Any = None
+) -> EnergyReport:
     """Energy analysis of a trajectory given at its reversals (a :class:`ReversalTable`).
 
     Takes ``E_p`` and the dissipation from the table (``table.E_d[k + 1]`` is the half-cycle
     from reversal k to k + 1), checks (2.10) between them, forms the series (2.11), checks the
     bound (2.12), and recomputes ``E_p`` independently from the tabulated forces as the branch
-    potential of the Dahl model ((3.9) for ``gamma = 1``), reported as ``E_p_check``.
+    potential of the model ((3.9) for Dahl with ``gamma = 1``), reported as ``E_p_check``.
+
+    Tables of rate-dependent classes (:class:`prefriction.LuGre`; :class:`prefriction.GMS`,
+    analysed only with ``Fs = Fc`` and no damping, as the equal Maxwell-slip model) hold no
+    ``E_p`` (NaN) and only the kinetic part of ``E_0``. Their ``E_p`` is computed here from the
+    tabulated forces (LuGre: the stored bristle energy ``F_i^2 / (2 sigma0)``, exact because
+    ``z' = 0`` at a reversal), ``E_0`` adds the stored energy of ``F0``, and the dissipation is
+    ``E_p[k] + W_u[k] - E_p[k+1]`` with the input work ``work_input``.
 
     Parameters
     ----------
     table : ReversalTable
-        Reversal states in SI units, e.g. from :func:`prefriction.exact_reversals`.
+        Reversal states in SI units, e.g. from :func:`prefriction.exact_reversals` or
+        ``prefriction.simulate(...).reversals``.
     system : Oscillator
-        The oscillator of the table (Dahl friction model).
+        The oscillator of the table.
+    F0 : float, default 0.0
+        Initial friction force [N] of the run (``simulate``'s ``F0``), ``|F0| <= Fc``; only for
+        tables without ``E_p`` (rate-dependent classes).
+    work_input : array_like, optional
+        Work of the input force over each half-cycle that ends at a reversal [J], one value per
+        reversal, finite (``SimulationResult.work_input``); only for tables without ``E_p``,
+        required if the system is forced.
 
     Returns
     -------
@@ -266,16 +305,19 @@ def analyze_table(table: ReversalTable, *, system: Oscillator) -> EnergyReport:
     Raises
     ------
     ValueError
-        Empty table, a non-finite entry, or times not strictly increasing.
+        Empty table, a non-finite entry, times not strictly increasing, ``F0`` or
+        ``work_input`` given for a table that has ``E_p``, or invalid ``F0``/``work_input``.
     TypeError
-        ``table`` is not a ReversalTable, or ``system`` not an Oscillator with a Dahl model.
+        ``table`` is not a ReversalTable, or ``system`` not an Oscillator with a model the
+        analysis covers.
     """
-    friction, _ = check_dahl_system(system)
+    friction, _ = check_system(system, lugre=True)
     if not isinstance(table, ReversalTable):
         raise TypeError(f"table must be a prefriction.ReversalTable, got {table!r} of type {type(table).__name__}")
     if len(table) < 1:
         raise ValueError("table holds no reversal (length 0); need at least 1")
-    for name in ("t", "x", "F", "E_p", "E_d", "E_0"):
+    defined = system.friction.rate_independent  # the table's E_p, E_d and E_0 are the model's
+    for name in ("t", "x", "F") + (("E_p", "E_d", "E_0") if defined else ()):
         bad = ~np.isfinite(np.atleast_1d(np.asarray(getattr(table, name), dtype=float)))
         if np.any(bad):
             i = int(np.flatnonzero(bad)[0])
@@ -286,8 +328,6 @@ def analyze_table(table: ReversalTable, *, system: Oscillator) -> EnergyReport:
         raise ValueError(f"table.t must be strictly increasing, got t[{i + 1}] = {float(t[i + 1])!r} <= t[{i}] = {float(t[i])!r}")
     x = np.asarray(table.x, dtype=float)
     F = np.asarray(table.F, dtype=float)
-    E_p = np.asarray(table.E_p, dtype=float)
-    E_d = np.asarray(table.E_d, dtype=float)[1:]
     n = t.size
     # direction after reversal k is opposite to the motion that ended there
     direction = np.empty(n, dtype=int)
@@ -297,10 +337,25 @@ def analyze_table(table: ReversalTable, *, system: Oscillator) -> EnergyReport:
     else:
         direction[0] = -1 if F[0] > 0 else 1
     direction[direction == 0] = np.where(F[direction == 0] > 0, -1, 1)
-    check = branch_energy(F, direction, friction=friction)
+    if defined:
+        if F0 != 0.0 or work_input is not None:
+            raise ValueError(
+                f"F0 and work_input apply only to tables without E_p (rate-dependent classes); the table of "
+                f"{type(system.friction).__name__} has its own E_0 and E_d, got F0 = {F0!r}, work_input = {work_input!r}"
+            )
+        E_p = np.asarray(table.E_p, dtype=float)
+        E_d = np.asarray(table.E_d, dtype=float)[1:]
+        E_0, E_d_initial = float(table.E_0), float(table.E_d[0])
+        check = branch_energy(F, direction, friction=friction)
+        label = "branch potential of the tabulated F_i, (3.9) for gamma = 1"
+    else:
+        E_p, E_0, W = _undefined_table_energy(table, system, friction, direction, F0, work_input)
+        E_d = E_p[:-1] + W[1:] - E_p[1:]
+        E_d_initial = E_0 + float(W[0]) - float(E_p[0])
+        check, label = None, "none: E_p is computed from the tabulated forces"
     top = float(np.max(E_p))
     S, R = series(E_p, E_d)
-    E_0 = float(table.E_0)
+    bound = lugre_bound(E_p, friction, E_0) if isinstance(friction, LuGre) else bound_check(E_p, friction=friction, E_0=E_0)
     return EnergyReport(
         source="reversal table",
         t=t,
@@ -310,12 +365,36 @@ def analyze_table(table: ReversalTable, *, system: Oscillator) -> EnergyReport:
         E_p=E_p,
         E_d=E_d,
         E_0=E_0,
-        E_d_initial=float(table.E_d[0]),
+        E_d_initial=E_d_initial,
         series_partial=S,
         series_remainder=R,
-        residual_2_10=_rel_residual(E_p[:-1] - E_d - E_p[1:], top),
+        residual_2_10=_rel_residual(E_p[:-1] - E_d - E_p[1:] + (0.0 if defined else W[1:]), top),
         E_p_check=check,
-        E_p_check_label="branch potential of the tabulated F_i, (3.9) for gamma = 1",
-        E_p_check_max_rel_dev=_rel_residual(check - E_p, top),
-        bound=bound_check(E_p, friction=friction, E_0=E_0),
+        E_p_check_label=label,
+        E_p_check_max_rel_dev=None if check is None else _rel_residual(check - E_p, top),
+        bound=bound,
     )
+
+
+def _undefined_table_energy(
+    table: ReversalTable, system: Oscillator, friction: FrictionModel, direction: np.ndarray, F0: Any, work_input: Any
+) -> tuple[np.ndarray, float, np.ndarray]:
+    """``E_p``, ``E_0`` and the input work per reversal for a table whose class defines no ``E_p``."""
+    F0 = check_finite("F0", F0)
+    if abs(F0) > friction.Fc:
+        raise ValueError(f"F0 must lie in [-Fc, Fc] = [{-friction.Fc!r}, {friction.Fc!r}] N, got {F0!r}")
+    n = len(table)
+    if work_input is None:
+        if system.forced:
+            raise ValueError("work_input is required for the table of a forced system whose class defines no E_p "
+                             "(pass SimulationResult.work_input), got None")
+        W = np.zeros(n)
+    else:
+        W = np.atleast_1d(value_array("work_input", work_input))
+        if W.shape != (n,):
+            raise ValueError(f"work_input must hold one value per reversal ({n}), got {W.size}")
+    F = np.asarray(table.F, dtype=float)
+    s0 = -int(direction[0])
+    if isinstance(friction, LuGre):
+        return lugre_table_energy(F, friction), float(table.E_0) + float(lugre_table_energy(F0, friction)), W
+    return branch_energy(F, direction, friction=friction), float(table.E_0) + float(branch_energy(F0, s0, friction=friction)), W

@@ -3,16 +3,15 @@ dissipation of a closed cycle (2.5)-(2.7), and the mechanical energy of a Dahl o
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
 from scipy.integrate import cumulative_simpson, cumulative_trapezoid
 
 from prefriction.analysis.energy.balance import branch_energy
-from prefriction.analysis.energy.checks import check_dahl_system, check_method, check_samples
+from prefriction.analysis.energy.checks import check_method, check_samples, check_system, value_array
 from prefriction.analysis.energy.sampled_reversals import find_reversals
-from prefriction._validation import check_positive
+from prefriction._validation import check_nonnegative, check_positive
 from prefriction.models import Oscillator
 
 
@@ -21,8 +20,8 @@ def kinetic_energy(v: Any, *, mass: float) -> np.ndarray:
 
     Parameters
     ----------
-    v : array_like
-        Velocities [m/s].
+    v : float or array_like
+        Velocities [m/s], a finite number or a non-empty 1-D array of them.
     mass : float
         Moving mass [kg], ``0 < mass < inf``.
 
@@ -30,9 +29,16 @@ def kinetic_energy(v: Any, *, mass: float) -> np.ndarray:
     -------
     numpy.ndarray
         ``E_k`` [J], same shape as ``v``.
+
+    Raises
+    ------
+    TypeError
+        ``v`` or ``mass`` not real (``None``, strings, complex).
+    ValueError
+        NaN or inf in ``v``, an empty ``v``, or ``mass`` not finite and > 0.
     """
     m = check_positive("mass", mass)
-    v = np.asarray(v, dtype=float)
+    v = value_array("v", v)
     return 0.5 * m * v * v
 
 
@@ -70,6 +76,8 @@ def integrated_power(
         ``E_f`` at every sample [J], 0 at ``t[0]`` (and at each reversal if reset).
     """
     method = check_method(method)
+    if not isinstance(reset_at_reversals, (bool, np.bool_)):
+        raise TypeError(f"reset_at_reversals must be True or False, got {reset_at_reversals!r}")
     t, v, F = check_samples(t=t, v=v, F=F)
     p = F * v
     if not reset_at_reversals:
@@ -138,9 +146,7 @@ def loop_integral(x: Any, F: Any, *, closure_tol: float = 1e-6) -> float:
         the arrays are invalid.
     """
     x, F = check_samples(x=x, F=F)
-    tol = float(closure_tol)
-    if not (math.isfinite(tol) and tol >= 0.0):
-        raise ValueError(f"closure_tol must be finite and >= 0, got {closure_tol!r} (allowed range: 0 <= closure_tol < inf)")
+    tol = check_nonnegative("closure_tol", closure_tol)
     if x.size < 3:
         raise ValueError(f"a closed cycle needs at least 3 points, got {x.size}")
     span_x = float(np.ptp(x))
@@ -191,14 +197,16 @@ def total_energy(t: Any, v: Any, F: Any, *, system: Oscillator) -> np.ndarray:
     Returns
     -------
     numpy.ndarray
-        ``E_k + E_branch`` at every sample [J]. For ``gamma >= 1`` it is infinite where a
-        sample has ``s F = Fc`` exactly (deep gross sliding rounds the force to ``Fc``).
+        ``E_k + E_branch`` at every sample [J], finite.
 
     Raises
     ------
     ValueError
-        Invalid arrays, ``|F| > Fc``, or ``v = 0`` at every sample (no direction).
+        Invalid arrays, ``|F| > Fc``, ``v = 0`` at every sample (no direction), or a sample
+        with ``s F = Fc`` for a model whose stored energy is unbounded there (Dahl with
+        ``gamma >= 1``: deep gross sliding rounds the force to ``Fc``, and the energy is no
+        longer a function of the force; the message names the sample).
     """
-    friction, mass = check_dahl_system(system)
+    friction, mass = check_system(system)
     t, v, F = check_samples(t=t, v=v, F=F)
     return kinetic_energy(v, mass=mass) + branch_energy(F, _sample_directions(v), friction=friction)
