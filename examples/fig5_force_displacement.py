@@ -64,12 +64,13 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
     ax.axvline(0.0, color="0.5", lw=0.8)
     ax.plot([], [], "ko", ms=5, label="reversals $x_i$, $x_{i+1}$ (exact)")
     ax.plot([], [], "kx", ms=8, mew=1.5, label="$x_{i+1}$ from corrected (3.13)")
+    ax.plot([], [], ":", color="0.3", lw=0.8, label=r"$\pm F_c$, in the colour of its curve")
     ax.set_xlabel(r"displacement $x$ [m] (force zero crossing at $x = 0$)")
     ax.set_ylabel(r"restoring force $f[x]$ [N]")
     ax.grid(True, alpha=0.3)
     ax.legend(loc="lower right", fontsize=9)
     ax.set_title("Fig. 5: force-displacement curve between two reversals")
-    add_note(fig, f"sigma = {SIGMA:g} N/m and F_i = -Fc (not stated in the paper); dotted: +-Fc.\n"
+    add_note(fig, f"sigma = {SIGMA:g} N/m and F_i = -Fc (not stated in the paper).\n"
                   "(3.13) as printed puts x_{i+1} off the curve at " + "; ".join(printed_notes) + ".",
              lines=2)
     png = save(fig, outdir, "fig5_force_displacement.png")
