@@ -1,9 +1,12 @@
 """Closed-loop simulation of a python-control controller around the reversal-aware Dahl stage.
 
 :func:`simulate_loop` turns any SISO, proper python-control LTI controller (error ``e = r - x``
-[m] to force ``u`` [N]) into a :class:`prefriction.simulation.feedback.LinearFeedback` and runs
-:func:`prefriction.simulate`, which integrates ``m x'' = u - F`` with the Dahl friction (3.2)
-and lands on every velocity reversal (also inside a sample interval of a sampled controller).
+[m] to force ``u`` [N]) into a :class:`prefriction.simulation.feedback.LinearFeedback`. A
+sampled controller runs in compiled code, many samples per call
+(:func:`prefriction.simulation.loops.run_sampled`); a continuous one, or a sampled one with a
+disturbance input, through :func:`prefriction.simulate`. Both integrate ``m x'' = u - F`` with
+the friction model and land on every velocity reversal (inside the sample intervals too)
+(``docs/controllers.md``).
 """
 
 from __future__ import annotations
@@ -17,7 +20,8 @@ import numpy as np
 
 import prefriction
 from prefriction.analysis.branch import force_after_distance
-from prefriction.simulation.feedback import LinearFeedback
+from prefriction.simulation.feedback import LinearFeedback, sample_count
+from prefriction.simulation.loops import LoopStats, run_sampled
 from prefriction._validation import check_positive, check_signal
 from prefriction.models import Oscillator
 from prefriction.reversals import ReversalTable
@@ -25,7 +29,6 @@ from prefriction.simulation.simulate import SimulationResult
 
 from ._linear import _check_system, _sample_time, as_lti, closed_loop
 from ._pid import PID
-from ._saturated import simulate_saturated
 
 Reference = Union[float, Callable[[Any], Any], tuple]
 
@@ -62,9 +65,13 @@ class LoopResult:
     kp : float or None
         Static gain of the controller at ``s = 0`` (or ``z = 1``) if it is finite and
         positive (PD), ``None`` otherwise: then ``Fc / kp`` bounds the residual error.
-    simulation : prefriction.simulation.simulate.SimulationResult or None
-        The raw result of :func:`prefriction.simulate` (run statistics, work of the input);
-        ``None`` for a saturated (``u_max``) loop, which calls the simulator once per sample.
+    simulation : prefriction.simulation.simulate.SimulationResult
+        The raw simulation result (run statistics, work of the input): of
+        :func:`prefriction.simulate` for a continuous loop or a loop with a disturbance input,
+        of the compiled loop :func:`prefriction.simulation.loops.run_sampled` otherwise.
+    loop_stats : prefriction.simulation.loops.LoopStats or None
+        Blocks, integrated and resting periods of the compiled sampled loop; ``None`` for the
+        other paths.
     """
 
     t: np.ndarray
@@ -80,7 +87,8 @@ class LoopResult:
     controller: control.StateSpace
     system: Oscillator
     kp: Optional[float]
-    simulation: Optional[SimulationResult]
+    simulation: SimulationResult
+    loop_stats: Optional[LoopStats] = None
 
     @property
     def Fc(self) -> float:
@@ -122,11 +130,24 @@ class LoopResult:
             cF.append(s * Fc * f)
         return np.concatenate(cx), np.concatenate(cF)
 
-    def settling_time(self, band: float = 0.02) -> float:
+    @property
+    def settling_time(self) -> float:
+        """Settling time [s] into a 2 % band (:meth:`settling_time_within` with ``band = 0.02``)."""
+        return self.settling_time_within(0.02)
+
+    def settling_time_within(self, band: float) -> float:
         """First time [s] after which ``x`` stays within ``band`` of the step around its final value.
 
-        The step is ``|x[-1] - x[0]|`` (not the reference: a PD loop with friction stops short).
-        ``nan`` if the position does not move.
+        Parameters
+        ----------
+        band : float
+            Relative band [-], ``0 < band < inf`` (0.02 for the usual 2 % settling time).
+
+        Returns
+        -------
+        float
+            The time [s]; the step is ``|x[-1] - x[0]|`` (not the reference: a PD loop with
+            friction stops short); ``nan`` if the position does not move.
         """
         band = check_positive("band", band)
         step = abs(self.x[-1] - self.x[0])
@@ -138,6 +159,11 @@ class LoopResult:
         k = outside[-1] + 1
         return float(self.t[min(k, len(self.t) - 1)])
 
+    def __repr__(self) -> str:
+        kind = f"sampled, Ts = {self.Ts:.4g} s" if self.Ts is not None else "continuous"
+        return (f"LoopResult({kind}, {len(self.t)} samples to t = {self.t[-1]:.6g} s, residual error "
+                f"{self.residual_error:.4e} m, {len(self.reversals)} reversals)")
+
     def summary(self) -> str:
         """A few readable lines: controller, settling, residual error (against ``Fc/kp``), reversals."""
         kind = f"sampled, Ts = {self.Ts:.4g} s" if self.Ts is not None else "continuous"
@@ -145,7 +171,7 @@ class LoopResult:
             f"closed loop ({kind}), t_end = {self.t[-1]:.6g} s, {len(self.t)} output samples",
             f"  reference at t_end      {self.reference[-1]: .6e} m",
             f"  position at t_end       {self.x[-1]: .6e} m",
-            f"  settling time (2 %)     {self.settling_time():.6g} s",
+            f"  settling time (2 %)     {self.settling_time:.6g} s",
             f"  residual error r - x    {self.residual_error: .6e} m",
         ]
         if self.error_bound is not None:
@@ -217,9 +243,9 @@ def simulate_loop(
         Continuous (its states are integrated with the plant) or discrete with ``dt > 0``
         (sampled-data loop: ``u[k] = C xc[k] + D e[k]`` held constant over each sample
         interval, zero-order hold), e.g. from ``control.c2d``. A :class:`PID` with a force
-        limit ``u_max`` (sampled loops only) saturates the force and corrects its integrator
-        by back-calculation (see :mod:`controllers._saturated`); this path calls the
-        simulator once per sample and is several times slower.
+        limit ``u_max`` (sampled loops only) applies ``clip(u, -u_max, u_max)`` and corrects
+        its integrator by back-calculation, ``xc[k+1] = A xc[k] + B e[k] + Ts k_aw (u[k] - v[k])``
+        with the unclipped output ``v[k]`` and ``k_aw`` of :meth:`PID.back_calculation_gain`.
     reference : float, callable or (t, r)
         Position reference [m]: a number (a step at ``t = 0``), a callable ``r(t)`` of time
         [s], or samples ``(t, r)`` of equal length (linear between samples, held constant
@@ -227,7 +253,8 @@ def simulate_loop(
         (numpy ufuncs and arithmetic, no ``if`` on ``t``); with a sampled controller any
         Python callable works (it is read at the sample instants only).
     t_end : float
-        End time [s], ``0 < t_end < inf``.
+        End time [s], ``0 < t_end < inf``; a sampled loop has at most
+        :data:`prefriction.simulation.feedback.MAX_SAMPLES` sample instants (``t_end / Ts``).
     Ts : float, optional
         Sample time [s], ``0 < Ts < inf``. Default: the discrete controller's ``dt``; ``None``
         for a continuous controller. Given with a continuous controller, the controller is
@@ -254,7 +281,7 @@ def simulate_loop(
     Raises
     ------
     ValueError
-        Non-positive or non-finite ``t_end`` or ``Ts``; ``Ts`` different from the discrete
+        Non-positive or non-finite ``t_end`` or ``Ts``; more than ``MAX_SAMPLES`` samples; ``Ts`` different from the discrete
         controller's ``dt``; malformed reference samples (lengths differ, not increasing,
         not finite); an improper or non-SISO controller; ``t_out`` with a sampled controller.
     TypeError
@@ -289,42 +316,42 @@ def simulate_loop(
     elif Ts is not None:
         C = control.c2d(C, Ts, method=discretization)
     closed_loop(system, C, regime="presliding", warn=True)
-    if saturated:
-        if Ts is None:
-            raise NotImplementedError(
-                f"u_max={controller.u_max!r}: force saturation with anti-windup is simulated for sampled "
-                "controllers only (prefriction.simulate's continuous feedback is linear); give Ts"
-            )
-        if t_out is not None:
-            raise ValueError("t_out is not allowed with a sampled controller: its outputs are at the sample instants k Ts")
-        out = simulate_saturated(
-            system, C, controller.back_calculation_gain(), controller.u_max,
-            lambda t: _evaluate(reference, t), t_end, Ts, x0=x0, v0=v0, F0=F0, xc0=xc0, rtol=rtol, jit=jit,
+    if saturated and Ts is None:
+        raise NotImplementedError(
+            f"u_max={controller.u_max!r}: force saturation with anti-windup is simulated for sampled "
+            "controllers only (prefriction.simulate's continuous feedback is linear); give Ts"
         )
-        return LoopResult(
-            t=out["t"], reference=out["reference"], x=out["x"], v=out["v"], F=out["F"], u=out["u"],
-            error=out["reference"] - out["x"], xc=out["xc"], reversals=out["reversals"], Ts=Ts, controller=C,
-            system=system, kp=None, simulation=None,
-        )
-
     fb_reference = reference
+    stats = None
     if Ts is not None:
         if t_out is not None:
             raise ValueError("t_out is not allowed with a sampled controller: its outputs are at the sample instants k Ts")
+        sample_count(t_end, Ts, t_end / Ts)  # refuse runs that would exhaust the memory
         if callable(reference):  # read at the sample instants only: any Python callable works
             tk = Ts * np.arange(int(math.floor(t_end / Ts * (1 + 1e-12))) + 2)
             fb_reference = (tk, _evaluate(reference, tk))
-        dense: Any = False
-    else:
-        if t_out is None:
-            dense = np.linspace(0.0, t_end, 2001)
+        fb = LinearFeedback(A=C.A, B=C.B, C=C.C, D=C.D, Ts=Ts, reference=fb_reference, xc0=xc0)
+        if saturated and system.forced:
+            raise ValueError(
+                "a force limit u_max needs an oscillator without its own input force (system.u = None), "
+                f"got system.u = {system.u!r}"
+            )
+        if system.forced:  # a disturbance force: the Python loop of prefriction.simulate
+            sim = prefriction.simulate(system, v0, x0=x0, F0=F0, t_end=t_end, rtol=rtol, feedback=fb, jit=jit)
         else:
-            dense = np.asarray(t_out, dtype=float)
-    fb = LinearFeedback(A=C.A, B=C.B, C=C.C, D=C.D, Ts=Ts, reference=fb_reference, xc0=xc0)
-    sim = prefriction.simulate(system, v0, x0=x0, F0=F0, t_end=t_end, rtol=rtol, dense=dense, feedback=fb, jit=jit)
+            sim, stats = run_sampled(
+                system, fb, t_end, x0=x0, v0=v0, F0=F0, rtol=rtol, jit=jit,
+                u_max=controller.u_max if saturated else None,
+                k_aw=controller.back_calculation_gain() if saturated else None,
+            )
+    else:
+        dense = np.linspace(0.0, t_end, 2001) if t_out is None else np.asarray(t_out, dtype=float)
+        fb = LinearFeedback(A=C.A, B=C.B, C=C.C, D=C.D, Ts=Ts, reference=fb_reference, xc0=xc0)
+        sim = prefriction.simulate(system, v0, x0=x0, F0=F0, t_end=t_end, rtol=rtol, dense=dense, feedback=fb, jit=jit)
     t = sim.t
     r = _evaluate(reference, t)
     return LoopResult(
         t=t, reference=r, x=sim.x, v=sim.v, F=sim.F, u=sim.u, error=r - sim.x, xc=sim.xc,
-        reversals=sim.reversals, Ts=Ts, controller=C, system=system, kp=_dc_gain(C), simulation=sim,
+        reversals=sim.reversals, Ts=Ts, controller=C, system=system, kp=None if saturated else _dc_gain(C),
+        simulation=sim, loop_stats=stats,
     )

@@ -67,7 +67,7 @@ def step_responses(design: PID, t_end: float, path: "str | Path", *, bound: Opti
         steps[label] = {
             "step": r, "t": res.t, "reference": res.reference, "x": res.x, "u": res.u, "F": res.F,
             "error": res.error, "residual_error": res.residual_error, "bound": res.error_bound,
-            "settling_time": res.settling_time(), "reversals": len(res.reversals),
+            "settling_time": res.settling_time, "reversals": len(res.reversals),
             "reversal_x": res.reversals.x, "reversal_F": res.reversals.F,
         }
     return {

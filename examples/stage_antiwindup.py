@@ -45,7 +45,7 @@ def main(outdir: "str | Path" = ".") -> dict:
         cases[label] = {
             "t": res.t, "x": res.x, "u": res.u, "F": res.F, "error": res.error,
             "overshoot": float(np.max(res.x) - STEP), "peak_force": float(np.max(np.abs(res.u))),
-            "residual_error": res.residual_error, "settling_time": res.settling_time(),
+            "residual_error": res.residual_error, "settling_time": res.settling_time,
             "reversals": len(res.reversals),
         }
     return {"path": path, "kp": pid.kp, "ki": pid.ki, "kd": pid.kd, "u_max": U_MAX, "step": STEP,

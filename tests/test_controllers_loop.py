@@ -263,7 +263,7 @@ def test_saturated_path_without_saturation_equals_linear_path():
     big = controllers.simulate_loop(system, controllers.PID(kp=c.kp, ki=c.ki, kd=c.kd, tau=c.tau, u_max=1e9),
                                     2e-6, 0.02, Ts=TS)
     n = min(len(lin.t), len(big.t))
-    assert big.simulation is None and lin.simulation is not None
+    assert big.loop_stats is not None and lin.loop_stats is not None
     assert rel_err(big.x[:n], lin.x[:n]) <= 1e-8
     assert len(big.reversals) == len(lin.reversals) >= 2
     np.testing.assert_allclose(big.reversals.x, lin.reversals.x, rtol=1e-8)
