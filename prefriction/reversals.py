@@ -48,6 +48,34 @@ class ReversalTable:
     def __len__(self) -> int:
         return len(self.t)
 
+    def __repr__(self) -> str:
+        if not len(self):
+            return f"ReversalTable(0 reversals, E_0 = {self.E_0:.6g} J)"
+        return (f"ReversalTable({len(self)} reversals in [{self.t[0]:.6g}, {self.t[-1]:.6g}] s, "
+                f"last x = {self.x[-1]:.6g} m, F = {self.F[-1]:.6g} N, E_0 = {self.E_0:.6g} J)")
+
+    def summary(self) -> str:
+        """A few lines: the number of reversals, their time span, the first and the last reversal,
+        the initial energy, the last stored energy and the energy dissipated in all half-cycles.
+
+        Returns
+        -------
+        str
+            Text without arrays, e.g. ``"50 reversals in [0.0314, 1.59] s"`` and three more lines.
+        """
+        n = len(self)
+        if not n:
+            return f"0 reversals; initial energy E_0 = {self.E_0:.6g} J"
+        stored = not np.all(np.isnan(self.E_p))  # NaN: no stored branch energy (rate-dependent model)
+        lines = [f"{n} reversals in [{self.t[0]:.9g}, {self.t[-1]:.9g}] s"]
+        for name, i in (("first", 0), ("last", n - 1)):
+            lines.append(f"{name}: t = {self.t[i]:.9g} s, x = {self.x[i]:.9g} m, F = {self.F[i]:.9g} N"
+                         + (f", E_p = {self.E_p[i]:.6g} J" if stored else ""))
+        lines.append(f"energy: E_0 = {self.E_0:.6g} J, " + (
+            f"dissipated over the {n} half-cycles {float(np.sum(self.E_d)):.6g} J" if stored
+            else "E_p and E_d not defined (no stored branch energy)"))
+        return "\n".join(lines)
+
     def format(self, max_rows: int = 20) -> str:
         """Return the table as aligned text, at most ``max_rows`` rows (first and last half)."""
         head = f"{'i':>5} {'t [s]':>14} {'x [m]':>14} {'F [N]':>14} {'E_p [J]':>12} {'E_d [J]':>12}"

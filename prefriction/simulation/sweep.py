@@ -59,6 +59,12 @@ class SweepResult(list):
         Index -> exception of each failed run.
     wall_time : float
         Wall time of the whole sweep [s], compiling included.
+    status : int
+        As scipy's ``OdeResult``: ``0`` every run returned a result, ``-1`` some run raised.
+    success : bool
+        True if no run raised (``status >= 0``).
+    message : str
+        The outcome in words: all runs succeeded, or how many failed and the first error.
     """
 
     def __init__(self, results: Iterable[Any] = (), wall_time: float = 0.0) -> None:
@@ -71,6 +77,21 @@ class SweepResult(list):
         return f"SweepResult({len(self)} runs, {len(self.failed)} failed, {self.wall_time:.2f} s)"
 
     __str__ = __repr__
+
+    @property
+    def status(self) -> int:
+        """``0`` if every run returned a result, ``-1`` if some run raised (as ``OdeResult.status``)."""
+        return -1 if self.failed else 0
+
+    @property
+    def success(self) -> bool:
+        """True if no run raised (as ``OdeResult.success``)."""
+        return self.status >= 0
+
+    @property
+    def message(self) -> str:
+        """The outcome in words (as ``OdeResult.message``)."""
+        return _failure_message(self) if self.failed else f"all {len(self)} runs succeeded"
 
     def summary(self) -> str:
         """One line of counts and wall time, then one line per failed run (at most 10).
