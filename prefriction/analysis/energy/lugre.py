@@ -134,4 +134,16 @@ def half_cycle_split(
     powers = np.vstack((p_s2, p_s1, p_h, u * v))
     ends = np.concatenate(([t[0]], rev.t))
     D = np.array([_piece_integrals(t, powers, ends[k], ends[k + 1], method) for k in range(ends.size - 1)]).T
-    return {"z": z, "interpolated": n_interp, "first": D[:, 0], "half": D[:, 1:]}
+    return {"z": z, "z_rev": _hermite(t, z, zd, rev), "interpolated": n_interp, "first": D[:, 0], "half": D[:, 1:]}
+
+
+def _hermite(t: np.ndarray, z: np.ndarray, zd: np.ndarray, rev: SampledReversals) -> np.ndarray:
+    """Deflection at the reversals by cubic Hermite interpolation of ``(z, z')`` in time between
+    the samples around each (third order; the force is no function of ``x`` near a reversal,
+    ``F' = sigma0 v + (sigma1 + sigma2) v'`` while ``x' = 0``, so it is not extrapolated in ``x``)."""
+    a = rev.index
+    b = a + 1
+    h = t[b] - t[a]
+    s = (rev.t - t[a]) / h
+    h00, h10, h01, h11 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s, -2 * s**3 + 3 * s**2, s**3 - s**2
+    return h00 * z[a] + h10 * h * zd[a] + h01 * z[b] + h11 * h * zd[b]

@@ -24,7 +24,8 @@ class LuGreEnergyReport:
     Attributes
     ----------
     t, x, F : numpy.ndarray
-        Reversal times [s], positions [m] and friction forces [N], length n.
+        Reversal times [s], positions [m] and friction forces ``F = sigma0 z`` [N] (``z`` by
+        cubic Hermite interpolation of the deflection and its rate in time), length n.
     direction : numpy.ndarray
         Sign of the velocity after each reversal.
     E_p : numpy.ndarray
@@ -141,7 +142,8 @@ def analyze_lugre_samples(
             "no reversal to analyse; simulate longer"
         )
     split = half_cycle_split(t, v, F, u, rev, friction, method)
-    E_p = rev.F**2 / (2.0 * friction.sigma0)
+    F_rev = friction.sigma0 * split["z_rev"]  # v = 0 and z' = 0 at a reversal: F = sigma0 z
+    E_p = F_rev**2 / (2.0 * friction.sigma0)
     z0 = float(split["z"][0])
     E_0 = 0.5 * system.mass * float(v[0]) ** 2 + 0.5 * friction.sigma0 * z0 * z0
     s2, s1, h, w = split["half"]
@@ -151,7 +153,7 @@ def analyze_lugre_samples(
     lost = np.concatenate(([E_d_initial - f2 - f1 - fh], E_d - s2 - s1 - h))
     scale = max(E_0, float(np.max(E_p)))
     return LuGreEnergyReport(
-        t=rev.t, x=rev.x, F=rev.F, direction=rev.direction, E_p=E_p, E_0=E_0, W_u=w, E_d=E_d,
+        t=rev.t, x=rev.x, F=F_rev, direction=rev.direction, E_p=E_p, E_0=E_0, W_u=w, E_d=E_d,
         D_sigma2=s2, D_sigma1=s1, D_viscous=s2 + s1, D_hysteretic=h,
         W_u_initial=fw, E_d_initial=E_d_initial, D_viscous_initial=f2 + f1, D_hysteretic_initial=fh,
         residual=float(np.max(np.abs(lost)) / scale) if scale > 0 else float(np.max(np.abs(lost))),
