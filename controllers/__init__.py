@@ -4,7 +4,8 @@
   ``u`` [N]: :class:`PID` (with :func:`pd`, :func:`pid`) gives ``kp + ki/s + kd s/(tau s + 1)``
   as ``.ss()``, ``.tf()`` or ``.c2d(Ts)``; :func:`design_pd` and :func:`design_pid` place the
   poles on the pre-sliding linearisation ``1/(m s^2 + sigma)`` or the sliding one ``1/(m s^2)``;
-  :func:`margins` reports ``control.stability_margins``; :func:`closed_loop` is the linear loop
+  :func:`margins` reads gain and phase margins at the exact crossovers (``inf`` where
+  there is none); :func:`closed_loop` is the linear loop
   (warns with its poles if unstable).
 - :func:`simulate_loop` runs any SISO proper controller, continuous or sampled (ZOH), around
   the reversal-aware plant of :func:`prefriction.simulate`; a :class:`PID` with a force limit
@@ -19,15 +20,8 @@
 from __future__ import annotations
 
 from ._iosys import plant_iosys
-from ._linear import (
-    Margins,
-    UnstableLoopWarning,
-    closed_loop,
-    design_pd,
-    design_pid,
-    linear_plant,
-    margins,
-)
+from ._linear import UnstableLoopWarning, closed_loop, design_pd, design_pid, linear_plant
+from ._margins import Margins, margins
 from ._loop import LoopResult, simulate_loop
 from ._pid import PID, pd, pid
 

@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import dataclass
 from typing import Optional
 
 import control
@@ -180,68 +179,6 @@ def warn_if_unstable(sys: control.LTI, *, what: str, stacklevel: int = 2) -> boo
         stacklevel=stacklevel + 1,
     )
     return True
-
-
-@dataclass(frozen=True)
-class Margins:
-    """Stability margins of the loop gain ``L = C P`` from ``control.stability_margins``.
-
-    Attributes
-    ----------
-    gain_margin : float
-        Gain margin [-] (``inf`` if the phase never crosses -180 deg). On the pre-sliding plant
-        the undamped resonance at ``sqrt(sigma/m)`` makes the phase cross -180 deg where
-        ``|L| = inf``: python-control then reports a gain margin of about 0, a lower margin
-        that only says "with the gain reduced to zero the loop is marginal".
-    phase_margin : float
-        Phase margin [deg].
-    stability_margin : float
-        Smallest distance of the Nyquist curve from -1 [-].
-    w_phase_crossover : float
-        Frequency where the gain margin is read [rad/s].
-    w_gain_crossover : float
-        Frequency where ``|L| = 1`` [rad/s].
-    """
-
-    gain_margin: float
-    phase_margin: float
-    stability_margin: float
-    w_phase_crossover: float
-    w_gain_crossover: float
-
-    def __str__(self) -> str:
-        gm_db = 20 * math.log10(self.gain_margin) if 0 < self.gain_margin < math.inf else self.gain_margin
-        return (
-            f"gain margin {self.gain_margin:.4g} ({gm_db:.3g} dB) at {self.w_phase_crossover:.5g} rad/s, "
-            f"phase margin {self.phase_margin:.4g} deg at {self.w_gain_crossover:.5g} rad/s, "
-            f"stability margin {self.stability_margin:.4g}"
-        )
-
-
-def margins(system: Oscillator, controller: "PID | control.LTI", *, regime: str = "presliding") -> Margins:
-    """Gain, phase and stability margins of ``L = C P`` (``control.stability_margins``).
-
-    A discrete controller is evaluated with the ZOH-discretised plant.
-
-    Parameters
-    ----------
-    system : prefriction.Oscillator
-        The stage: mass [kg] and Dahl friction (rest stiffness sigma [N/m]).
-    controller : PID or control.LTI
-        Controller from the error ``e = r - x`` [m] to the force ``u`` [N].
-    regime : {"presliding", "sliding"}, default "presliding"
-        Linearisation of the plant: ``1/(m s^2 + sigma)`` or ``1/(m s^2)``.
-
-    Returns
-    -------
-    Margins
-        Gain margin [-], phase margin [deg], stability margin [-] and the phase and gain
-        crossover frequencies [rad/s], as ``control.stability_margins`` reports them.
-    """
-    C = as_lti(controller)
-    P = linear_plant(system, regime, _sample_time(C))
-    gm, pm, sm, wpc, wgc, _ = control.stability_margins(P * C)
-    return Margins(float(gm), float(pm), float(sm), float(wpc), float(wgc))
 
 
 def _plant_numbers(system: Oscillator, regime: str) -> tuple[float, float]:

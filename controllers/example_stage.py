@@ -15,7 +15,7 @@ from typing import Any, Optional
 
 import prefriction
 
-from ._linear import margins
+from ._margins import margins
 from ._loop import simulate_loop
 from ._pid import PID
 from .plotting import plot_steps

@@ -163,3 +163,56 @@ def test_stable_design_does_not_warn(stage):
         controllers.design_pd(stage, wn=2 * np.pi * 300)
         controllers.design_pid(stage, wn=2 * np.pi * 150)
         controllers.closed_loop(stage, controllers.design_pid(stage, wn=2 * np.pi * 150).c2d(1e-4))
+
+
+def _crossover(f, lo, hi):
+    return brentq(f, lo, hi, xtol=1e-12)
+
+
+def test_margins_pd_by_hand(stage):
+    """PD on 1/(m s^2 + sigma): Im C(jw) = kd w/(1 + tau^2 w^2) > 0 for every w > 0, so L is
+    never real and negative: no phase crossover, an infinite gain margin (python-control reports
+    a number at the resonance or at 1e11 rad/s). The gain crossover solves |C(jw)| = |sigma - m w^2|."""
+    kp, kd, tau = 2.55e6, 2640.0, 5.3e-5
+    mg = controllers.margins(stage, controllers.pd(kp, kd, tau=tau))
+    C = lambda w: kp + kd * 1j * w / (tau * 1j * w + 1)  # noqa: E731
+    wgc = _crossover(lambda w: abs(C(w)) - abs(SIGMA - M * w * w), 1.5e3, 1e5)
+    pm = 180.0 + np.degrees(np.angle(C(wgc) / (SIGMA - M * wgc ** 2)))
+    assert mg.gain_margin == np.inf and np.isnan(mg.w_phase_crossover) and mg.phase_crossovers == ()
+    assert mg.w_gain_crossover == pytest.approx(wgc, rel=1e-9)
+    assert mg.phase_margin == pytest.approx(pm, rel=1e-9)
+    assert "gain margin inf" in str(mg)
+
+
+def test_margins_pid_by_hand(stage):
+    """PID: Im C(jw) = kd w/(1 + tau^2 w^2) - ki/w vanishes at w1 = sqrt(ki/(kd - ki tau^2)), where
+    C = kp + kd tau w1^2/(1 + tau^2 w1^2) is real and positive. Pre-sliding (w1 < sqrt(sigma/m)) L is
+    positive there: no phase crossover. Sliding, L = -C/(m w1^2) < 0 with |L| > 1: a lower gain
+    margin m w1^2 / C (the loop is conditionally stable) and still no upper one."""
+    kp, ki, kd, tau = 1.13e6, 8.37e8, 2262.0, 1.06e-4
+    c = controllers.PID(kp=kp, ki=ki, kd=kd, tau=tau)
+    w1 = np.sqrt(ki / (kd - ki * tau * tau))
+    C1 = kp + kd * tau * w1 ** 2 / (1 + (tau * w1) ** 2)
+    pre = controllers.margins(stage, c)
+    assert w1 < np.sqrt(SIGMA / M) and pre.gain_margin == np.inf and pre.phase_crossovers == ()
+    C = lambda w: kp + ki / (1j * w) + kd * 1j * w / (tau * 1j * w + 1)  # noqa: E731
+    wgc = _crossover(lambda w: abs(C(w)) - abs(SIGMA - M * w * w), 1.5e3, 1e5)
+    assert pre.w_gain_crossover == pytest.approx(wgc, rel=1e-9)
+    assert pre.phase_margin == pytest.approx(180.0 + np.degrees(np.angle(C(wgc) / (SIGMA - M * wgc ** 2))), rel=1e-9)
+    sl = controllers.margins(stage, c, regime="sliding")
+    assert sl.gain_margin == np.inf
+    assert sl.phase_crossovers == pytest.approx((w1,), rel=1e-9)
+    assert sl.lower_gain_margin == pytest.approx(M * w1 ** 2 / C1, rel=1e-9)
+    wgs = _crossover(lambda w: abs(C(w)) - M * w * w, 1e3, 1e5)
+    assert sl.phase_margin == pytest.approx(180.0 + np.degrees(np.angle(-C(wgs) / (M * wgs ** 2))), rel=1e-9)
+
+
+def test_margins_sampled_pd_against_python_control(stage):
+    """A sampled PD (ZOH plant) has a finite gain margin below the Nyquist frequency; there
+    python-control's grid search is reliable and serves as the reference."""
+    Cd = controllers.design_pd(stage, wn=2 * np.pi * 300).c2d(1e-4)
+    gm, pm, _, wpc, wgc, _ = control.stability_margins(controllers.linear_plant(stage, Ts=1e-4) * Cd)
+    mg = controllers.margins(stage, Cd)
+    assert mg.gain_margin == pytest.approx(gm, rel=1e-6) and mg.w_phase_crossover == pytest.approx(wpc, rel=1e-6)
+    assert mg.phase_margin == pytest.approx(pm, rel=1e-6) and mg.w_gain_crossover == pytest.approx(wgc, rel=1e-6)
+    assert 1.0 < mg.gain_margin < 10.0
