@@ -66,7 +66,7 @@ def branch_energy(F: Any, direction: Any, *, friction: FrictionModel) -> np.ndar
     if np.any(infinite):
         i = np.unravel_index(int(np.flatnonzero(infinite)[0]), E.shape)
         raise ValueError(
-            f"the branch energy is infinite at F{list(i) if E.ndim else ''} = {float(F[i])!r} N in direction "
+            f"the branch energy is infinite at F{[int(k) for k in i] if E.ndim else ''} = {float(F[i])!r} N in direction "
             f"{int(s[i]):+d}: the force has reached (or rounded to) the saturation force s Fc, where this model "
             f"({type(friction).__name__}) stores unbounded energy and the force no longer determines it; "
             "allowed: s F < Fc on the loading side (deep gross sliding cannot be analysed from the force)"
