@@ -19,7 +19,7 @@ __all__ = ["fit"]
 
 def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequence[str] | None = None,
         fixed: Sequence[str] | None = None, bounds: dict[str, tuple[float, float]] | None = None,
-        mass0: float | None = None, substeps: int | None = None, max_iter: int = 200, tol: float = 1e-10,
+        mass0: float | None = None, reversals: Sequence[float] | None = None, substeps: int | None = None, max_iter: int = 200, tol: float = 1e-10,
         identifiability_limit: float = 0.5) -> FitResult:
     """Fit a friction model's parameters to measured data.
 
@@ -46,6 +46,11 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
         structure (Dahl ``gamma``).
     mass0 : float, optional
         Start value of the mass [kg] when ``data.mass`` is ``None`` (the mass is then fitted).
+    reversals : sequence of float, optional
+        Approximate velocity reversal times [s] of :class:`Motion` data, each refined within a
+        sample and a half; default: located from the sign changes of a smoothed velocity. The
+        nonlinear program is built once per model structure, free set, number of samples and
+        sample interval of every reversal, so refits with the same reversal layout reuse it.
     substeps : int, optional
         Runge-Kutta sub-steps per sample interval (1 to 64); default: chosen from the data and
         the start values.
@@ -100,7 +105,10 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
     tol = check_positive("tol", tol)
     limit = check_positive("identifiability_limit", identifiability_limit)
     if isinstance(data, Motion):
-        return _fit_motion(model, data, free, fixed, bounds, mass0, substeps, max_iter, tol, limit)
+        return _fit_motion(model, data, free, fixed, bounds, mass0, reversals, substeps, max_iter, tol, limit)
+    if reversals is not None:
+        raise ValueError("reversals is for Motion data; force-displacement data have their directions from dx "
+                         "(allowed: reversals=None)")
     if mass0 is not None:
         raise ValueError(f"mass0 = {mass0!r} is for Motion data with a free mass; force-displacement data "
                          f"involve no mass (allowed: mass0=None)")
@@ -115,7 +123,7 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
     return _finish(space, values, est, stats, -sol.residuals, sol.prediction, data, None, nuisance, sol.message)
 
 
-def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bounds: Any, mass0: Any,
+def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bounds: Any, mass0: Any, reversals: Any,
                 substeps: int | None, max_iter: int, tol: float, limit: float) -> FitResult:
     from prefriction.identify.shooting import fit_motion
 
@@ -128,7 +136,7 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
         raise ValueError(f"mass0 = {mass0!r} is only for a free mass, but data.mass = {data.mass!r} is known "
                          f"(allowed: mass0=None)")
     space = ParameterSpace(model, free, fixed, bounds, mass=mass0)
-    sol = fit_motion(model, data, space, n_sub=substeps, max_iter=max_iter, tol=tol)
+    sol = fit_motion(model, data, space, n_sub=substeps, max_iter=max_iter, tol=tol, reversals=reversals)
     values = space.values(sol.w[: space.n_free])
     est = np.array([values[n] for n in space.free])
     stats = gauss_newton(sol.jacobian, sol.residuals, space.free, est, space.scale,
