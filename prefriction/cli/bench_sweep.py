@@ -741,6 +741,22 @@ def targets(rows: Sequence[SweepRow], cases: Sequence[SweepCase], quick: bool) -
     return lines
 
 
+def out_dir(text: str) -> Path:
+    """``--out`` of the bench commands: a directory path (created later if missing).
+
+    Raises
+    ------
+    argparse.ArgumentTypeError
+        If ``text`` is empty or names an existing file that is not a directory.
+    """
+    path = Path(text)
+    if not text.strip():
+        raise argparse.ArgumentTypeError("must be a directory path, got an empty string")
+    if path.exists() and not path.is_dir():
+        raise argparse.ArgumentTypeError(f"must be a directory, got {text!r}, an existing file")
+    return path
+
+
 def _progress(message: str) -> None:
     """One progress line on stderr (the table goes to stdout)."""
     print(f"  ... {message}", file=sys.stderr, flush=True)
@@ -760,12 +776,19 @@ def main(argv: Optional[list[str]] = None) -> int:
     int
         0 if the target lines all say PASS, else 1.
     """
-    ap = argparse.ArgumentParser(prog="prefriction bench --sweep", description=__doc__.split("\n\n")[0])
-    ap.add_argument("--out", default="bench_out", help="output directory for sweep.csv [bench_out]")
+    ap = argparse.ArgumentParser(
+        prog="prefriction bench --sweep", formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="Parameter sweeps with one compiled integrator per structure: 20 values of gamma in\n"
+                    "[1, 3], 20 in [0.3, 0.9] and 20 amplitudes of a 5 Hz sine input, each run once in a\n"
+                    "new process with an empty compiled-code cache (cold) and then in new processes that\n"
+                    "find it cached (warm), against scipy DOP853 with restarts at the same error.\n"
+                    "Targets T1 (speed, one compile) and T2 (one compile per structure); docs/bench.md.")
+    ap.add_argument("--out", default="bench_out", type=out_dir, metavar="DIR",
+                    help="output directory for sweep.csv, created if missing (default: bench_out)")
     ap.add_argument("--quick", action="store_true",
                     help="4 values per sweep, one warm process, one scipy repeat (T1 speed not checked)")
     args = ap.parse_args(argv)
-    out = Path(args.out)
+    out = args.out
     out.mkdir(parents=True, exist_ok=True)
     cases = sweep_cases(QUICK_VALUES if args.quick else N_VALUES)
     warm_repeats = 1 if args.quick else WARM_REPEATS
