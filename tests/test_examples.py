@@ -105,6 +105,16 @@ def test_fig4_omega_star_meets_omega_at_zero_and_at_its_secant_point(outdir):
         # ... which is the next reversal only approximately (the paper requires equality there)
         assert rel(p["x_cross"][1.0], p["x_exact"][1.0]) < 0.01
         assert rel(p["x_cross"][0.2], p["x_exact"][0.2]) > 0.1
+    # panel (c): errors of the secant crossing and of the corrected (3.13) against the exact map
+    err = r["error"]
+    for k in (0, len(err["a"]) // 2, len(err["a"]) - 1):
+        am = mp.mpf(err["a"][k])
+        ye = mp_distance_for_energy(mp_potential(am))
+        ya = mp_potential(am) / (1 - (1 + am) ** mp.mpf("-0.6"))
+        kk = (1 + am) ** mp.mpf("-0.6")
+        yc = mp.findroot(lambda y: mp.exp(-y) - 1 + kk * y, 1.2 * ye)
+        assert err["approx"][k] == pytest.approx(float(ya / ye - 1), abs=1e-10)
+        assert err["cross"][k] == pytest.approx(float(yc / ye - 1), abs=1e-10)
 
 
 def test_fig5_branch_reaches_the_exact_next_reversal_with_energy_39(outdir):
@@ -182,6 +192,9 @@ def test_beyond_convergence_follows_3_over_2n(outdir):
     off200 = 1 / ref[200] - mp.mpf(400) / 3
     assert abs(r["offset"][-1] - float(off200)) < 0.01
     assert abs(r["rel_dev"][-1]) < 2.0 / n[-1]
+    # the refined law 15k/(10k^2 - 1), k = n + n0: 1/a_n = (2/3) k - 1/(15 k) + O(k^-3) at n = 200
+    k200 = (15 / ref[200] + mp.sqrt(225 / ref[200] ** 2 + 40)) / 20
+    assert abs(r["n0"] - float(k200 - 200)) < 1e-4
     assert np.allclose(r["law"], 1.5 / n)
 
 

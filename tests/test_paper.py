@@ -47,3 +47,27 @@ def test_examples_dir_holds_every_figure_script():
     d = examples_dir()
     for name in FIGURES:
         assert (d / f"{name}.py").is_file()
+
+
+@pytest.mark.parametrize("kind", ["file", "under_a_file"])
+def test_paper_command_refuses_an_unwritable_out(tmp_path, capsys, kind):
+    blocker = tmp_path / "a_file"
+    blocker.write_text("not a directory")
+    out = blocker if kind == "file" else blocker / "sub"
+    with pytest.raises(SystemExit) as err:
+        cli.main(["paper", "--out", str(out), "--quick"])
+    assert err.value.code == 2
+    printed = capsys.readouterr()
+    assert "--out" in printed.err and str(out) in printed.err
+    assert "Traceback" not in printed.err and printed.out == ""
+
+
+def test_paper_help_is_plain_text(capsys):
+    with pytest.raises(SystemExit) as err:
+        cli.main(["paper", "--help"])
+    assert err.value.code == 0
+    text = capsys.readouterr().out
+    assert "--out DIR" in text and "report.md" in text
+    for rest in ("``", ":func:", ":class:", ".. ", "Parameters\n"):
+        assert rest not in text
+

@@ -14,6 +14,7 @@ from __future__ import annotations
 import argparse
 import importlib.util
 import sys
+import tempfile
 import time
 import traceback
 from pathlib import Path
@@ -116,11 +117,20 @@ def _captions(r: dict) -> dict[str, tuple[str, str]]:
         + (f"Maximum at a = 1: {f3['E_p_max'][1.0]:.6f} J for sigma/Fc = 1, i.e. "
            f"{f3['E_p_max'][1.0] * 1.0 / f3['Fc'] ** 2:.6f} Fc^2/sigma (paper: 0.3069)." if f3 else ""),
     )
+    f4 = get("fig4_omega")
+    p4 = f4["panels"][1.0] if f4 else None
     out["fig4_omega"] = (
         "Figure 4: Omega (3.10) and its linear approximation Omega* (3.11)",
-        "Omega = exp(-sigma x/Fc) (black dashed) and Omega* = 1 - K x for F_i = -Fc x {0.2, ..., 1} "
-        "and sigma/Fc in {1, 2, 8} 1/m (Fc = 1 N). Circles: exact next reversal; crosses: next "
-        "reversal from the corrected (3.13). In normalised units the three panels are one.",
+        "(a) Omega = exp(-sigma x/Fc) (black dashed) and Omega* = 1 - K x for F_i = -Fc x {0.2, ..., 1} "
+        "at sigma/Fc = 1 1/m, Fc = 1 N (top axis: x at 8 1/m; the paper's panels for sigma/Fc = 1, 2, 8 "
+        "1/m differ only by this scale); circles: exact next reversal, crosses: next reversal from the "
+        "corrected (3.13). (b) The gap Omega* - Omega against sigma x/Fc: it vanishes at the secant "
+        "crossing (diamonds), which the paper takes for the next reversal. (c) Error of the secant "
+        "crossing and of the corrected (3.13) against the exact next reversal. "
+        + (("Error of the crossing / of (3.13): "
+            + ", ".join(f"|F_i|/Fc = {a:g}: {_fmt_pct(p4['x_cross'][a] / p4['x_exact'][a] - 1)} / "
+                        f"{_fmt_pct(p4['x_approx'][a] / p4['x_exact'][a] - 1)}" for a in (1.0, 0.6, 0.2))
+            + ".") if p4 else ""),
     )
     out["fig5_force_displacement"] = (
         "Figure 5: force-displacement curve between two reversals",
@@ -133,13 +143,14 @@ def _captions(r: dict) -> dict[str, tuple[str, str]]:
         "(a) E_p(i+n) from the exact map and (3.14), first reversal at F_i = -Fc, sigma/Fc in "
         "{10, 100, 1000} 1/m (Fc = 1 N), with the asymptotic law 9 Fc^2/(8 sigma n^2) dashed. "
         "(b) Normalised: the exact sequence (one curve for every sigma/Fc) against the paper's "
-        "recursion (3.13)+(3.14), corrected and as printed.",
+        "recursion (3.13)+(3.14), corrected (grey) and as printed (red band from sigma/Fc = 10 1/m, "
+        "upper edge, to 1000 1/m, lower edge; the printed recursion depends on sigma/Fc only slightly).",
     )
     f7 = get("fig7_energy_time_series")
     out["fig7_energy_time_series"] = (
         "Figure 7: energy time series of the simulated oscillator",
         "Kinetic energy and the magnitude of the restoring-force work (2.8), integrated from the "
-        "last reversal, for sigma/Fc in {10, 100, 1000} 1/m; circles: E_p (3.9) of the preceding "
+        "last reversal, one panel for each sigma/Fc in {10, 100, 1000} 1/m; circles: E_p (3.9) of the preceding "
         "reversal, which each kinetic-energy peak must reach. m = 1 kg, Fc = 1 N, x(0) = F(0) = 0, "
         "v(0) = 0.1 m/s (not stated in the paper). "
         + (("Energy balance max |E_k + E_f - E_k(0)|/E_k(0): "
@@ -157,17 +168,17 @@ def _captions(r: dict) -> dict[str, tuple[str, str]]:
     fc = get("beyond_convergence")
     out["beyond_convergence"] = (
         "Beyond: convergence of the reversal amplitudes, a_n ~ 3/(2n)",
-        "Amplitudes a_n = |F_n|/Fc of the exact map from a_0 = 1 on log-log axes against 3/(2n); "
-        "right: 1/a_n - 2n/3, which stays bounded. "
+        "Amplitudes a_n = |F_n|/Fc of the exact map from a_0 = 1 on log-log axes against 3/(2n) and "
+        "the refined law 15k/(10k^2 - 1), k = n + n_0; right: 1/a_n - 2n/3, which stays bounded. "
         + (f"After {fc['n'][-1]:,.0f} reversals a_n = {fc['a'][-1]:.6e}, a_n/(3/(2n)) - 1 = "
-           f"{fc['rel_dev'][-1]:.2e}, 1/a_n - 2n/3 = {fc['offset'][-1]:.4f}." if fc else ""),
+           f"{fc['rel_dev'][-1]:.2e}, 1/a_n - 2n/3 = {fc['offset'][-1]:.4f}; n_0 = {fc['n0']:.4f}." if fc else ""),
     )
     fe = get("beyond_energy_envelope")
     out["beyond_energy_envelope"] = (
         "Beyond: the energy envelope of Figure 7 against the t^-2 law",
-        "Potential energy at the reversals against time (exact reference lines, simulated "
-        "circles) with 9 pi^2 m Fc^2/(8 sigma^2 t^2); right: n^2 E_p sigma/Fc^2 -> 9/8 and the "
-        "half-cycle duration over pi sqrt(m/sigma) -> 1. "
+        "(a) Potential energy at the reversals against time (exact reference lines, simulated "
+        "circles) with 9 pi^2 m Fc^2/(8 sigma^2 t^2); the law's two ingredients: (b) n^2 E_p sigma/Fc^2 "
+        "-> 9/8 and (c) the half-cycle duration's excess over pi sqrt(m/sigma), -> 0. "
         + (("At the last exact reversal sigma^2 t^2 E_p / (9 pi^2 m Fc^2/8) = "
             + ", ".join(f"{k:g}: {(k ** 2 * v['t'][-1] ** 2 * v['E_p'][-1]) / fe['law_product']:.4f}"
                         for k, v in fe["exact"].items()) + " (sigma/Fc: value).") if fe else ""),
@@ -347,15 +358,50 @@ def write_report(outdir: Path, results: dict, *, seconds: float, quick: bool) ->
     return path
 
 
+def writable_dir(path: Path) -> str | None:
+    """Create ``path`` if needed and check that a file can be written in it.
+
+    Returns
+    -------
+    str or None
+        ``None`` if it can, else the reason it cannot (from the operating system).
+    """
+    if path.exists() and not path.is_dir():
+        return "it exists and is not a directory"
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=path):
+            pass
+    except OSError as exc:
+        return exc.strerror or str(exc)
+    return None
+
+
+DESCRIPTION = """\
+Reproduce the figures of Ruderman (2023), go past them, and write DIR/report.md.
+
+Runs every figure script (examples/fig*.py and examples/beyond_*.py), prints one
+line per figure (name, seconds, ok or the error), and writes DIR/<figure>.png and
+DIR/report.md: captions, key numbers, the erratum in (3.13) and every place where
+the toolbox disagrees with the paper. Exit code 0 if every figure ran, 1 if some
+failed, 2 for bad options (e.g. a DIR that cannot be written)."""
+
+
 def main(argv: list[str] | None = None) -> int:
-    """Command line ``prefriction paper --out DIR [--quick]``; returns 0 if every figure ran."""
+    """Command line ``prefriction paper --out DIR [--quick]``; returns 0 if every figure ran.
+
+    Exits with code 2 (argparse's usage error) if ``--out`` is missing or cannot be written.
+    """
     parser = argparse.ArgumentParser(
-        prog="prefriction paper",
-        description="Reproduce the figures of Ruderman (2023), go past them, and write DIR/report.md.",
+        prog="prefriction paper", description=DESCRIPTION, formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    parser.add_argument("--out", required=True, type=Path, help="output directory (created if missing)")
+    parser.add_argument("--out", required=True, type=Path, metavar="DIR",
+                        help="output directory for the PNG files and report.md (created if missing)")
     parser.add_argument("--quick", action="store_true", help="coarser grids and fewer reversals (for tests)")
     args = parser.parse_args(argv)
+    problem = writable_dir(args.out)
+    if problem is not None:
+        parser.error(f"argument --out: cannot write to {str(args.out)!r}: {problem}")
     try:
         where = examples_dir()
     except FileNotFoundError as exc:
