@@ -132,7 +132,7 @@ class FitResult:
         rows.append("")
         unit = "N" if isinstance(self.data, ForceDisplacement) else "m"
         rows.append(f"residual sd {st.sigma_hat:.4g} {unit} ({st.dof} degrees of freedom), "
-                    f"condition number {st.condition:.3g} (relative units)")
+                    f"condition number {st.condition:.3g} (Jacobi-scaled)")
         for key, val in self.nuisance.items():
             if np.ndim(val) == 0:
                 rows.append(f"{key}: {float(val):.6g}")

@@ -19,8 +19,9 @@ from scipy.stats import t as student_t
 
 __all__ = ["IdentifiabilityWarning", "Statistics", "gauss_newton"]
 
-SINGULAR = 1e-10
-"""Eigenvalue of ``N^T J^T J N`` (relative to the largest) below which a direction is undetermined."""
+SINGULAR = 1e-12
+"""Eigenvalue of the Jacobi-scaled ``N^T J^T J N`` (relative to the largest) below which a
+direction is undetermined."""
 
 
 class IdentifiabilityWarning(UserWarning):
@@ -45,7 +46,7 @@ class Statistics:
     dof : int
         Degrees of freedom ``n - p``.
     condition : float
-        Condition number of the information matrix in relative units (``p / p_start``).
+        Condition number of the Jacobi-scaled information matrix (columns of ``J`` normalised).
     unidentifiable : tuple of (str, str)
         Names of the parameters the data cannot identify, each with the reason.
     """
@@ -98,18 +99,21 @@ def gauss_newton(J: np.ndarray, r: np.ndarray, names: list[str], estimates: np.n
     rss = float(r @ r)
     s2 = rss / dof
     H = (J @ N).T @ (J @ N)
-    lam, U = np.linalg.eigh(H)
+    d = np.sqrt(np.diag(H))
+    d[d == 0.0] = 1.0  # a column that changes nothing stays zero: a singular direction
+    lam, U = np.linalg.eigh(H / np.outer(d, d))  # Jacobi-scaled: eigenvalues measure collinearity
     top = max(float(lam[-1]), 1e-300)
     good = lam > SINGULAR * top
-    inv = (U[:, good] / lam[good]) @ U[:, good].T
+    inv = ((U[:, good] / lam[good]) @ U[:, good].T) / np.outer(d, d)
+    U = U / d[:, None]  # null directions back in the coordinates of w
     cov_w = s2 * N @ inv @ N.T
     cov = cov_w[:k, :k] * np.outer(scale, scale)
     var = np.clip(np.diag(cov).copy(), 0.0, None)
     reasons: dict[str, str] = {}
     null_dirs = N @ U[:, ~good]
     for j in range(null_dirs.shape[1]):
-        comp = null_dirs[:k, j]
-        involved = [names[i] for i in np.flatnonzero(np.abs(comp) > 0.2)]
+        comp = null_dirs[:k, j] / max(float(np.max(np.abs(null_dirs[:, j]))), 1e-300)
+        involved = [names[i] for i in np.flatnonzero(np.abs(comp) > 0.2)]  # relative to the largest entry
         for name in involved:
             var[names.index(name)] = np.inf
             others = [o for o in involved if o != name]
@@ -128,6 +132,6 @@ def gauss_newton(J: np.ndarray, r: np.ndarray, names: list[str], estimates: np.n
     for i, name in enumerate(names):
         if name not in reasons and not rse[i] <= limit:
             reasons[name] = f"relative standard error {100.0 * rse[i]:.3g} % > {100.0 * limit:.3g} %"
-    cond = float(top / max(float(lam[0]), 1e-300 * top)) if lam[0] > 0 else np.inf
+    cond = float(top / lam[0]) if lam[0] > 0 else np.inf
     return Statistics(se, estimates - tq * se, estimates + tq * se, corr, float(np.sqrt(s2)), dof, cond,
                       tuple((n_, reasons[n_]) for n_ in names if n_ in reasons))
