@@ -3,7 +3,7 @@
 For each model case (an unforced oscillator, normalised initial speed ``v0~``, ``n`` reversals)
 it measures, in one run, the maximum relative error of the reversal times, positions and forces
 against the model's reference and the warm run time, for :func:`prefriction.simulate` over the
-tolerances 1e-4..1e-10 and for scipy ``solve_ivp`` (DOP853, LSODA, Radau) restarted at every
+tolerances 1e-4..1e-10 and for scipy ``solve_ivp`` (Radau, BDF, LSODA, DOP853) restarted at every
 reversal and every model event (:func:`prefriction.testing.reference_reversals`, the same
 equations evaluated in Python). The reference is the closed form where there is one
 (:class:`prefriction.MaxwellSlip`: the event-by-event solution) and otherwise scipy Radau at
@@ -32,7 +32,7 @@ from prefriction.units import Scales
 __all__ = ["LADDER", "ModelCase", "ModelRow", "model_cases", "run"]
 
 LADDER = (1e-4, 1e-6, 1e-8, 1e-10)
-PEERS = ("DOP853", "LSODA", "Radau")
+PEERS = ("Radau", "BDF", "LSODA", "DOP853")
 TARGET_ERROR = 1e-7
 
 
@@ -68,22 +68,25 @@ def _maxwell_exact(system: Oscillator, v0: float, n: int) -> np.ndarray:
 
 
 def model_cases() -> list[ModelCase]:
-    """The benchmarked cases: Maxwell-slip (3 elements, and a stiff-element variant), and
-    LuGre and generalised Maxwell-slip where those models exist."""
-    cases = [
-        ModelCase("MaxwellSlip N=3", MaxwellSlip([3e4, 3e4, 4e4], [0.15, 0.35, 0.5]), 1.5, 20, _maxwell_exact),
+    """The benchmarked cases (mass 1 kg): for each model a typical case first, then stiff and
+    extreme ones. Maxwell-slip: 3 elements; 8 elements with stiffnesses over 7 decades; gross
+    sliding at 20x the speed. LuGre (1995 Table I); bristles 1000x stiffer; a Stribeck velocity
+    100x smaller. GMS: 3 elements; stiff elements (1e7 N/m) with a sharp Stribeck curve."""
+    from prefriction.models import GMS, LuGre
+
+    ms3 = MaxwellSlip([3e4, 3e4, 4e4], [0.15, 0.35, 0.5])
+    return [
+        ModelCase("MaxwellSlip N=3", ms3, 1.5, 20, _maxwell_exact),
         ModelCase("MaxwellSlip N=8, k 1e2..1e9", MaxwellSlip(np.geomspace(1e2, 1e9, 8), np.full(8, 0.125)),
                   1.2, 20, _maxwell_exact),
+        ModelCase("MaxwellSlip N=3, v0~=30", ms3, 30.0, 20, _maxwell_exact),
+        ModelCase("LuGre (1995 Table I)", LuGre(1e5, math.sqrt(1e5), 0.4, 1.0, 1.5, 1e-3), 1.0, 6),
+        ModelCase("LuGre sigma0=1e8", LuGre(1e8, math.sqrt(1e8), 0.4, 1.0, 1.5, 1e-3), 1.0, 6),
+        ModelCase("LuGre vs=1e-5", LuGre(1e5, math.sqrt(1e5), 0.4, 1.0, 1.5, 1e-5), 1.0, 6),
+        ModelCase("GMS N=3", GMS([3e4, 2e4, 5e4], [0.2, 0.3, 0.5], Fc=1.0, Fs=1.5, vs=1e-2, C=2e3), 1.5, 12),
+        ModelCase("GMS N=3 stiff, vs=1e-4", GMS([1e7, 2e7, 5e7], [0.2, 0.3, 0.5], Fc=1.0, Fs=1.5, vs=1e-4, C=2e3),
+                  1.5, 12),
     ]
-    import prefriction
-
-    if hasattr(prefriction, "LuGre"):
-        lugre = prefriction.LuGre(1e5, math.sqrt(1e5), 0.4, 1.0, 1.5, 1e-3)
-        cases.append(ModelCase("LuGre (1995 Table I)", lugre, 1.0, 6))
-    if hasattr(prefriction, "GMS"):
-        gms = prefriction.GMS([3e4, 2e4, 5e4], [0.2, 0.3, 0.5], Fc=1.0, Fs=1.5, vs=1e-2, C=2e3)
-        cases.append(ModelCase("GMS N=3", gms, 1.5, 12))
-    return cases
 
 
 def _error(rows: np.ndarray, ref: np.ndarray) -> float:
