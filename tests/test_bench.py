@@ -1,4 +1,5 @@
-"""prefriction bench --quick: table, CSV, PNG and the three target lines; the error metric."""
+"""prefriction bench: the error metric, the peers, the stability rows and the targets in-process
+with tiny sizes; options and --help; one end-to-end CLI run (bench --models --quick)."""
 
 from __future__ import annotations
 
@@ -6,9 +7,14 @@ import csv
 import math
 
 import numpy as np
+import pytest
 
-from prefriction.cli.bench import HEADLINE, main, reversal_error
+import prefriction as pf
+from prefriction.cli import bench_stability as bs
 from prefriction.cli import main as cli_main
+from prefriction.cli.bench import (HEADLINE, Case, Row, StabilityRow, _plot, _scipy_events, _scipy_noevents,
+                                   _write_csv, format_rows, headline, linear_cost, main, reversal_error,
+                                   stability, stability_cases, targets)
 from prefriction.reversals import ReversalTable
 
 
@@ -29,45 +35,117 @@ def test_reversal_error_metric() -> None:
     assert reversal_error(HEADLINE, t[:49], x[:49], F[:49], ref) == math.inf  # a missed reversal
 
 
-def test_quick_bench_writes_table_csv_png(tmp_path, capsys) -> None:
-    code = cli_main(["bench", "--quick", "--out", str(tmp_path)])
-    out = capsys.readouterr().out
-    assert code in (0, 1)
-    for needle in ("simulate[erk]", "scipy DOP853 +events", "scipy LSODA |v| form", "python-control |v| form",
-                   "gamma=0", "energy ratio=1e-20", "sigma/Fc=1e+10", "mass=1e-06 kg", "F0=-0.999999 Fc",
-                   "JIT compile"):
-        assert needle in out, needle
-    targets = [line for line in out.splitlines() if line.startswith("target")]
-    assert len(targets) == 3
-    assert all(("PASS" in line) or ("FAIL" in line) for line in targets)
-    assert "ratio" in targets[1]
-    assert (code == 0) == all("PASS" in line for line in targets)
+def test_scipy_peers_against_the_exact_table() -> None:
+    """The peers with restarts and on the |v| form (python-control, ~10 s, runs in the bench only)."""
+    case = Case("small", 1e4, 1.0, 1.0, 0.005)  # short first excursion: a short |v|-form span
+    ref = pf.exact_reversals(case.system, case.v0, 50)
+    t, x, F = _scipy_events(case, 1e-6, "DOP853")
+    assert reversal_error(case, t, x, F, ref) < 1e-5
+    t, x, F = _scipy_noevents(case, 1e-6, "DOP853")  # across the kinks at v = 0: less accurate
+    assert reversal_error(case, t, x, F, ref) < 1e-3
+
+
+def test_simulate_rows_and_stability_in_process() -> None:
+    rows = headline([1e-6], 1, peers=False, budget=0.0)
+    assert [r.solver for r in rows] == ["simulate[erk]"] and rows[0].error <= 10 * rows[0].tol
+    stab, points = stability([1e-6], 100, 1e-8, cases=[HEADLINE])
+    assert len(points) == 1 and stab[0].n_long == 100 and stab[0].passed
+    names = [c.name for c in stability_cases()]
+    for needle in ("gamma=0", "energy ratio=1e-20", "sigma/Fc=1e+10", "mass=1e-06 kg", "F0=-0.999999 Fc"):
+        assert any(needle == n.split(",")[0] or needle == n for n in names), needle
+    t50, tl = linear_cost(1e-6, 100, 1)
+    assert 0 < t50 < 1e-2 and 0 < tl < 1e-2
+
+
+def test_stability_rows_against_their_references() -> None:
+    # the forced row's reference has the 30 reversals of the issue (0.5 sin(5 t) N, 2.5133 s)
+    forced = next(c for c in bs.row_cases(quick=True) if c.expected)
+    assert len(bs.reference(forced)) == 30
+    # energy row: an elastic Prandtl stop keeps F^2 / (2 sigma) = m v0^2 / 2 at every reversal
+    energy = bs.RowCase("gamma=0 elastic", 0.0, 0.005, n=40, metric="energy")
+    res = bs.measure(energy, (1e-6,))
+    assert res.n_sim == (40,) and res.passed
+    # a saturating row (scipy DOP853 rtol 1e-13 with restarts at reversals and saturation)
+    sat = bs.RowCase("gamma=0.3 saturating", 0.3, 0.02, n=6)
+    res = bs.measure(sat, (1e-6,))
+    assert res.n_ref == 6 and res.n_sim == (6,) and res.passed
+    text = bs.format_rows([res])
+    assert "PASS" in text and "rtol 1e-06" in text
+    got = np.zeros((5, 3))
+    assert bs.row_error(sat, got, np.zeros((6, 3))) == math.inf  # a missing reversal
+
+
+def _rows(err: float) -> list[Row]:
+    return [Row("h", "simulate[erk]", 1e-8, err, 1e-3), Row("h", "scipy DOP853 +events", 1e-9, 5e-9, 0.05)]
+
+
+def test_targets_decide_from_the_measured_rows() -> None:
+    stab = [StabilityRow("c", 2.0, 1e-6, 1e-9, 1e-8, 500, 1e-8, 0.01, 1e-9, True)]
+    ok = bs.RowResult("r", "positions", (1.0, 9.0), (1e-6, 1e-9), 10, (10, 10))
+    bad = bs.RowResult("r", "positions", (math.inf, 1.0), (1e-6, 1e-9), 10, (9, 10))
+    lines = targets(_rows(5e-9), stab, 1e-5, 1.2e-5, 500, [1e-8], [ok])
+    assert len(lines) == 3 and all(line.startswith("target") and "PASS" in line for line in lines)
+    assert "ratio 50.0x" in lines[1] and "ratio 1.20" in lines[2]
+    lines = targets(_rows(5e-7), stab, 1e-5, 1.6e-5, 500, [1e-8], [ok])
+    assert "FAIL" in lines[0] and lines[1].startswith("target 2: not measured") and "FAIL" in lines[2]
+    assert "FAIL" in targets(_rows(5e-9), stab, 1e-5, 1e-5, 500, [1e-8], [bad])[0]
+
+
+def test_outputs_csv_and_png(tmp_path) -> None:
+    rows = _rows(5e-9) + [Row("h", "simulate[erk]", 1e-6, 4e-7, 8e-4)]
+    text = format_rows(rows)
+    assert "simulate[erk]" in text and "scipy DOP853 +events" in text
+    _write_csv(tmp_path / "bench.csv", rows)
     with (tmp_path / "bench.csv").open() as fh:
-        rows = list(csv.DictReader(fh))
-    assert {"case", "solver", "tol", "max_rel_error", "warm_run_s", "compile_s"} <= set(rows[0])
-    sim = [r for r in rows if r["solver"] == "simulate[erk]" and r["case"] == HEADLINE.name]
-    assert len(sim) >= 2 and all(float(r["max_rel_error"]) <= 10 * float(r["tol"]) for r in sim)
-    png = (tmp_path / "work_precision.png").read_bytes()
+        got = list(csv.DictReader(fh))
+    assert {"case", "solver", "tol", "max_rel_error", "warm_run_s", "compile_s"} <= set(got[0]) and len(got) == 3
+    _plot(tmp_path / "wp.png", rows)
+    png = (tmp_path / "wp.png").read_bytes()
     assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 10_000
-    assert "pass" in (tmp_path / "stability.txt").read_text()
 
 
-def test_bench_help_and_bad_option(capsys) -> None:
-    try:
+def test_help_is_plain_text(capsys) -> None:
+    with pytest.raises(SystemExit) as exc:
         main(["--help"])
-    except SystemExit as exc:
-        assert exc.code == 0
-    assert "--stability" in capsys.readouterr().out
+    assert exc.value.code == 0
+    out = capsys.readouterr().out
+    assert "--stability" in out and "--sweep" in out and "--models" in out and "docs/bench.md" in out
+    assert "``" not in out and ":func:" not in out
 
 
-def test_models_bench_quick(tmp_path, capsys) -> None:
-    """``prefriction bench --models --quick``: Maxwell-slip against its closed form and scipy."""
+@pytest.mark.parametrize(("argv", "message"), [
+    (["--repeats", "-1"], "argument --repeats: must be an integer in [1, 1000], got '-1'"),
+    (["--repeats", "0"], "got '0'"),
+    (["--repeats", "2.5"], "got '2.5'"),
+    (["--repeats", "1001"], "got '1001'"),
+    (["--models", "--sweep"], "not allowed with argument"),
+    (["--models", "--repeats", "3"], "--repeats applies to the headline and stability sections"),
+    (["--unknown"], "unrecognized arguments: --unknown"),
+])
+def test_bad_options_are_argparse_errors(argv: list[str], message: str, capsys) -> None:
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2
+    assert message in capsys.readouterr().err
+
+
+def test_out_must_be_a_directory(tmp_path, capsys) -> None:
+    path = tmp_path / "file.txt"
+    path.write_text("x")
+    with pytest.raises(SystemExit):
+        main(["--out", str(path)])
+    assert "must be a directory" in capsys.readouterr().err
+
+
+def test_models_bench_quick_end_to_end(tmp_path, capsys) -> None:
+    """``prefriction bench --models --quick`` from the command line entry point: Maxwell-slip
+    against its closed form and scipy DOP853; table, target lines and models.csv."""
     code = cli_main(["bench", "--models", "--quick", "--out", str(tmp_path)])
     out = capsys.readouterr().out
-    assert code in (0, 1)
     assert "MaxwellSlip N=3" in out and "scipy DOP853 +events" in out
-    targets = [line for line in out.splitlines() if line.startswith("target models/")]
-    assert len(targets) == 2 and "accuracy" in targets[0] and "PASS" in targets[0]
+    targets_ = [line for line in out.splitlines() if line.startswith("target models/")]
+    assert len(targets_) == 2 and "accuracy" in targets_[0] and "PASS" in targets_[0]
+    assert (code == 0) == all("PASS" in line for line in targets_)
     with (tmp_path / "models.csv").open() as fh:
         rows = list(csv.DictReader(fh))
     sim = [r for r in rows if r["solver"] == "simulate[erk]"]

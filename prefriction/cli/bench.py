@@ -300,10 +300,12 @@ class StabilityRow:
     passed: bool
 
 
-def stability(ladder: list[float], n_long: int, tol_long: float) -> tuple[list[StabilityRow], list[Row]]:
-    """Every stiff/extreme case over the ladder (50 reversals) and one run of ``n_long`` reversals."""
+def stability(ladder: list[float], n_long: int, tol_long: float,
+              cases: Optional[list[Case]] = None) -> tuple[list[StabilityRow], list[Row]]:
+    """Every stiff/extreme case (default :func:`stability_cases`) over the ladder (50 reversals)
+    and one run of ``n_long`` reversals."""
     out, rows = [], []
-    cases = stability_cases()
+    cases = stability_cases() if cases is None else cases
     for k, case in enumerate(cases, 1):
         _progress(f"stability [{k}/{len(cases)}]: {case.name}")
         ref = _exact(case, max(n_long, N_REV))
@@ -477,7 +479,7 @@ def _models_main(out: Path, quick: bool) -> int:
     start = time.perf_counter()
     cases = bm.model_cases()
     rows = bm.run(cases[:1] if quick else cases, ladder=bm.LADDER[:2] if quick else bm.LADDER,
-                  peers=bm.PEERS[:1] if quick else bm.PEERS, budget=0.05 if quick else 0.3)
+                  peers=("DOP853",) if quick else bm.PEERS, budget=0.05 if quick else 0.3)
     print("Friction models: error over the first reversals against the reference, warm run time\n")
     print(bm.table(rows))
     lines = bm.targets(rows)
