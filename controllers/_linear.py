@@ -13,6 +13,7 @@ around the ZOH discretisation ``control.c2d(P, dt, "zoh")``, exact at the sample
 
 from __future__ import annotations
 
+import functools
 import math
 import warnings
 from typing import Optional
@@ -107,11 +108,16 @@ def linear_plant(system: Oscillator, regime: str = "presliding", Ts: Optional[fl
     _check_regime(regime)
     m = system.mass
     k = system.friction.sigma if regime == "presliding" else 0.0
+    return _plant(m, k, None if Ts is None else check_positive("Ts", Ts))
+
+
+@functools.lru_cache(maxsize=64)
+def _plant(m: float, k: float, Ts: Optional[float]) -> control.StateSpace:
+    """``1/(m s^2 + k)`` as a state-space system, ZOH-discretised if ``Ts`` (cached: each loop
+    simulation checks its linear loop, and ``c2d`` costs milliseconds)."""
     P = control.ss([[0.0, 1.0], [-k / m, 0.0]], [[0.0], [1.0 / m]], [[1.0, 0.0]], [[0.0]],
                    inputs="u", outputs="x", states=["x", "v"], name="plant")
-    if Ts is not None:
-        P = control.c2d(P, check_positive("Ts", Ts), method="zoh")
-    return P
+    return P if Ts is None else control.c2d(P, Ts, method="zoh")
 
 
 def closed_loop(

@@ -20,6 +20,7 @@ import numpy as np
 
 import prefriction
 from prefriction.analysis.branch import force_after_distance
+from prefriction.signals import Signal
 from prefriction.simulation.feedback import LinearFeedback, sample_count
 from prefriction.simulation.loops import LoopStats, run_sampled
 from prefriction._validation import check_positive, check_signal
@@ -189,6 +190,8 @@ def _evaluate(reference: Reference, t: np.ndarray) -> np.ndarray:
     """Numeric reference at times ``t`` [s] (samples: linear, held constant outside their range)."""
     if isinstance(reference, tuple):
         return np.interp(t, reference[0], reference[1])
+    if isinstance(reference, Signal):  # vectorised
+        return np.broadcast_to(np.asarray(reference(t), dtype=float), t.shape).copy()
     if callable(reference):
         vals = np.empty(t.shape)
         for i, ti in enumerate(t):
@@ -327,7 +330,7 @@ def simulate_loop(
         if t_out is not None:
             raise ValueError("t_out is not allowed with a sampled controller: its outputs are at the sample instants k Ts")
         sample_count(t_end, Ts, t_end / Ts)  # refuse runs that would exhaust the memory
-        if callable(reference):  # read at the sample instants only: any Python callable works
+        if callable(reference) and not isinstance(reference, Signal):  # read at the sample instants only
             tk = Ts * np.arange(int(math.floor(t_end / Ts * (1 + 1e-12))) + 2)
             fb_reference = (tk, _evaluate(reference, tk))
         fb = LinearFeedback(A=C.A, B=C.B, C=C.C, D=C.D, Ts=Ts, reference=fb_reference, xc0=xc0)

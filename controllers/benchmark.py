@@ -1,41 +1,60 @@
-"""Run time and accuracy of :func:`controllers.simulate_loop` against python-control, same loop, same run.
+"""Benchmark of the compiled sampled-data loop against python-control, same loop, same run.
 
-``python -m controllers.benchmark`` prints two tables for the stage of the examples
-(m = 1 kg, sigma = 1e6 N/m, Fc = 1 N, PD placed at 300 Hz, zeta = 0.7, 1 um step):
+``python -m controllers.benchmark`` (``prefriction bench --loops``) prints, for the PID loop of
+``examples/stage_pid.py`` (stage m = 1 kg, sigma = 1e6 N/m, Fc = 1 N; PID placed at 150 Hz,
+zeta = 0.7; 10 kHz ZOH; 1 um step; 1 s):
 
-1. Sampled-data loop, 10 kHz, 1 s: wall time of ``simulate_loop`` (warm, integrator already
-   compiled) against ``control.input_output_response`` on ``control.interconnect`` of
-   :func:`controllers.plant_iosys` (ZOH-sampled plant) and the discrete controller, plus the
-   largest position difference between the two at the sample instants.
-2. Continuous loop: python-control's own continuous simulation of ``plant_iosys`` with the
-   continuous PD (``solve_ivp`` across the reversal kinks) over a ladder of tolerances,
-   against ``simulate_loop`` at ``rtol = 1e-11``: position error relative to the step, error of
-   the residual position error, and wall time. This is the accuracy shortfall of
-   ``plant_iosys`` documented in its notes.
+1. the warm time per sample of :func:`controllers.simulate_loop` and of
+   ``control.input_output_response`` on ``control.interconnect`` of
+   :func:`controllers.plant_iosys` (ZOH-sampled plant) and the discrete PID, and the error of
+   both against :func:`controllers.zoh_reference.zoh_reference` (scipy DOP853 at rtol 1e-12
+   with restarts at every zero velocity), relative to the step;
+2. a 100-gain tuning sweep (pole placement from 110 to 200 Hz), end to end in a fresh process
+   with an empty compile cache: wall time and the number of compiles (the lines
+   ``prefriction: compiling`` on stderr);
+3. the time per sample for loops of 0.1, 1 and 10 s with a sinusoidal reference (the plant
+   moves in every period, so the three do the same work per sample);
+
+and the targets as PASS/FAIL (``docs/controllers.md#benchmark``).
 """
 
 from __future__ import annotations
 
 import argparse
+import os
+import subprocess
+import sys
+import tempfile
 import time
+from pathlib import Path
 from typing import Any, Optional
 
 import control
 import numpy as np
 
+from prefriction.signals import Sine
+
 from ._iosys import plant_iosys
-from ._linear import design_pd
+from ._linear import design_pid
 from ._loop import simulate_loop
-from .example_stage import stage
+from .example_stage import TS, stage
+from .zoh_reference import zoh_reference
 
 STEP = 1e-6  # reference step [m]
+RTOL = 1e-11  # tolerance of simulate_loop in the benchmark: error <= 1e-9 of the step
+TARGET_US, TARGET_SPEEDUP, TARGET_ERROR, TARGET_SPREAD = 5.0, 50.0, 1e-9, 1.5
+
+
+def _pid() -> control.StateSpace:
+    """The discrete PID of ``examples/stage_pid.py``."""
+    return design_pid(stage(), wn=2 * np.pi * 150.0, zeta=0.7, alpha=1.0).c2d(TS)
 
 
 def _loop(P: control.NonlinearIOSystem, C: control.StateSpace) -> control.InterconnectedSystem:
-    """Interconnection ``e = r - x``, ``u = C e``, ``x = P u`` with input ``r`` and outputs ``x, u``."""
+    """Interconnection ``e = r - x``, ``u = C e``, ``x = P u`` with input ``r`` and output ``x``."""
     sj = control.summing_junction(inputs=["r", "-x"], output="e", name="sum")
     C = control.ss(C, inputs="e", outputs="u", name="controller")
-    return control.interconnect([P, C, sj], inplist=["r"], outlist=["x", "u"], name="loop")
+    return control.interconnect([P, C, sj], inplist=["r"], outlist=["x"], name="loop")
 
 
 def _best_time(fun, repeats: int) -> tuple[float, Any]:
@@ -47,101 +66,144 @@ def _best_time(fun, repeats: int) -> tuple[float, Any]:
     return best, out
 
 
-def sampled_timing(*, t_end: float = 1.0, Ts: float = 1e-4, repeats: int = 2) -> dict[str, float]:
-    """Wall time of a sampled-data loop: ``simulate_loop`` against ``input_output_response``.
+def sampled_timing(*, t_end: float = 1.0, rtol: float = RTOL, repeats: int = 3) -> dict[str, Any]:
+    """Time per sample and error of the PID loop: ``simulate_loop`` against python-control.
 
-    Returns a dict with ``t_ours``, ``t_python_control`` [s] (minimum over ``repeats``),
-    ``ratio`` (python-control / ours), ``n_samples`` and ``max_dx_rel`` (largest position
-    difference at the sample instants, relative to the step).
+    Returns a dict: ``n_samples``, ``t_ours``, ``t_python_control`` [s] (warm; the minimum of
+    ``repeats`` for ours, one run of python-control), ``us_ours``, ``us_python_control`` [us per
+    sample], ``speedup``, ``err_ours``, ``err_python_control`` (largest position error at the
+    samples against the scipy reference, relative to the step), ``stats`` (the loop's
+    :class:`~prefriction.simulation.loops.LoopStats`) and ``t_reference`` [s].
     """
-    system = stage()
-    Cd = design_pd(system, wn=2 * np.pi * 300.0, zeta=0.7).c2d(Ts)
-    simulate_loop(system, Cd, STEP, 10 * Ts)  # warm-up: compile or load the integrator
-    t_ours, ours = _best_time(lambda: simulate_loop(system, Cd, STEP, t_end), repeats)
-    loop = _loop(plant_iosys(system, Ts=Ts), Cd)
-    t = ours.t
-    t_pc, resp = _best_time(lambda: control.input_output_response(loop, t, np.full(t.shape, STEP)), repeats)
-    x_pc = np.asarray(resp.outputs[0])
+    system, Cd = stage(), _pid()
+    simulate_loop(system, Cd, STEP, 10 * TS, rtol=rtol)  # warm-up: compile or load
+    t_ours, ours = _best_time(lambda: simulate_loop(system, Cd, STEP, t_end, rtol=rtol), repeats)
+    n = len(ours.t)
+    r = np.full(n, STEP)
+    t_pc, resp = _best_time(lambda: control.input_output_response(_loop(plant_iosys(system, Ts=TS), Cd), ours.t, r), 1)
+    t_ref, x_ref = _best_time(lambda: zoh_reference(system, Cd, r, TS), 1)
+    periods = max(n - 1, 1)
     return {
-        "t_ours": t_ours,
-        "t_python_control": t_pc,
-        "ratio": t_pc / t_ours,
-        "n_samples": float(len(t)),
-        "max_dx_rel": float(np.max(np.abs(x_pc - ours.x)) / STEP),
+        "n_samples": n, "t_ours": t_ours, "t_python_control": t_pc, "t_reference": t_ref,
+        "us_ours": 1e6 * t_ours / periods, "us_python_control": 1e6 * t_pc / periods, "speedup": t_pc / t_ours,
+        "err_ours": float(np.max(np.abs(ours.x - x_ref)) / STEP),
+        "err_python_control": float(np.max(np.abs(np.atleast_2d(resp.outputs)[0] - x_ref)) / STEP),
+        "stats": ours.loop_stats,
     }
 
 
-def continuous_accuracy(
-    *, t_end: float = 0.05, rtols: tuple = (1e-3, 1e-6, 1e-9), methods: tuple = ("RK45", "LSODA")
-) -> list[dict[str, Any]]:
-    """python-control's continuous simulation of ``plant_iosys`` against ``simulate_loop``.
-
-    Each row: ``method``, ``rtol`` (1e-3 means python-control's defaults, ``atol = 1e-6``;
-    otherwise ``atol`` is ``rtol`` times the state scales ``Fc/sigma``, ``Fc/sqrt(m sigma)``,
-    ``Fc``, ``Fc/sigma``), ``time`` [s], ``max_dx_rel`` (largest position error over the
-    output times, relative to the step) and ``residual_rel`` (error of the final ``r - x``
-    relative to the reference's final ``r - x``). The first row is ``simulate_loop`` itself
-    at ``rtol = 1e-8`` against the ``rtol = 1e-11`` reference.
-    """
+def _sweep_worker(n: int, t_end: float, rtol: float) -> None:
+    """Run ``n`` PID designs (110 to 200 Hz) on the stage; print the wall time."""
     system = stage()
-    C = design_pd(system, wn=2 * np.pi * 300.0, zeta=0.7).ss()
-    t = np.linspace(0.0, t_end, 2001)
-    simulate_loop(system, C, STEP, t_end, t_out=t, rtol=1e-8)  # warm-up (compile)
-    ref = simulate_loop(system, C, STEP, t_end, t_out=t, rtol=1e-11)
-    e_ref = ref.residual_error
+    start = time.perf_counter()
+    for wn_hz in np.linspace(110.0, 200.0, n):
+        simulate_loop(system, design_pid(system, wn=2 * np.pi * wn_hz, zeta=0.7).c2d(TS), STEP, t_end, rtol=rtol)
+    print(f"{time.perf_counter() - start:.6f}")
+
+
+def sweep_from_empty_cache(*, n: int = 100, t_end: float = 0.1, rtol: float = RTOL) -> dict[str, Any]:
+    """A tuning sweep over ``n`` gains in a fresh process with an empty compile cache.
+
+    Returns a dict: ``n``, ``t_end``, ``wall`` (end to end, process start included) and
+    ``loop_time`` (the loops alone) [s], and ``compiles`` (lines ``prefriction: compiling``).
+    """
+    root = Path(__file__).resolve().parent.parent
+    with tempfile.TemporaryDirectory(prefix="prefriction-bench-") as cache:
+        env = dict(os.environ, PREFRICTION_CACHE=cache, PYTHONPATH=str(root) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+        code = f"from controllers.benchmark import _sweep_worker; _sweep_worker({n}, {t_end!r}, {rtol!r})"
+        start = time.perf_counter()
+        proc = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=3600)
+        wall = time.perf_counter() - start
+    if proc.returncode != 0:
+        raise RuntimeError(f"the sweep process failed: {proc.stderr.strip()[-2000:]}")
+    compiles = sum(line.startswith("prefriction: compiling") for line in proc.stderr.splitlines())
+    return {"n": n, "t_end": t_end, "wall": wall, "loop_time": float(proc.stdout.split()[-1]), "compiles": compiles}
+
+
+def length_scaling(*, lengths: tuple = (0.1, 1.0, 10.0), rtol: float = RTOL, repeats: int = 2) -> list[dict[str, float]]:
+    """Warm time per sample of the PID loop following a 1 um, 20 Hz sine, for each length [s]:
+    ``us`` the loop itself (``LoopStats.wall_time``), ``us_call`` the whole ``simulate_loop``
+    call (with its fixed cost: the linear loop check, the output arrays)."""
+    system, Cd = stage(), _pid()
+    ref = Sine(amplitude=STEP, frequency=20.0)
     rows = []
-    t8, ours8 = _best_time(lambda: simulate_loop(system, C, STEP, t_end, t_out=t, rtol=1e-8), 2)
-    rows.append({"method": "simulate_loop", "rtol": 1e-8, "time": t8,
-                 "max_dx_rel": float(np.max(np.abs(ours8.x - ref.x)) / STEP),
-                 "residual_rel": abs(ours8.residual_error - e_ref) / abs(e_ref)})
-    loop = _loop(plant_iosys(system), C)
-    scale = np.array([1e-6, 1e-3, 1.0, 1e-6])  # x [m], v [m/s], F [N], filter state [m]
-    for method in methods:
-        for rtol in rtols:
-            kw: dict[str, Any] = {"method": method}
-            if rtol != 1e-3:
-                kw.update(rtol=rtol, atol=rtol * scale)
-            tt, resp = _best_time(
-                lambda: control.input_output_response(loop, t, np.full(t.shape, STEP), solve_ivp_kwargs=kw), 1
-            )
-            x = np.asarray(resp.outputs[0])
-            rows.append({"method": f"input_output_response {method}", "rtol": rtol, "time": tt,
-                         "max_dx_rel": float(np.max(np.abs(x - ref.x)) / STEP),
-                         "residual_rel": abs((STEP - x[-1]) - e_ref) / abs(e_ref)})
+    for T in lengths:
+        simulate_loop(system, Cd, ref, 10 * TS, rtol=rtol)
+        best, best_call = np.inf, np.inf
+        for _ in range(repeats):
+            t0 = time.perf_counter()
+            res = simulate_loop(system, Cd, ref, T, rtol=rtol)
+            best_call = min(best_call, time.perf_counter() - t0)
+            best = min(best, res.loop_stats.wall_time)
+        periods = max(len(res.t) - 1, 1)
+        rows.append({"t_end": T, "n_samples": len(res.t), "us": 1e6 * best / periods, "us_call": 1e6 * best_call / periods})
     return rows
 
 
-def format_tables(timing: dict[str, float], rows: Optional[list[dict[str, Any]]]) -> str:
-    """Readable text of both tables."""
+def _verdict(ok: bool) -> str:
+    return "PASS" if ok else "FAIL"
+
+
+def format_tables(timing: dict[str, Any], sweep: Optional[dict[str, Any]], lengths: Optional[list]) -> str:
+    """The benchmark's tables and its targets as PASS/FAIL."""
+    n = timing["n_samples"]
     out = [
-        f"Sampled-data PD loop, Ts = 1e-4 s, {int(timing['n_samples'])} samples (stage m=1 kg, sigma=1e6 N/m, Fc=1 N, 1 um step)",
-        f"{'simulator':<44} {'wall time [s]':>14} {'relative':>9}",
-        f"{'controllers.simulate_loop (warm)':<44} {timing['t_ours']:>14.3f} {1.0:>9.2f}",
-        f"{'control.input_output_response (plant_iosys)':<44} {timing['t_python_control']:>14.3f} {timing['ratio']:>9.2f}",
-        f"max |x_python-control - x_ours| / step at the samples: {timing['max_dx_rel']:.2e}",
+        f"Sampled PID loop of examples/stage_pid.py, Ts = {TS:g} s, {n} samples, 1 um step, rtol = {RTOL:g}",
+        f"{'simulator':<44} {'wall [s]':>9} {'us/sample':>10} {'max|x - x_ref|/step':>20}",
+        f"{'controllers.simulate_loop (compiled, warm)':<44} {timing['t_ours']:>9.4f} {timing['us_ours']:>10.3g} "
+        f"{timing['err_ours']:>20.2e}",
+        f"{'control.input_output_response (plant_iosys)':<44} {timing['t_python_control']:>9.3f} "
+        f"{timing['us_python_control']:>10.4g} {timing['err_python_control']:>20.2e}",
+        f"x_ref: scipy DOP853 at rtol 1e-12 with restarts at zero velocity ({timing['t_reference']:.3g} s)",
+        f"loop: {timing['stats'].summary()}",
     ]
-    if rows:
-        out += [
-            "",
-            "Continuous PD loop, 0.05 s: error against simulate_loop at rtol = 1e-11",
-            f"{'simulator':<34} {'rtol':>7} {'time [s]':>9} {'max|dx|/step':>13} {'residual err':>13}",
-        ]
-        for r in rows:
-            tag = "default" if r["rtol"] == 1e-3 and r["method"] != "simulate_loop" else f"{r['rtol']:.0e}"
-            out.append(f"{r['method']:<34} {tag:>7} {r['time']:>9.3f} {r['max_dx_rel']:>13.2e} {r['residual_rel']:>13.2e}")
+    targets = [
+        (f"time per sample <= {TARGET_US:g} us (warm)", f"{timing['us_ours']:.3g} us", timing["us_ours"] <= TARGET_US),
+        (f"speed-up over python-control >= {TARGET_SPEEDUP:g}x", f"{timing['speedup']:.0f}x",
+         timing["speedup"] >= TARGET_SPEEDUP),
+        (f"error <= {TARGET_ERROR:g} of the step", f"{timing['err_ours']:.2e}", timing["err_ours"] <= TARGET_ERROR),
+    ]
+    if sweep is not None:
+        out += ["", f"Tuning sweep: {sweep['n']} PID gains, {sweep['t_end']:g} s loops, fresh process, empty cache: "
+                    f"{sweep['wall']:.3g} s end to end ({sweep['loop_time']:.3g} s in the loops), "
+                    f"{sweep['compiles']} compile(s)"]
+        targets.append(("tuning sweep from an empty cache: one compile", f"{sweep['compiles']}", sweep["compiles"] == 1))
+    if lengths:
+        out += ["", "Loop length (1 um, 20 Hz sine reference), us per sample in the loop (whole call): " + ", ".join(
+            f"{r['t_end']:g} s: {r['us']:.3g} ({r['us_call']:.3g})" for r in lengths)]
+        us = [r["us"] for r in lengths]
+        spread = max(us) / min(us)
+        targets.append((f"time per sample over the lengths within {TARGET_SPREAD:g}x", f"{spread:.2f}x",
+                        spread <= TARGET_SPREAD))
+    out += ["", f"{'target':<52} {'measured':>10}  verdict"]
+    out += [f"{name:<52} {val:>10}  {_verdict(ok)}" for name, val, ok in targets]
     return "\n".join(out)
 
 
+def run(*, t_end: float = 1.0, repeats: int = 3, sweep: int = 100, lengths: tuple = (0.1, 1.0, 10.0)) -> str:
+    """Run the benchmark (progress on stderr) and return its table."""
+    print("bench --loops: timing the 1 s loop and python-control ...", file=sys.stderr, flush=True)
+    timing = sampled_timing(t_end=t_end, repeats=repeats)
+    sw = None
+    if sweep:
+        print(f"bench --loops: {sweep}-gain sweep from an empty cache ...", file=sys.stderr, flush=True)
+        sw = sweep_from_empty_cache(n=sweep)
+    rows = None
+    if lengths:
+        print("bench --loops: loop lengths " + ", ".join(f"{T:g} s" for T in lengths) + " ...", file=sys.stderr, flush=True)
+        rows = length_scaling(lengths=lengths)
+    return format_tables(timing, sw, rows)
+
+
 def main(argv: Optional[list[str]] = None) -> int:
-    """Command line: ``python -m controllers.benchmark [--t-end 1.0] [--repeats 2] [--no-accuracy]``."""
+    """Command line: ``python -m controllers.benchmark [--t-end 1] [--repeats 3] [--sweep 100] [--lengths 0.1 1 10]``."""
     ap = argparse.ArgumentParser(prog="python -m controllers.benchmark", description=__doc__.splitlines()[0])
-    ap.add_argument("--t-end", type=float, default=1.0, help="simulated time of the sampled loop [s]")
-    ap.add_argument("--repeats", type=int, default=2, help="repeats per timing (minimum is reported)")
-    ap.add_argument("--no-accuracy", action="store_true", help="skip the continuous accuracy table")
+    ap.add_argument("--t-end", type=float, default=1.0, help="simulated time of the timed loop [s]")
+    ap.add_argument("--repeats", type=int, default=3, help="repeats of the warm timing (the minimum is reported)")
+    ap.add_argument("--sweep", type=int, default=100, help="gains in the tuning sweep (0: skip)")
+    ap.add_argument("--lengths", type=float, nargs="*", default=[0.1, 1.0, 10.0], help="loop lengths [s] (none: skip)")
     args = ap.parse_args(argv)
-    timing = sampled_timing(t_end=args.t_end, repeats=args.repeats)
-    rows = None if args.no_accuracy else continuous_accuracy()
-    print(format_tables(timing, rows))
+    print(run(t_end=args.t_end, repeats=args.repeats, sweep=args.sweep, lengths=tuple(args.lengths)))
     return 0
 
 

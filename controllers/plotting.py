@@ -5,6 +5,7 @@ Uses ``matplotlib.figure.Figure`` directly (Agg canvas, no pyplot state, no back
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Mapping
 
@@ -18,6 +19,17 @@ def _scale(values: np.ndarray) -> tuple[float, str]:
     """Factor and unit label that bring a displacement [m] to um or nm."""
     peak = float(np.max(np.abs(values))) if values.size else 0.0
     return (1e6, "um") if peak >= 1e-7 else (1e9, "nm")
+
+
+def _headroom(ax, values: np.ndarray, level: "float | None") -> None:
+    """Log y-limits with the top third of the panel free for the legend (it covers no curve)."""
+    pos = values[values > 0]
+    if pos.size == 0:
+        return
+    lo = math.log10(float(np.min(pos)))
+    hi = math.log10(max(float(np.max(pos)), level or 0.0))
+    span = max(hi - lo, 1.0)
+    ax.set_ylim(10 ** (lo - 0.05 * span), 10 ** (hi + 0.6 * span))
 
 
 def plot_steps(
@@ -68,20 +80,25 @@ def plot_steps(
         rv = res.reversals
         if len(rv):
             ax.plot(rv.x * k, rv.F, "o", ms=4, mfc="none", label=f"reversals ({len(rv)})")
+        lo, hi = float(np.min(lF)), float(np.max(lF))
         if np.max(np.abs(lF)) > 0.2 * res.Fc:
             ax.axhline(res.Fc, color="0.5", lw=0.8, ls=":")
             ax.axhline(-res.Fc, color="0.5", lw=0.8, ls=":", label="+-Fc")
+            lo, hi = -res.Fc, res.Fc
+        span = max(hi - lo, 1e-300)
+        ax.set_ylim(lo - 0.05 * span, hi + 0.6 * span)  # the top third free for the legend
         ax.set(xlabel=f"position x [{unit}]", ylabel="friction force F [N]", title=f"{label}: friction loop")
-        ax.legend(loc="lower right")
+        ax.legend(loc="upper left", ncol=2, fontsize="small")
         ax = row[3]
-        err = np.abs(res.error)
-        ax.semilogy(t_ms, np.where(err > 0, err, np.nan) * k, lw=1, label="|e| = |r - x|")
+        err = np.abs(res.error) * k
+        ax.semilogy(t_ms, np.where(err > 0, err, np.nan), lw=1, label="|e| = |r - x|")
         level = res.error_bound if bound is None else bound
         if level is not None:
-            note = "" if res.error_bound is not None else " (PD bound, for comparison)"
+            note = "" if res.error_bound is not None else " (PD bound)"
             ax.axhline(level * k, color="C3", ls="--", label=f"Fc/kp = {level * k:.3g} {unit}{note}")
+        _headroom(ax, err, None if level is None else level * k)
         ax.set(xlabel="time t [ms]", ylabel=f"|error| [{unit}]", title=f"{label}: error")
-        ax.legend(loc="best")
+        ax.legend(loc="upper right", fontsize="small")
         for a in row:
             a.grid(True, alpha=0.3)
     fig.suptitle(title)

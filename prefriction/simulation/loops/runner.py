@@ -58,6 +58,8 @@ class LoopStats:
         Periods with more than ``NSTOP`` reversals, finished by the Python loop.
     wall_time, setup_time : float
         Wall time of the loop and of building, compiling or loading the Function [s].
+    compiled_time : float
+        Wall time spent inside the compiled block calls [s] (the rest of ``wall_time`` is Python).
     jit : str
         ``"compiled"``, ``"cached"`` or ``"interpreted"``.
     """
@@ -68,7 +70,15 @@ class LoopStats:
     finished_in_python: int
     wall_time: float
     setup_time: float
+    compiled_time: float
     jit: str
+
+    def summary(self) -> str:
+        """One line: samples, blocks, integrated periods, time per sample and its compiled share."""
+        per = self.wall_time / max(self.samples - 1, 1)
+        return (f"{self.samples} samples in {self.blocks} blocks ({self.jit}), {self.integrated} periods integrated, "
+                f"{self.finished_in_python} finished in Python; {per * 1e6:.3g} us per sample, "
+                f"{100 * self.compiled_time / max(self.wall_time, 1e-300):.0f} % in compiled code")
 
 
 class _Block:
@@ -202,13 +212,16 @@ def run_sampled(
     recs = np.empty((n_s, LL.nrec))
     rev: list = []
     blocks = finished = 0
+    inside = 0.0
     start = time.perf_counter()
     k = 0
     while k < n_s:
         blk.S0[:] = S
         blk.W[:] = Wall[k: k + block]
+        t_call = time.perf_counter()
         try:
             blk.trigger()
+            inside += time.perf_counter() - t_call
             failed = blk.buf.ret() != 0
         except RuntimeError as exc:
             failed, why = True, str(exc).strip().splitlines()[-1]
@@ -244,7 +257,7 @@ def run_sampled(
         t=t, x=x, v=v, F=recs[:, LL.rec["F"]] * sc.F, E_k=0.5 * system.mass * v * v, u=recs[:, LL.rec["u"]],
         xc=np.array(xc),
     )
-    return sim, LoopStats(n_s, blocks, integrated, finished, wall, setup, mode)
+    return sim, LoopStats(n_s, blocks, integrated, finished, wall, setup, inside, mode)
 
 
 def _initial_state(system: Oscillator, fb: LinearFeedback, LL: LoopLayout, x0: float, v0: float, F0: float,
