@@ -11,6 +11,8 @@ Public API, re-exported from private modules:
 - simulation: :func:`simulate` (closed linear loops: :class:`LinearFeedback`), :func:`sweep`
 - energy analysis: :mod:`prefriction.energy`
 - model checks for new models: :mod:`prefriction.testing`
+- identification: :mod:`prefriction.identify` (``fit``, ``ForceDisplacement``, ``Motion``,
+  ``FitResult``, ``IdentifiabilityWarning``)
 """
 
 from __future__ import annotations
@@ -23,7 +25,7 @@ from prefriction.simulation.simulate import SimulationResult, simulate
 from prefriction.simulation.sweep import SweepResult, sweep
 from prefriction.simulation.feedback import LinearFeedback
 from prefriction.analysis import dahl, energy
-from prefriction import signals
+from prefriction import identify, signals
 from prefriction.analysis.exact import exact_reversals
 
 __all__ = [
@@ -44,6 +46,7 @@ __all__ = [
     "dahl",
     "energy",
     "exact_reversals",
+    "identify",
     "signals",
     "simulate",
     "sweep",
