@@ -1,42 +1,47 @@
-"""prefriction bench --sweep --quick: compiles per structure, cold and warm, errors; the scipy peer."""
+"""prefriction bench --sweep, in-process with tiny sizes: the child's body against exact_reversals,
+one warm child process (no compile), the matched-error scipy peer, the target decisions, the
+table and CSV, --help and --out."""
 
 from __future__ import annotations
 
 import csv
+import dataclasses
 import math
 
 import numpy as np
+import pytest
 
 import prefriction as pf
 from prefriction.cli.bench import main as bench_main
-from prefriction.cli.bench_sweep import QUICK_VALUES, main, reversal_error, scipy_reversals, sweep_cases
+from prefriction.cli.bench_sweep import (SweepRow, format_table, main, matched_rtol, reversal_error, run_child,
+                                         scipy_reversals, sweep_cases, targets, worker, write_csv, _exact_tables)
+from prefriction.simulation.compiled import cache_dir
+
+SPEC = {"case": "gamma_ge1", "n": 2, "reference": None}
 
 
-def test_quick_sweep_bench(tmp_path, monkeypatch, capsys) -> None:
-    cache = tmp_path / "parent_cache"
-    cache.mkdir()
-    monkeypatch.setenv("PREFRICTION_CACHE", str(cache))
+def test_worker_against_exact_reversals() -> None:
+    """The child's body in this process: a sweep of 2 gamma values, errors vs exact_reversals."""
+    rep = worker(SPEC, 0.25)
+    assert rep["failed"] == 0 and rep["import_s"] == 0.25 and len(rep["errors"]) == 2
+    assert rep["error"] < 1e-7 and rep["sweep_s"] > 0 and rep["sim_wall_s"] > 0
+
+
+def test_warm_child_process_compiles_nothing(monkeypatch) -> None:
+    """A new process that finds the structure in the cache: no new library, no compile line."""
     monkeypatch.delenv("PREFRICTION_NO_JIT", raising=False)
-    out = tmp_path / "out"
-    code = main(["--quick", "--out", str(out)])
-    text = capsys.readouterr().out
-    assert code == 0, text
-    targets = [line for line in text.splitlines() if line.startswith(("T1", "T2"))]
-    assert len(targets) == 2 and all("PASS" in line for line in targets), targets
+    worker(SPEC, 0.0)  # the structure is in this process's cache (compiled or loaded)
+    child = run_child(SPEC, cache_dir())
+    assert child.new_libraries == 0 and child.compile_lines == 0
+    assert child.report["error"] < 1e-7 and child.report["failed"] == 0
 
-    with (out / "sweep.csv").open() as fh:
-        rows = list(csv.DictReader(fh))
-    cases = sweep_cases(QUICK_VALUES)
-    assert [(r["case"], r["run"]) for r in rows] == [(c.label, run) for c in cases for run in ("cold", "warm")]
-    for r in rows:
-        assert int(r["n_values"]) == QUICK_VALUES
-        expected = 1 if r["run"] == "cold" else 0  # one structure per case, fresh cache for the cold run
-        assert int(r["compiles"]) == expected and int(r["compile_lines"]) == expected, r
-        assert float(r["max_rel_error"]) < 1e-7, r
-        assert float(r["scipy_error"]) < 1e-5, r
-        assert float(r["end_to_end_s"]) > 0 and float(r["scipy_s"]) > 0 and float(r["ratio"]) > 0
-    # the parent process only runs scipy: nothing is compiled into its own cache
-    assert not list(cache.glob("*.so"))
+
+def test_matched_scipy_rtol_reaches_the_target() -> None:
+    case = sweep_cases(2)[0]
+    refs = _exact_tables(case)
+    rtol, matched, tried = matched_rtol(case, refs, 1e-8)
+    assert matched and tried[-1] == (rtol, tried[-1][1]) and tried[-1][1] <= 1e-8
+    assert all(err > 1e-8 for _, err in tried[:-1])  # the loosest rtol that matches
 
 
 def test_scipy_peer_matches_exact_reversals() -> None:
@@ -56,9 +61,40 @@ def test_reversal_error_counts_reversals() -> None:
     assert reversal_error(t[:4], t[:4], t[:4], t, t, t) == math.inf
 
 
-def test_bench_help_lists_sweep(capsys) -> None:
-    try:
+def _row(case: str, run: str, compiles: int, ratio: float, error: float = 1e-9) -> SweepRow:
+    return SweepRow(case=case, run=run, n_values=4, compiles=compiles, compile_lines=compiles, end_to_end_s=0.1,
+                    per_value_ms=25.0, import_s=0.5, setup_s=0.01, sim_wall_s=0.05, max_rel_error=error,
+                    reference="exact_reversals", scipy_rtol=1e-10, scipy_s=0.1 * ratio, scipy_error=5e-9,
+                    ratio=ratio, repeats=1, jit="cached:4")
+
+
+def test_targets_table_and_csv(tmp_path) -> None:
+    cases = sweep_cases(4)
+    good = [_row(c.label, run, 1 if run == "cold" else 0, 30.0) for c in cases for run in ("cold", "warm")]
+    lines = targets(good, cases, quick=False)
+    assert [line[:2] for line in lines] == ["T1", "T2"] and all("PASS" in line for line in lines)
+    slow = [dataclasses.replace(r, ratio=5.0) for r in good]
+    assert "FAIL" in targets(slow, cases, quick=False)[0] and "PASS" in targets(slow, cases, quick=True)[0]
+    twice = [dataclasses.replace(r, compiles=2, compile_lines=2) if r.run == "cold" else r for r in good]
+    assert all("FAIL" in line for line in targets(twice, cases, quick=False))
+    text = format_table(good)
+    assert all(c.label in text for c in cases) and "30.0x" in text
+    write_csv(tmp_path / "sweep.csv", good)
+    with (tmp_path / "sweep.csv").open() as fh:
+        rows = list(csv.DictReader(fh))
+    assert [(r["case"], r["run"]) for r in rows] == [(c.label, run) for c in cases for run in ("cold", "warm")]
+    assert set(rows[0]) == {f.name for f in dataclasses.fields(SweepRow)}
+
+
+def test_help_and_out(tmp_path, capsys) -> None:
+    with pytest.raises(SystemExit) as exc:
         bench_main(["--help"])
-    except SystemExit as exc:
-        assert exc.code == 0
-    assert "--sweep" in capsys.readouterr().out
+    assert exc.value.code == 0 and "--sweep" in capsys.readouterr().out
+    with pytest.raises(SystemExit) as exc:
+        main(["--help"])
+    out = capsys.readouterr().out
+    assert exc.value.code == 0 and "--quick" in out and "``" not in out and ":func:" not in out
+    (tmp_path / "f").write_text("")
+    with pytest.raises(SystemExit) as exc:
+        main(["--out", str(tmp_path / "f")])
+    assert exc.value.code == 2 and "must be a directory" in capsys.readouterr().err
