@@ -1,8 +1,9 @@
-"""``prefriction paper``: the command runs every figure, prints progress and writes report.md."""
+"""``prefriction paper``: options, progress lines, report, failures and where the figure scripts are found."""
 
 from __future__ import annotations
 
 import re
+from pathlib import Path
 
 import matplotlib
 
@@ -85,3 +86,14 @@ def test_paper_help_is_plain_text(capsys):
     for rest in ("``", ":func:", ":class:", ".. ", "Parameters\n"):
         assert rest not in text
 
+
+
+def test_examples_dir_is_found_beside_the_package_from_any_directory(tmp_path, monkeypatch):
+    beside = Path(paper.__file__).resolve().parents[2] / "examples"
+    if not (beside / "fig3_potential_energy.py").is_file():
+        pytest.skip("prefriction is imported from an installed copy, not the source tree")
+    monkeypatch.chdir(tmp_path)
+    assert examples_dir() == beside
+    monkeypatch.setattr(paper, "__file__", str(tmp_path / "site-packages" / "prefriction" / "cli" / "paper.py"))
+    with pytest.raises(FileNotFoundError, match="examples/fig"):
+        examples_dir()

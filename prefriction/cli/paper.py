@@ -46,7 +46,7 @@ def examples_dir() -> Path:
     FileNotFoundError
         If neither place holds ``fig3_potential_energy.py``; names both places.
     """
-    candidates = [Path(__file__).resolve().parent.parent / "examples", Path.cwd() / "examples"]
+    candidates = [Path(__file__).resolve().parents[2] / "examples", Path.cwd() / "examples"]
     for cand in candidates:
         if (cand / "fig3_potential_energy.py").is_file():
             return cand
