@@ -5,6 +5,7 @@ negative energies, empty arrays, mismatched lengths and unsorted times, at any p
 from __future__ import annotations
 
 import math
+import types
 
 import numpy as np
 import pytest
@@ -43,6 +44,8 @@ def valid_calls():
         "bound_check": (energy.bound_check, dict(E_p=E_P, friction=DAHL, E_0=0.4), {"E_p": "energies", "E_0": "nonnegative"}),
         "analyze_samples": (energy.analyze_samples, dict(t=T, x=X, v=V, F=F, system=SYSTEM),
                             {"t": "times", "x": "array", "v": "array", "F": "array"}),
+        "analyze_samples(u)": (energy.analyze_samples, dict(t=T, x=X, v=V, F=F, system=SYSTEM, u=0.1 * F),
+                               {"u": "array"}),
         "analyze_samples(LuGre)": (energy.analyze_samples, dict(t=T, x=1e-5 * X, v=1e-3 * V, F=F, system=LUGRE),
                                    {"t": "times", "x": "array", "v": "array", "F": "array"}),
         "bristle_deflection": (energy.bristle_deflection, dict(t=T, v=1e-3 * V, F=F, friction=LUGRE.friction), samples),
@@ -53,7 +56,7 @@ def valid_calls():
 
 CALLS = valid_calls()
 PAIRS = [(fn, arg) for fn, (_, _, kinds) in CALLS.items() for arg in kinds]
-OPTIONAL = {("analyze_table(LuGre)", "work_input"), ("dissipation", "input_work"), ("bound_check", "E_0"),
+OPTIONAL = {("analyze_table(LuGre)", "work_input"), ("analyze_samples(u)", "u"), ("dissipation", "input_work"), ("bound_check", "E_0"),
             ("find_reversals", "x"), ("find_reversals", "F")}  # None means "not given" there
 SCALAR_BAD = [None, "abc", 1j, math.nan, math.inf, -math.inf, [1.0, 2.0]]
 ARRAY_BAD = ["None", "string", "complex", "nan", "inf", "-inf", "empty", "short", "strings inside"]
@@ -80,8 +83,42 @@ def bad_array(good: np.ndarray, kind: str, pos: int):
 
 def test_every_public_function_is_covered():
     public = {name for name in energy.__all__ if callable(getattr(energy, name)) and name[0].islower()}
-    covered = {fn.split("(")[0] for fn in CALLS}
+    covered = {fn.split("(")[0] for fn in CALLS} | {"analyze_result"}  # its own test below
     assert public == covered
+
+
+def loop_like(**fields):
+    """An object with the fields of ``controllers.LoopResult`` that ``analyze_result`` reads."""
+    base = dict(t=T, x=X, v=V, F=F, u=0.1 * F, system=SYSTEM, Ts=None)
+    return types.SimpleNamespace(**{**base, **fields})
+
+
+@pytest.mark.parametrize("kwargs,error,message", [
+    (dict(result=None), TypeError, r"result must be a prefriction.SimulationResult .* got NoneType"),
+    (dict(result="abc"), TypeError, r"result must be .* got str"),
+    (dict(result=RuntimeError("a failed sweep run")), TypeError, r"result must be .* got RuntimeError"),
+    (dict(result=loop_like(), system=pf.Oscillator(DAHL, mass=2.0)), TypeError, r"system must be None or the loop's own"),
+    (dict(result=loop_like(), zoh="yes"), TypeError, r"zoh must be True or False, got 'yes'"),
+    (dict(result=loop_like(), method="euler"), ValueError, r"method must be one of \('trapezoid', 'simpson'\), got 'euler'"),
+    (dict(result=loop_like(u=F[:-1])), ValueError, r"u has length 39 but t has length 40"),
+    (dict(result=loop_like(u=np.where(T > 1.0, math.nan, F))), ValueError, r"u must be finite, got u\[7\] = nan"),
+    (dict(result=loop_like(u=None, Ts=0.1)), ValueError, r"zoh=True needs the held force samples u"),
+    (dict(result=loop_like(), extra=1), TypeError, r"unexpected keyword argument 'extra'"),
+])
+def test_analyze_result_refuses_bad_input(kwargs, error, message):
+    with pytest.raises(error, match=message):
+        energy.analyze_result(**kwargs)
+
+
+def test_analyze_result_needs_samples_and_the_system():
+    run = pf.exact_reversals(SYSTEM, 1.0, 2)  # not a run: a table
+    with pytest.raises(TypeError, match="result must be"):
+        energy.analyze_result(run, system=SYSTEM)
+    res = pf.simulate(SYSTEM, 1.0, reversals=2)  # no samples
+    with pytest.raises(TypeError, match="system is required with a SimulationResult"):
+        energy.analyze_result(res)
+    with pytest.raises(ValueError, match=r"result holds no samples \(result.t is None\): simulate with dense="):
+        energy.analyze_result(res, system=SYSTEM)
 
 
 @pytest.mark.parametrize("fn", list(CALLS))

@@ -13,7 +13,10 @@ Building blocks (model-free unless said otherwise):
 - :func:`branch_energy`, :func:`total_energy` (Dahl model): energy stored on a branch relative
   to its force zero crossing, (3.9) for ``gamma = 1``;
 - :func:`dissipation` (2.10), :func:`series` (2.11), :func:`bound_check` (2.12);
-- :func:`analyze_samples`, :func:`analyze_table`: all of it at once, as an :class:`EnergyReport`.
+- :func:`analyze_samples`, :func:`analyze_table`: all of it at once, as an :class:`EnergyReport`;
+  :func:`analyze_result` of a run with samples (``prefriction.simulate``, an entry of
+  ``prefriction.sweep``, ``controllers.simulate_loop``), counting the work of the applied force
+  ``result.u``, a controller's too (held between the samples of a sampled controller).
 
 Models: any rate-independent :class:`prefriction.FrictionModel` with a branch energy (Dahl,
 Maxwell-slip); a :class:`prefriction.GMS` with ``Fs = Fc`` and no damping, analysed as the equal
@@ -33,11 +36,11 @@ the energy dissipated in the half-cycle from reversal ``k`` to reversal ``k + 1`
 paper's ``E_d(i)`` in (2.10). :class:`prefriction.ReversalTable` indexes ``E_d`` by the
 half-cycle that *ends* at a reversal instead: ``table.E_d[k + 1]`` is ``E_d[k]`` here.
 
-The functions live in private modules: reversals in samples :mod:`prefriction.analysis.energy.sampled_reversals`,
-energies along samples :mod:`prefriction.analysis.energy.sampled_energy`, energies at reversals
-:mod:`prefriction.analysis.energy.balance`, the report :mod:`prefriction.analysis.energy.report`, LuGre
-:mod:`prefriction.analysis.energy.lugre` and :mod:`prefriction.analysis.energy.lugre_report`, argument checks
-:mod:`prefriction.analysis.energy.checks`.
+The functions live in private modules of :mod:`prefriction.analysis.energy`: reversals in
+samples ``sampled_reversals``, energies along samples ``sampled_energy``, the input's work
+between reversals ``work``, energies at reversals ``balance``, the report ``report``, the
+analysis of samples and runs ``analyze``, of reversal tables ``table_report``, LuGre ``lugre``
+and ``lugre_report``, argument checks ``checks``.
 """
 
 from __future__ import annotations
@@ -45,7 +48,9 @@ from __future__ import annotations
 from prefriction.analysis.energy.balance import BoundCheck, bound_check, branch_energy, dissipation, series
 from prefriction.analysis.energy.lugre import bristle_deflection
 from prefriction.analysis.energy.lugre_report import LuGreEnergyReport
-from prefriction.analysis.energy.report import EnergyReport, analyze_samples, analyze_table
+from prefriction.analysis.energy.analyze import analyze_result, analyze_samples
+from prefriction.analysis.energy.report import EnergyReport
+from prefriction.analysis.energy.table_report import analyze_table
 from prefriction.analysis.energy.sampled_energy import integrated_power, kinetic_energy, loop_integral, total_energy, work_integral
 from prefriction.analysis.energy.sampled_reversals import SampledReversals, find_reversals
 
@@ -54,6 +59,7 @@ __all__ = [
     "EnergyReport",
     "LuGreEnergyReport",
     "SampledReversals",
+    "analyze_result",
     "analyze_samples",
     "analyze_table",
     "bound_check",

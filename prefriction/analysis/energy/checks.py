@@ -103,6 +103,13 @@ def check_method(method: Any) -> str:
     return method
 
 
+def check_flag(name: str, value: Any) -> bool:
+    """Return ``value`` if it is ``True`` or ``False`` (numpy booleans too); ``TypeError`` otherwise."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise TypeError(f"{name} must be True or False, got {_describe(value)} of type {type(value).__name__}")
+    return bool(value)
+
+
 def check_system(system: Any, *, lugre: bool = False) -> tuple[FrictionModel, float]:
     """Return the friction model the energy analysis works with and the mass of ``system``.
 

@@ -15,15 +15,14 @@ and the viscous dissipation ``int (sigma1 z' + sigma2 v) v dt``.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy.integrate import simpson, trapezoid
 
 from prefriction.analysis.energy.balance import BoundCheck
 from prefriction.analysis.energy.checks import check_samples
 from prefriction.analysis.energy.sampled_reversals import SampledReversals
+from prefriction.analysis.energy.work import split_integrals
 from prefriction.models import LuGre
 
 CONDITION_MIN = 1e-3
@@ -109,31 +108,16 @@ def lugre_bound(E_p: np.ndarray, friction: LuGre, E_0: float) -> BoundCheck:
     )
 
 
-def _piece_integrals(t: np.ndarray, powers: np.ndarray, t_a: float, t_b: float, method: str) -> np.ndarray:
-    """Integrals over ``(t_a, t_b)`` of each row of ``powers``, with the samples strictly inside
-    and zero power at both ends (a reversal: ``v = 0`` and ``z' = 0``, so every power vanishes).
-    ``t_a`` is ``t[0]`` (not a reversal) for the first excursion: the power there is the sample's."""
-    inside = (t > t_a) & (t < t_b)
-    first = t_a == t[0]
-    tt = np.concatenate(([t_a], t[inside], [t_b]))
-    start = powers[:, :1] if first else np.zeros((powers.shape[0], 1))
-    pp = np.concatenate((start, powers[:, inside], np.zeros((powers.shape[0], 1))), axis=1)
-    if method == "simpson" and tt.size >= 3:
-        return simpson(pp, x=tt, axis=1)
-    return trapezoid(pp, tt, axis=1)
-
-
 def half_cycle_split(
-    t: np.ndarray, v: np.ndarray, F: np.ndarray, u: np.ndarray, rev: SampledReversals, friction: LuGre, method: str
+    t: np.ndarray, v: np.ndarray, F: np.ndarray, rev: SampledReversals, friction: LuGre, method: str
 ) -> dict[str, Any]:
-    """Every energy term of the LuGre oscillator over the first excursion and each half-cycle."""
+    """The dissipation terms of the LuGre oscillator over the first excursion and each half-cycle:
+    rows ``int sigma2 v^2``, ``int sigma1 z' v`` and ``int sigma0 z (v - z')`` [J]."""
     z, zd, n_interp = _deflection(t, v, F, friction)
     p_s2 = friction.sigma2 * v * v
     p_s1 = friction.sigma1 * zd * v
     p_h = friction.sigma0 * z * (v - zd)
-    powers = np.vstack((p_s2, p_s1, p_h, u * v))
-    ends = np.concatenate(([t[0]], rev.t))
-    D = np.array([_piece_integrals(t, powers, ends[k], ends[k + 1], method) for k in range(ends.size - 1)]).T
+    D = split_integrals(t, np.vstack((p_s2, p_s1, p_h)), rev, method)
     return {"z": z, "z_rev": _hermite(t, z, zd, rev), "interpolated": n_interp, "first": D[:, 0], "half": D[:, 1:]}
 
 

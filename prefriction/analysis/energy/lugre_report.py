@@ -10,7 +10,7 @@ import numpy as np
 
 from prefriction.analysis.energy.balance import BoundCheck
 from prefriction.analysis.energy.lugre import half_cycle_split, lugre_bound
-from prefriction.analysis.energy.sampled_reversals import find_reversals
+from prefriction.analysis.energy.sampled_reversals import SampledReversals
 from prefriction.models import LuGre, Oscillator
 
 
@@ -131,23 +131,20 @@ class LuGreEnergyReport:
 
 
 def analyze_lugre_samples(
-    t: np.ndarray, x: np.ndarray, v: np.ndarray, F: np.ndarray, *, system: Oscillator, u: np.ndarray, method: str
+    t: np.ndarray, v: np.ndarray, F: np.ndarray, rev: SampledReversals, W: np.ndarray, *, system: Oscillator, method: str
 ) -> LuGreEnergyReport:
-    """The report of validated samples of a LuGre oscillator (called by ``analyze_samples``)."""
+    """The report of validated samples of a LuGre oscillator (called by ``analyze_samples``):
+    ``rev`` the reversals in the samples, ``W`` the input's work over the first excursion and
+    each half-cycle [J] (length ``len(rev)``)."""
     friction: LuGre = system.friction
-    rev = find_reversals(t, v, x=x, F=F)
-    if len(rev) == 0:
-        raise ValueError(
-            f"v changes sign nowhere in the {t.size} samples (t from {float(t[0])!r} to {float(t[-1])!r} s): "
-            "no reversal to analyse; simulate longer"
-        )
-    split = half_cycle_split(t, v, F, u, rev, friction, method)
+    split = half_cycle_split(t, v, F, rev, friction, method)
     F_rev = friction.sigma0 * split["z_rev"]  # v = 0 and z' = 0 at a reversal: F = sigma0 z
     E_p = F_rev**2 / (2.0 * friction.sigma0)
     z0 = float(split["z"][0])
     E_0 = 0.5 * system.mass * float(v[0]) ** 2 + 0.5 * friction.sigma0 * z0 * z0
-    s2, s1, h, w = split["half"]
-    f2, f1, fh, fw = (float(a) for a in split["first"])
+    s2, s1, h = split["half"]
+    f2, f1, fh = (float(a) for a in split["first"])
+    fw, w = float(W[0]), W[1:]
     E_d = E_p[:-1] + w - E_p[1:]
     E_d_initial = E_0 + fw - float(E_p[0])
     lost = np.concatenate(([E_d_initial - f2 - f1 - fh], E_d - s2 - s1 - h))
