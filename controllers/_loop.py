@@ -318,6 +318,8 @@ def simulate_loop(
         Ts = dt
     elif Ts is not None:
         C = control.c2d(C, Ts, method=discretization)
+    if Ts is not None:
+        sample_count(t_end, Ts, t_end / Ts)  # refuse runs that would exhaust the memory
     closed_loop(system, C, regime="presliding", warn=True)
     if saturated and Ts is None:
         raise NotImplementedError(
@@ -329,7 +331,6 @@ def simulate_loop(
     if Ts is not None:
         if t_out is not None:
             raise ValueError("t_out is not allowed with a sampled controller: its outputs are at the sample instants k Ts")
-        sample_count(t_end, Ts, t_end / Ts)  # refuse runs that would exhaust the memory
         if callable(reference) and not isinstance(reference, Signal):  # read at the sample instants only
             tk = Ts * np.arange(int(math.floor(t_end / Ts * (1 + 1e-12))) + 2)
             fb_reference = (tk, _evaluate(reference, tk))

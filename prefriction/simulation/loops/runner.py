@@ -245,7 +245,7 @@ def run_sampled(
             S = blk.S.copy()
         k += upto
     wall = time.perf_counter() - start
-    integrated = int(np.count_nonzero(recs[:, LL.rec["moved"]] > 0.5)) + finished
+    integrated = int(np.count_nonzero(recs[:, LL.rec["moved"]] > 0.5))
     table, W_r = _reversal_table(rev, system, s0, v0, F0)
     ix = LL.state
     t = tk * sc.t
