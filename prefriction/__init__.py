@@ -13,6 +13,9 @@ Public API, re-exported from private modules:
 - model checks for new models: :mod:`prefriction.testing`
 - identification: :mod:`prefriction.identify` (``fit``, ``ForceDisplacement``, ``Motion``,
   ``FitResult``, ``IdentifiabilityWarning``)
+- derivatives through the simulator and the exact map: :func:`sensitivities`
+  (:mod:`prefriction.sensitivity`)
+- describing functions and limit cycles (hunting): :mod:`prefriction.describing`
 """
 
 from __future__ import annotations
@@ -25,7 +28,8 @@ from prefriction.simulation.simulate import SimulationResult, simulate
 from prefriction.simulation.sweep import SweepResult, sweep
 from prefriction.simulation.feedback import LinearFeedback
 from prefriction.analysis import dahl, energy
-from prefriction import identify, signals
+from prefriction import describing, identify, sensitivity, signals
+from prefriction.sensitivity import sensitivities
 from prefriction.analysis.exact import exact_reversals
 
 __all__ = [
@@ -46,7 +50,10 @@ __all__ = [
     "dahl",
     "energy",
     "exact_reversals",
+    "describing",
     "identify",
+    "sensitivities",
+    "sensitivity",
     "signals",
     "simulate",
     "sweep",
