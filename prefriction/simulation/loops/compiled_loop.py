@@ -23,7 +23,6 @@ order and the block length.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 import casadi as ca
 
