@@ -19,6 +19,7 @@ from prefriction.plotting import COLORS, add_note, new_figure, save
 
 FC = 1.0  # Coulomb force [N]; not stated in the paper
 RATIOS = (1.0, 10.0, 100.0, 1000.0)  # sigma/Fc [1/m], as in the paper
+RATIO_COLORS = (COLORS[4], COLORS[0], COLORS[1], COLORS[2])  # 10, 100, 1000 1/m as in Figs. 6 and 7
 
 
 def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
@@ -42,7 +43,7 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
     ax = axes[0, 0]
     curves: dict[float, np.ndarray] = {}
     maxima: dict[float, float] = {}
-    for color, ratio in zip(COLORS, RATIOS):
+    for color, ratio in zip(RATIO_COLORS, RATIOS):
         sigma = ratio * FC
         e_p = np.asarray(dahl.potential_energy(-a * FC, sigma, FC), dtype=float)
         curves[ratio] = e_p
