@@ -38,6 +38,8 @@ from typing import Any, Callable, Optional, Union
 import casadi as ca
 import numpy as np
 
+from prefriction._validation import check_real_array
+
 __all__ = [
     "compiled_form",
     "Chirp",
@@ -293,9 +295,9 @@ class Signal(ABC):
         float or numpy.ndarray
             The value(s), shaped like ``t`` (a float for a scalar ``t``).
         """
-        if isinstance(t, float) and self.n_piece == 0:  # one time: no numpy broadcasting (~30 us)
+        if isinstance(t, float) and self.n_piece == 0 and math.isfinite(t):  # one time: no numpy (~30 us)
             return float(self._expr(t, self.params().tolist(), (), _MathOps))
-        return self.expr(t, self.params())
+        return self.expr(check_real_array("t", t, "s"), self.params())
 
     def breaks(self) -> np.ndarray:
         """Times at which the signal or its first derivative jumps.
@@ -761,7 +763,7 @@ class Samples(Signal):
         float or numpy.ndarray
             ``numpy.interp(t, self.t, self.u)``.
         """
-        value = np.interp(np.asarray(t, dtype=float), self._t, self._u)
+        value = np.interp(check_real_array("t", t, "s"), self._t, self._u)
         return float(value) if np.ndim(value) == 0 else value
 
     def breaks(self) -> np.ndarray:

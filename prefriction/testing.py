@@ -17,9 +17,28 @@ import casadi as ca
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from prefriction._validation import check_choice, check_count, check_finite, check_interval, check_positive
 from prefriction.models import FrictionModel, Oscillator
 
-__all__ = ["ModelCheck", "check_model", "reference_reversals"]
+__all__ = ["MAX_CHECK_REVERSALS", "ModelCheck", "check_model", "reference_reversals"]
+
+MAX_CHECK_REVERSALS = 100_000
+"""Most reversals of :func:`reference_reversals` and :func:`check_model` (one scipy run per
+reversal: about a minute at the limit)."""
+_METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
+_MAX_SPEED = 1e150  # |v0| in normalised units: initial energy far inside double precision
+
+
+def _check_model_and_speed(model: Any, v0: Any) -> float:
+    """Check ``model`` (a FrictionModel) and the normalised initial velocity ``v0``."""
+    if not isinstance(model, FrictionModel):
+        raise TypeError(f"model must be a prefriction.FrictionModel (e.g. prefriction.Dahl), got {model!r} "
+                        f"of type {type(model).__name__}")
+    v0 = check_finite("v0", v0)
+    if not 0.0 < abs(v0) <= _MAX_SPEED:
+        raise ValueError(f"v0 must be a finite nonzero normalised velocity with |v0| <= {_MAX_SPEED:g} (the motion "
+                         f"starts from F = 0, so v0 = 0 never moves; larger speeds overflow), got {v0!r}")
+    return v0
 
 
 @dataclass(frozen=True)
@@ -114,12 +133,29 @@ def reference_reversals(model: FrictionModel, v0: float, n: int, *, rtol: float 
     oscillator (unit mass) in normalised units, by scipy ``solve_ivp`` (``method``, default
     DOP853; Radau for stiff models) restarted at every reversal and every model event.
 
+    Parameters
+    ----------
+    model : FrictionModel
+        The friction model.
+    v0 : float
+        Initial normalised velocity (from ``F = 0``), ``0 < |v0| <= 1e150``.
+    n : int
+        Number of reversals, ``1 <= n <=`` :data:`MAX_CHECK_REVERSALS`.
+    rtol : float, default 1e-12
+        Relative tolerance of ``solve_ivp``, in ``[1e-13, 1e-2]`` (``atol = rtol / 100``).
+    method : str, default "DOP853"
+        A ``solve_ivp`` method: ``"RK45"``, ``"RK23"``, ``"DOP853"``, ``"Radau"``, ``"BDF"`` or ``"LSODA"``.
+
     Returns
     -------
     (numpy.ndarray, numpy.ndarray)
         Reversal rows ``(t, x, F)`` (shape ``(k, 3)``) and, per reversal, ``-int F dx`` from the
         reversal to the next zero crossing of ``F`` (NaN where the run ended before it).
     """
+    v0 = _check_model_and_speed(model, v0)
+    n = check_count("n", n, minimum=1, maximum=MAX_CHECK_REVERSALS, why="one scipy run per reversal")
+    rtol = check_interval("rtol", rtol, 1e-13, 1e-2)
+    method = check_choice("method", method, _METHODS)
     q = model.runtime_params().tolist()
     nz = model.n_states
     s = 1.0 if v0 > 0 else -1.0
@@ -193,15 +229,22 @@ def check_model(model: FrictionModel, *, v0: float = 1.5, reversals: int = 12, r
     model : FrictionModel
         The model under test (its ``sigma`` and ``Fc`` set the units; the check runs in them).
     v0 : float, default 1.5
-        Initial normalised velocity (from ``F = 0``).
+        Initial normalised velocity (from ``F = 0``), ``0 < |v0| <= 1e150``.
     reversals : int, default 12
-        Number of reversals compared.
+        Number of reversals compared, ``1 <= reversals <=`` :data:`MAX_CHECK_REVERSALS`.
     rtol : float, default 1e-8
-        Tolerance of the simulation.
+        Tolerance of the simulation, in ``[1e-13, 1e-2]``.
     tol_factor : float, default 20
-        Allowed error in units of ``rtol``.
+        Allowed error in units of ``rtol``, finite and > 0.
     seed : int, default 0
-        Seed of the random states of the contract check.
+        Seed of the random states of the contract check, ``>= 0``.
+
+    Raises
+    ------
+    TypeError, ValueError
+        For an argument of the wrong type or out of range (before any simulation), naming it.
+    AssertionError
+        If the model fails a check.
 
     Returns
     -------
@@ -210,6 +253,12 @@ def check_model(model: FrictionModel, *, v0: float = 1.5, reversals: int = 12, r
     from prefriction.simulation.simulate import simulate
     from prefriction.units import Scales
 
+    v0 = _check_model_and_speed(model, v0)
+    reversals = check_count("reversals", reversals, minimum=1, maximum=MAX_CHECK_REVERSALS,
+                            why="one scipy run per reversal")
+    rtol = check_interval("rtol", rtol, 1e-13, 1e-2)
+    tol_factor = check_positive("tol_factor", tol_factor)
+    seed = check_count("seed", seed, minimum=0)
     _contract(model, np.random.default_rng(seed))
     system = Oscillator(model, mass=1.0)
     sc = Scales.of(system)

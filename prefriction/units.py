@@ -11,7 +11,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from prefriction._validation import check_positive
 from prefriction.models import Oscillator
+
+_TINY = 2.2250738585072014e-308  # smallest normal double
+_LABELS = {"x": "Fc/sigma", "F": "Fc", "t": "sqrt(m/sigma)", "v": "Fc/sqrt(m sigma)", "E": "Fc^2/sigma"}
 
 
 @dataclass(frozen=True)
@@ -38,14 +42,38 @@ class Scales:
     v: float
     E: float
 
+    def __post_init__(self) -> None:
+        for name in ("x", "F", "t", "v", "E"):
+            object.__setattr__(self, name, check_positive(name, getattr(self, name)))
+
     @classmethod
     def of(cls, system: Oscillator) -> "Scales":
-        """Scales of ``system`` (its friction model's ``sigma``, ``Fc`` and its mass)."""
+        """Scales of ``system`` (its friction model's ``sigma``, ``Fc`` and its mass).
+
+        Raises
+        ------
+        TypeError
+            If ``system`` is not a :class:`prefriction.Oscillator`.
+        ValueError
+            If a unit is not a finite normal double (``sigma``, ``Fc`` and ``mass`` too far apart,
+            e.g. ``sigma = 1e308`` N/m with ``Fc = 1e-308`` N): the simulator and the exact
+            references divide by them.
+        """
+        if not isinstance(system, Oscillator):
+            raise TypeError(f"system must be a prefriction.Oscillator, got {system!r} of type {type(system).__name__}")
         sigma, Fc, m = system.friction.sigma, system.friction.Fc, system.mass
-        return cls(
-            x=Fc / sigma,
-            F=Fc,
-            t=math.sqrt(m / sigma),
-            v=Fc / math.sqrt(m * sigma),
-            E=Fc * Fc / sigma,
-        )
+        with_units = {
+            "x": Fc / sigma,
+            "F": Fc,
+            "t": math.sqrt(m / sigma),
+            "v": Fc / math.sqrt(m * sigma) if math.isfinite(m * sigma) else Fc / math.sqrt(m) / math.sqrt(sigma),
+            "E": Fc / sigma * Fc,
+        }
+        bad = [f"{_LABELS[k]} = {u!r}" for k, u in with_units.items() if not (math.isfinite(u) and u >= _TINY)]
+        if bad:
+            raise ValueError(
+                f"sigma = {sigma!r} N/m, Fc = {Fc!r} N and mass = {m!r} kg are out of range together: the units "
+                f"Fc/sigma [m], Fc [N], sqrt(m/sigma) [s], Fc/sqrt(m sigma) [m/s] and Fc^2/sigma [J] must be "
+                f"finite doubles >= {_TINY!r}, got {', '.join(bad)}"
+            )
+        return cls(**with_units)

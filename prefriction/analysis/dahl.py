@@ -19,10 +19,19 @@ from typing import Any
 
 import numpy as np
 
-from prefriction._validation import check_array_interval, check_count, check_interval, check_positive
+from prefriction._validation import (
+    check_array_interval,
+    check_bool,
+    check_broadcast,
+    check_count,
+    check_interval,
+    check_positive,
+    check_real_array,
+)
 
 __all__ = [
     "MAX_POTENTIAL_FACTOR",
+    "MAX_STEPS",
     "amplitude_sequence",
     "asymptotic_amplitude",
     "branch_energy",
@@ -37,6 +46,9 @@ __all__ = [
     "reversal_abscissa",
     "zero_crossing",
 ]
+
+#: Most steps of :func:`amplitude_sequence` in one call (80 MB, about 10 s).
+MAX_STEPS = 10_000_000
 
 #: ``1 - ln 2``: the largest potential energy at a reversal is this times ``Fc^2 / sigma``.
 MAX_POTENTIAL_FACTOR = 1.0 - math.log(2.0)
@@ -64,13 +76,52 @@ _NEWTON_STEPS = 2
 
 
 def _as_sigma_fc(sigma: Any, Fc: Any) -> tuple[float, float]:
-    return check_positive("sigma", sigma), check_positive("Fc", Fc)
+    """``sigma`` [N/m] and ``Fc`` [N] as floats > 0 whose units ``Fc / sigma`` [m], ``sigma / Fc``
+    [1/m] and ``Fc^2 / sigma`` [J] are finite and normal in double precision."""
+    sigma, Fc = check_positive("sigma", sigma), check_positive("Fc", Fc)
+    units = (Fc / sigma, sigma / Fc, Fc / sigma * Fc)
+    if not all(math.isfinite(u) and u >= _TINY for u in units):
+        raise ValueError(
+            f"sigma = {sigma!r} N/m and Fc = {Fc!r} N are out of range together: the units Fc/sigma [m], "
+            f"sigma/Fc [1/m] and Fc^2/sigma [J] must lie in [{_TINY!r}, {_HUGE!r}] (double precision), "
+            f"got {units[0]!r}, {units[1]!r} and {units[2]!r}"
+        )
+    return sigma, Fc
+
+
+_TINY = 2.2250738585072014e-308  # smallest normal double
+_HUGE = 1.7976931348623157e308
 
 
 def _direction(direction: Any) -> float:
-    if direction not in (1, -1):
+    if isinstance(direction, (bool, np.bool_)) or direction not in (1, -1):
         raise ValueError(f"direction must be +1 or -1 (sign of the velocity), got {direction!r}")
     return float(direction)
+
+
+def _normalised_position(name: str, x: Any, sigma: float, Fc: float) -> np.ndarray:
+    """``sigma x / Fc`` of the positions ``x`` [m]: finite entries whose normalised value is finite."""
+    x = check_real_array(name, x, "m")
+    y = sigma * x / Fc
+    bad = ~np.isfinite(y)
+    if np.any(bad):
+        raise ValueError(
+            f"{name} = {float(x[bad].flat[0])!r} m is too large for sigma = {sigma!r} N/m and Fc = {Fc!r} N: "
+            f"sigma {name} / Fc overflows (allowed: |{name}| <= {_HUGE * Fc / sigma:.6g} m)"
+        )
+    return y
+
+
+def _finite_result(name: str, x: np.ndarray, out: np.ndarray, what: str) -> np.ndarray:
+    """``out`` if every entry is finite; else ``ValueError`` naming the entry of ``x`` behind it."""
+    bad = ~np.isfinite(out)
+    if np.any(bad):
+        raise ValueError(
+            f"{name} = {float(np.broadcast_to(x, out.shape)[bad][0])!r} m lies too far before the zero crossing: "
+            f"{what} exceeds the double-precision range (allowed: {name} with a finite {what}, i.e. "
+            f"sigma {name} / Fc >= about -700)"
+        )
+    return out
 
 
 def branch_force(x: Any, x_i: Any, F_i: Any, sigma: float, Fc: float, direction: int = 1) -> np.ndarray:
@@ -101,7 +152,18 @@ def branch_force(x: Any, x_i: Any, F_i: Any, sigma: float, Fc: float, direction:
     sigma, Fc = _as_sigma_fc(sigma, Fc)
     s = _direction(direction)
     F_i = check_array_interval("F_i", F_i, -Fc, Fc)
-    y = sigma * (np.asarray(x, dtype=float) - np.asarray(x_i, dtype=float)) / Fc
+    x = check_real_array("x", x, "m")
+    x_i = check_real_array("x_i", x_i, "m")
+    check_broadcast(x=x, x_i=x_i, F_i=F_i)
+    with np.errstate(over="ignore", invalid="ignore"):
+        y = sigma * (x - x_i) / Fc
+    behind = ~(s * y >= 0.0)
+    if np.any(behind):
+        raise ValueError(
+            f"x must lie on the branch, direction (x - x_i) >= 0 [m] (and sigma (x - x_i) / Fc finite), got "
+            f"x = {float(np.broadcast_to(x, y.shape)[behind][0])!r} m with x_i = "
+            f"{float(np.broadcast_to(x_i, y.shape)[behind][0])!r} m and direction = {int(s)}"
+        )
     # s F = Fc - (Fc - s F_i) e^{-s y} = s F_i + (Fc - s F_i)(1 - e^{-s y})
     return s * (s * F_i - (Fc - s * F_i) * np.expm1(-s * y))
 
@@ -133,8 +195,20 @@ def zero_crossing(x_i: Any, F_i: Any, sigma: float, Fc: float, direction: int = 
     sigma, Fc = _as_sigma_fc(sigma, Fc)
     s = _direction(direction)
     F_i = check_array_interval("F_i", F_i, -Fc, Fc)
-    with np.errstate(divide="ignore"):
-        return np.asarray(x_i, dtype=float) + s * (Fc / sigma) * np.log1p(-s * F_i / Fc)
+    x_i = check_real_array("x_i", x_i, "m")
+    check_broadcast(x_i=x_i, F_i=F_i)
+    _check_not_saturated(F_i, s, Fc)
+    return x_i + s * (Fc / sigma) * np.log1p(-s * F_i / Fc)
+
+
+def _check_not_saturated(F_i: np.ndarray, s: float, Fc: float) -> None:
+    """A branch that starts at ``s F_i = Fc`` stays there: no zero crossing, (3.6) and (3.8) diverge."""
+    if np.any(s * F_i >= Fc):
+        raise ValueError(
+            f"F_i must satisfy direction F_i < Fc = {Fc!r} N (a branch that starts at the Coulomb force "
+            f"never crosses zero), got F_i = {float(s * Fc)!r} N with direction = {int(s)} "
+            f"(allowed: -Fc <= direction F_i < Fc)"
+        )
 
 
 def reversal_abscissa(F_i: Any, sigma: float, Fc: float) -> np.ndarray:
@@ -159,8 +233,8 @@ def reversal_abscissa(F_i: Any, sigma: float, Fc: float) -> np.ndarray:
     """
     sigma, Fc = _as_sigma_fc(sigma, Fc)
     F_i = check_array_interval("F_i", F_i, -Fc, Fc)
-    with np.errstate(divide="ignore"):
-        return -(Fc / sigma) * np.log1p(-F_i / Fc)
+    _check_not_saturated(F_i, 1.0, Fc)
+    return -(Fc / sigma) * np.log1p(-F_i / Fc)
 
 
 def branch_energy(x: Any, sigma: float, Fc: float) -> np.ndarray:
@@ -185,8 +259,10 @@ def branch_energy(x: Any, sigma: float, Fc: float) -> np.ndarray:
         Energy [J], ``>= 0``.
     """
     sigma, Fc = _as_sigma_fc(sigma, Fc)
-    y = sigma * np.asarray(x, dtype=float) / Fc
-    return (Fc * Fc / sigma) * _g(y)
+    y = _normalised_position("x", x, sigma, Fc)
+    with np.errstate(over="ignore", invalid="ignore"):
+        out = (Fc * Fc / sigma) * _g(y)
+    return _finite_result("x", y * (Fc / sigma), out, "the energy")
 
 
 def _g(y: np.ndarray) -> np.ndarray:
@@ -400,6 +476,7 @@ def next_reversal_position_paper(F_i: Any, sigma: float, Fc: float, *, printed: 
     """
     sigma, Fc = _as_sigma_fc(sigma, Fc)
     F_i = check_array_interval("F_i", F_i, -Fc, 0.0)
+    printed = check_bool("printed", printed)
     y = _paper_normalised_position(-F_i / Fc, sigma / Fc if printed else None)
     return (Fc / sigma) * y
 
@@ -422,7 +499,10 @@ def omega(x: Any, sigma: float, Fc: float) -> np.ndarray:
         ``Omega(x)`` (dimensionless).
     """
     sigma, Fc = _as_sigma_fc(sigma, Fc)
-    return np.exp(-sigma * np.asarray(x, dtype=float) / Fc)
+    y = _normalised_position("x", x, sigma, Fc)
+    with np.errstate(over="ignore"):
+        out = np.exp(-y)
+    return _finite_result("x", y * (Fc / sigma), out, "exp(-sigma x / Fc)")
 
 
 def omega_star(x: Any, F_i: Any, sigma: float, Fc: float) -> np.ndarray:
@@ -448,8 +528,10 @@ def omega_star(x: Any, F_i: Any, sigma: float, Fc: float) -> np.ndarray:
     """
     sigma, Fc = _as_sigma_fc(sigma, Fc)
     F_i = check_array_interval("F_i", F_i, -Fc, 0.0)
-    K = (sigma / Fc) * np.exp(-0.6 * np.log1p(-F_i / Fc))
-    return 1.0 - K * np.asarray(x, dtype=float)
+    y = _normalised_position("x", x, sigma, Fc)
+    check_broadcast(x=y, F_i=F_i)
+    # K x = (sigma x / Fc) (1 + a)^-0.6 with (1 + a)^-0.6 in [0.66, 1]: finite when sigma x / Fc is
+    return 1.0 - np.exp(-0.6 * np.log1p(-F_i / Fc)) * y
 
 
 def amplitude_sequence(a0: float, n: int) -> np.ndarray:
@@ -472,7 +554,7 @@ def amplitude_sequence(a0: float, n: int) -> np.ndarray:
         Array of length ``n + 1``.
     """
     a = check_interval("a0", a0, 0.0, 1.0)
-    n = check_count("n", n, minimum=0)
+    n = check_count("n", n, minimum=0, maximum=MAX_STEPS, why=f"{8 * MAX_STEPS // 10**6} MB and about 10 s")
     out = np.empty(n + 1)
     out[0] = a
     series = _MAP_SERIES[::-1]
@@ -517,9 +599,7 @@ def asymptotic_amplitude(n: Any, a0: float = 1.0) -> np.ndarray:
     a0 = check_interval("a0", a0, 0.0, 1.0)
     if a0 == 0.0:
         raise ValueError("a0 must lie in (0, 1] for the asymptotic law, got 0.0 (a_n = 0 for all n)")
-    n = np.asarray(n, dtype=float)
-    if np.any(~np.isfinite(n) | (n < 0)):
-        raise ValueError(f"n must be finite and >= 0 (every entry), got {n[~(np.isfinite(n) & (n >= 0))].flat[0]!r}")
+    n = check_real_array("n", n, lo=0.0)
     k, a = 0, a0
     while a > 0.005:
         a = float(next_amplitude(a))

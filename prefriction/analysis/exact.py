@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import math
 from functools import lru_cache
+from typing import Any
 
 import numpy as np
 
@@ -41,7 +42,12 @@ from prefriction.models import Dahl, Oscillator, check_dahl_oscillator
 from prefriction.reversals import ReversalTable
 from prefriction.units import Scales
 
-__all__ = ["exact_reversals"]
+__all__ = ["MAX_REVERSALS", "MAX_SPEED", "check_initial_state", "exact_reversals"]
+
+MAX_REVERSALS = 10_000_000
+"""Most reversals :func:`exact_reversals` computes in one call (about 0.5 GB and two minutes)."""
+MAX_SPEED = 1e150
+"""Largest ``|v0|`` in velocity units ``Fc / sqrt(m sigma)`` (initial energy ``< 1e300 Fc^2 / sigma``)."""
 
 _N = 32  # Gauss-Legendre order of the panel rules (first half-cycle)
 _N_REG = 24  # order of the vectorised half-cycle rules (integrands analytic on ellipses rho >= 3)
@@ -107,39 +113,24 @@ def exact_reversals(system: Oscillator, v0: float, n: int, *, x0: float = 0.0, F
         return maxwell_slip_reversals(system, v0, n, x0=x0, F0=F0)
     if isinstance(system, Oscillator) and not isinstance(system.friction, Dahl):
         raise TypeError(
-            f"exact_reversals has an exact reference for Dahl and MaxwellSlip only, got "
-            f"{system.friction!r} of type {type(system.friction).__name__}; use prefriction.simulate"
+            f"system.friction must be a prefriction.Dahl or MaxwellSlip model: exact_reversals has an exact "
+            f"reference for Dahl and MaxwellSlip only, got {system.friction!r} of type "
+            f"{type(system.friction).__name__}; use prefriction.simulate"
         )
     check_dahl_oscillator(system, "exact_reversals")
     if system.u is not None:
         raise ValueError(
-            "exact_reversals covers the unforced system (2.1) only, got an oscillator with an input force u "
-            "(allowed: system.u is None); use prefriction.simulate for forced motion"
+            "system must be unforced: exact_reversals covers the unforced system (2.1) only, got an oscillator "
+            "with an input force u (allowed: system.u is None); use prefriction.simulate for forced motion"
         )
-    v0 = check_finite("v0", v0)
-    x0 = check_finite("x0", x0)
-    F0 = check_finite("F0", F0)
-    n = check_count("n", n, minimum=1)
-    dahl_model = system.friction
-    Fc, gamma = dahl_model.Fc, dahl_model.gamma
-    if abs(F0) > Fc:
-        raise ValueError(f"F0 must lie in [-Fc, Fc] = [{-Fc!r}, {Fc!r}] N, got {F0!r}")
-    if v0 == 0.0 and F0 == 0.0:
-        raise ValueError(
-            "v0 = 0 and F0 = 0: the oscillator is at rest at its equilibrium and nothing moves "
-            "(allowed: v0 != 0 or F0 != 0)"
-        )
+    sc = Scales.of(system)
+    v0, x0, F0, n = check_initial_state(system, sc, v0, x0, F0, n)
+    Fc, gamma = system.friction.Fc, system.friction.gamma
     if gamma >= 1.0 and v0 != 0.0 and F0 == math.copysign(Fc, v0):
         raise ValueError(
             f"F0 = {F0!r} N equals Fc in the direction of v0 = {v0!r} m/s: for gamma = {gamma!r} >= 1 the "
             "Dahl force reaches Fc only asymptotically, so this state stores infinite branch energy "
             "(allowed: |F0| < Fc, or F0 opposing v0)"
-        )
-    sc = Scales.of(system)
-    if 0.5 * (v0 / sc.v) ** 2 + (F0 / Fc) ** 2 == 0.0:
-        raise ValueError(
-            f"v0 = {v0!r} m/s and F0 = {F0!r} N give an initial energy below the double-precision range "
-            f"(allowed: |v0| > {1e-150 * sc.v!r} m/s or |F0| > {1e-150 * Fc!r} N)"
         )
     s0 = math.copysign(1.0, v0) if v0 != 0.0 else -math.copysign(1.0, F0)
     f0 = s0 * F0 / Fc
@@ -160,9 +151,49 @@ def exact_reversals(system: Oscillator, v0: float, n: int, *, x0: float = 0.0, F
     if gamma == 0.0:
         # the stop dissipates only while sliding: exactly v1^2 / 2 = E0 - 1/2 in the first half-cycle
         Ed[0] = max(E0 - 0.5, 0.0)
+    if not (np.all(np.isfinite(x)) and math.isfinite(E0 * sc.E)):
+        raise ValueError(
+            f"v0 = {v0!r} m/s and x0 = {x0!r} m carry the oscillator beyond the double-precision range "
+            f"(first excursion {float(dist[0]) * sc.x:.6g} m, initial energy {E0 * sc.E:.6g} J); allowed: smaller |v0| or |x0|"
+        )
     return ReversalTable(
         t=_cumsum(t) * sc.t, x=x, F=F, E_p=Ep * sc.E, E_d=Ed * sc.E, E_0=float(E0 * sc.E)
     )
+
+
+def check_initial_state(system: Oscillator, sc: Scales, v0: Any, x0: Any, F0: Any, n: Any,
+                        maximum: int = MAX_REVERSALS) -> tuple[float, float, float, int]:
+    """``v0`` [m/s], ``x0`` [m], ``F0`` [N] and ``n`` of an exact reference, checked.
+
+    ``|v0|`` is at most ``MAX_SPEED`` velocity units ``Fc / sqrt(m sigma)`` (the initial kinetic
+    energy in units ``Fc^2 / sigma`` then stays far below the double-precision range), ``|F0| <= Fc``,
+    ``1 <= n <= maximum`` (default :data:`MAX_REVERSALS`); the oscillator must move (``v0 != 0``
+    or ``F0 != 0``).
+    """
+    Fc = system.friction.Fc
+    v_max = MAX_SPEED * sc.v
+    v0 = check_finite("v0", v0)
+    if abs(v0) > v_max:
+        raise ValueError(
+            f"v0 must be a finite real number in [-{v_max:.6g}, {v_max:.6g}] m/s ({MAX_SPEED:g} velocity units "
+            f"Fc/sqrt(m sigma): larger initial energies overflow double precision), got {v0!r}"
+        )
+    x0 = check_finite("x0", x0)
+    F0 = check_finite("F0", F0)
+    if abs(F0) > Fc:
+        raise ValueError(f"F0 must lie in [-Fc, Fc] = [{-Fc!r}, {Fc!r}] N, got {F0!r}")
+    n = check_count("n", n, minimum=1, maximum=maximum, why="memory and run time")
+    if v0 == 0.0 and F0 == 0.0:
+        raise ValueError(
+            "v0 = 0 and F0 = 0: the oscillator is at rest at its equilibrium and nothing moves "
+            "(allowed: v0 != 0 or F0 != 0)"
+        )
+    if 0.5 * (v0 / sc.v) ** 2 + (F0 / Fc) ** 2 == 0.0:
+        raise ValueError(
+            f"v0 = {v0!r} m/s and F0 = {F0!r} N give an initial energy below the double-precision range "
+            f"(allowed: |v0| > {1e-150 * sc.v!r} m/s or |F0| > {1e-150 * Fc!r} N)"
+        )
+    return v0, x0, F0, n
 
 
 def _cumsum(values: np.ndarray) -> np.ndarray:

@@ -57,13 +57,15 @@ from typing import Any, Optional
 
 import numpy as np
 
-from prefriction._validation import check_count, check_finite
+from prefriction._validation import check_array_interval, check_count, check_interval, check_nonnegative
+from prefriction.analysis.exact import check_initial_state
 from prefriction.models import Oscillator
 from prefriction.models.maxwell_slip import MaxwellSlip
 from prefriction.reversals import ReversalTable
 from prefriction.units import Scales
 
 __all__ = [
+    "MAX_REVERSALS",
     "MaxwellSlipTrajectory",
     "first_reversal",
     "DissipationLimit",
@@ -74,16 +76,26 @@ __all__ = [
     "maxwell_slip_trajectory",
 ]
 
+MAX_REVERSALS = 1_000_000
+"""Most reversals of one exact Maxwell-slip reference (a Python loop over events: about a minute)."""
+
 _TANGENT = 4.0 * np.finfo(float).eps  # slip within this (relative) of the reversal: at the reversal
 
 
 def _check_system(system: Any, purpose: str) -> MaxwellSlip:
     if not isinstance(system, Oscillator) or not isinstance(system.friction, MaxwellSlip):
-        raise TypeError(f"{purpose} needs a prefriction.Oscillator with MaxwellSlip friction, got {system!r}")
+        raise TypeError(f"system must be a prefriction.Oscillator with MaxwellSlip friction ({purpose}), got "
+                        f"{system!r} of type {type(system).__name__}")
     if system.u is not None:
-        raise ValueError(f"{purpose} covers the unforced system only, got an oscillator with an input force u "
-                         "(allowed: system.u is None); use prefriction.simulate for forced motion")
+        raise ValueError(f"system must be unforced: {purpose} covers the unforced system only, got an oscillator "
+                         "with an input force u (allowed: system.u is None); use prefriction.simulate for forced motion")
     return system.friction
+
+
+def _check_model(model: Any) -> MaxwellSlip:
+    if not isinstance(model, MaxwellSlip):
+        raise TypeError(f"model must be a prefriction.MaxwellSlip model, got {model!r} of type {type(model).__name__}")
+    return model
 
 
 class _Sum:
@@ -266,17 +278,9 @@ def maxwell_slip_trajectory(system: Oscillator, v0: float, n: int, *, x0: float 
         As :func:`maxwell_slip_reversals`.
     """
     model = _check_system(system, "maxwell_slip_reversals")
-    v0 = check_finite("v0", v0)
-    x0 = check_finite("x0", x0)
-    F0 = check_finite("F0", F0)
-    n = check_count("n", n, minimum=1)
-    Fc = model.Fc
-    if abs(F0) > Fc:
-        raise ValueError(f"F0 must lie in [-Fc, Fc] = [{-Fc!r}, {Fc!r}] N, got {F0!r}")
-    if v0 == 0.0 and F0 == 0.0:
-        raise ValueError("v0 = 0 and F0 = 0: the oscillator rests at its equilibrium and nothing moves "
-                         "(allowed: v0 != 0 or F0 != 0)")
     sc = Scales.of(system)
+    v0, x0, F0, n = check_initial_state(system, sc, v0, x0, F0, n, maximum=MAX_REVERSALS)
+    Fc = model.Fc
     q = model.runtime_params()
     N = model.n_elements
     kappa, w = q[:N].tolist(), q[N:].tolist()
@@ -392,8 +396,8 @@ def masing_next(model: MaxwellSlip, a: Any) -> tuple[np.ndarray, np.ndarray]:
     (numpy.ndarray, numpy.ndarray)
         Next amplitudes ``a'`` and spans ``delta*`` (normalised displacement, units ``Fc / sigma``).
     """
-    v = model._virgin
-    a = np.atleast_1d(np.asarray(a, dtype=float))
+    v = _check_model(model)._virgin
+    a = np.atleast_1d(check_array_interval("a", a, 0.0, 1.0)).ravel()
     out_a, out_d = np.empty_like(a), np.empty_like(a)
     H = v.P - 0.5 * a[:, None] * v.y[None, :]  # Phi(y_j) - a y_j / 2 at every breakpoint
     for i, ai in enumerate(a):
@@ -422,7 +426,7 @@ def masing_amplitudes(model: MaxwellSlip, a1: float, n: int) -> np.ndarray:
     model : MaxwellSlip
         The friction model.
     a1 : float
-        Amplitude at the first reversal, ``0 < a1 <= 1``.
+        Amplitude at the first reversal, ``0 <= a1 <= 1``.
     n : int
         Number of amplitudes.
 
@@ -430,6 +434,9 @@ def masing_amplitudes(model: MaxwellSlip, a1: float, n: int) -> np.ndarray:
     -------
     numpy.ndarray
     """
+    _check_model(model)
+    a1 = check_interval("a1", a1, 0.0, 1.0)
+    n = check_count("n", n, minimum=1, maximum=MAX_REVERSALS, why="a Python loop: about a minute")
     out = np.empty(n)
     out[0] = a1
     for k in range(1, n):
@@ -453,7 +460,8 @@ def first_reversal(model: MaxwellSlip, E0: float) -> tuple[float, float]:
     (float, float)
         ``y1`` [``Fc / sigma``] and ``a1`` [``Fc``].
     """
-    v = model._virgin
+    v = _check_model(model)._virgin
+    E0 = check_nonnegative("E0", E0)
     j = int(np.searchsorted(v.P, E0, side="right") - 1)
     j = min(max(j, 0), v.n)
     dE = E0 - v.P[j]
@@ -508,7 +516,7 @@ def dissipation_limit(model: MaxwellSlip) -> DissipationLimit:
     -------
     DissipationLimit
     """
-    d = model.slip_deflections
+    d = _check_model(model).slip_deflections
     dmin = float(np.min(d))
     group = d <= dmin * (1.0 + 1e-12)
     kappa1 = float(np.sum(model.stiffness[group]) / model.sigma)

@@ -10,11 +10,13 @@ from __future__ import annotations
 
 import argparse
 import math
+import re
 
 import numpy as np
 
 from prefriction import dahl
-from prefriction.analysis.exact import exact_reversals
+from prefriction._validation import check_count
+from prefriction.analysis.exact import MAX_REVERSALS, exact_reversals
 from prefriction.models import Dahl, Oscillator
 from prefriction.reversals import ReversalTable
 
@@ -24,16 +26,21 @@ def _parser() -> argparse.ArgumentParser:
         prog="prefriction table",
         description="Exact reversal table of the unforced Dahl oscillator m x'' + F = 0 (paper (2.1), (3.2)).",
     )
-    p.add_argument("--sigma", type=float, default=1e4, help="rest stiffness sigma [N/m] (default 1e4)")
-    p.add_argument("--Fc", type=float, default=1.0, help="Coulomb force Fc [N] (default 1)")
-    p.add_argument("--mass", type=float, default=1.0, help="mass m [kg] (default 1)")
+    p.add_argument("--sigma", type=float, default=1e4, help="rest stiffness sigma [N/m] > 0 (default 1e4)")
+    p.add_argument("--Fc", type=float, default=1.0, help="Coulomb force Fc [N] > 0 (default 1)")
+    p.add_argument("--mass", type=float, default=1.0, help="mass m [kg] > 0 (default 1)")
     p.add_argument("--gamma", type=float, default=1.0, help="Dahl shape factor gamma >= 0 (default 1)")
     p.add_argument("--v0", type=float, default=0.01, help="initial velocity [m/s] (default 0.01)")
     p.add_argument("--F0", type=float, default=0.0, help="initial friction force [N], |F0| <= Fc (default 0)")
     p.add_argument("--x0", type=float, default=0.0, help="initial position [m] (default 0)")
-    p.add_argument("--n", type=int, default=20, help="number of reversals (default 20)")
-    p.add_argument("--rows", type=int, default=20, help="rows printed: first and last halves (default 20)")
+    p.add_argument("--n", type=int, default=20, help=f"number of reversals, 1 to {MAX_REVERSALS:_} (default 20)")
+    p.add_argument("--rows", type=int, default=20, help="rows printed, >= 1: first and last halves (default 20)")
     return p
+
+
+# the options behind the arguments of Dahl, Oscillator and exact_reversals, for their messages
+_OPTIONS = {"sigma": "--sigma", "Fc": "--Fc", "mass": "--mass", "gamma": "--gamma", "v0": "--v0", "F0": "--F0",
+            "x0": "--x0", "n": "--n", "rows": "--rows"}
 
 
 def report(system: Oscillator, table: ReversalTable, v0: float, F0: float, rows: int = 20) -> str:
@@ -99,13 +106,20 @@ def report(system: Oscillator, table: ReversalTable, v0: float, F0: float, rows:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Entry point of ``prefriction table``; returns the exit code (0 on success, 2 on bad input)."""
+    """Entry point of ``prefriction table``; returns the exit code (0 on success, 2 on bad input).
+
+    A value that is not a number exits through argparse (``SystemExit`` with code 2); a number
+    out of range prints a message naming the option, its value and the allowed range.
+    """
     args = _parser().parse_args(argv)
     try:
+        check_count("rows", args.rows, minimum=1)
         system = Oscillator(Dahl(args.sigma, args.Fc, args.gamma), mass=args.mass)
         table = exact_reversals(system, args.v0, args.n, x0=args.x0, F0=args.F0)
     except (TypeError, ValueError) as exc:
-        print(f"prefriction table: error: {exc}")
+        message = str(exc)
+        named = [opt for name, opt in _OPTIONS.items() if re.match(rf"{name}\b", message)]
+        print(f"prefriction table: error: {named[0] + ': ' if named else ''}{message}")
         return 2
     print(report(system, table, args.v0, args.F0, rows=args.rows))
     return 0
