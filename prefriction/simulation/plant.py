@@ -23,9 +23,10 @@ State vector (indices in :class:`Layout`), kept short because the cost of a step
     ``n`` reaches the parameter ``nstop``;
 ``m0 ...``
     the model's flags (e.g. Dahl's saturation for gamma < 1);
-``rest, Wh``
-    (forced systems only) rest flag (``v = 0`` and ``u = F``) and the input work since the last
-    reversal, ``W~ = AE Wh``;
+``rest, Wh, armed, tmiss``
+    (forced systems only) rest flag (``v = 0`` and ``u = F``), the input work since the last
+    reversal, ``W~ = AE Wh``, the flag of the least-speed event and ``1 + t~`` of a skipped
+    reversal pair (0 if none; see below);
 ``Eh``
     work of the friction force since t = 0, ``E_f~ = Efref + AE Eh`` (dense output only), (2.8);
 ``xch``
@@ -46,6 +47,14 @@ Events (the integrator fires when an indicator goes from positive to negative):
 - the model's in-branch events (Dahl with gamma < 1: saturation), with its transitions.
 - end of rest (forced only), indicator ``eps_rest - |a~|``: the mass moves again in direction
   ``sign(a~)``, a reversal if that differs from ``s``.
+- least speed (forced only, while ``armed``), indicator ``-s a~``: the speed ``s v`` has a
+  local minimum. If ``s v < 0`` there, the velocity changed sign twice inside one step (a
+  reversal pair that the reversal indicator, checked at the ends of the steps only, skipped):
+  ``tmiss = 1 + t~`` and the right-hand side stops; the loop integrates the call again up to that
+  time, so that a step ends where ``s v < 0`` and the first reversal is located
+  (:meth:`Run.advance`). The event clears ``armed``; the next greatest speed (indicator
+  ``s a~`` while not armed) and every reversal set it again, so neither event fires twice at the
+  same instant.
 
 ``eps`` and ``eps_rest`` are :data:`EPS_TOUCH` and :data:`EPS_REST` times the amplitude scale.
 
@@ -72,10 +81,10 @@ from prefriction.models.base import FrictionModel
 
 __all__ = ["EPS_TOUCH", "EPS_REST", "Layout", "PlantSpec", "build_integrator"]
 
-EPS_TOUCH = 10.0
+EPS_TOUCH = 1.0
 """Net force, in units of the call's velocity scale ``Av = eps A`` (the tolerance times the
 amplitude: the integrator's error level of the net force), below which a zero velocity is rest."""
-EPS_REST = 30.0
+EPS_REST = 3.0
 """Net force, in units of ``Av = eps A``, above which a resting mass moves again (a hysteresis
 above :data:`EPS_TOUCH`, so that a mass just put to rest does not leave at once)."""
 EPS_START = 1e-13
@@ -152,7 +161,7 @@ class Layout:
         names = ["xh", "vh"] + [f"z{i}" for i in range(self.nz)] + ["s", "n"]
         names += [f"m{i}" for i in range(self.nm)]
         if spec.forced:
-            names += ["rest", "Wh"]
+            names += ["rest", "Wh", "armed", "tmiss"]
         if spec.energy:
             names.append("Eh")
         self.state = {k: i for i, k in enumerate(names)}
@@ -268,6 +277,8 @@ def build_integrator(spec: PlantSpec) -> ca.Function:
             u = u + c["uhold"] / p["Fc"]
     acc = u - F
     run = ca.if_else(st["n"] < p["nstop"], 1.0, 0.0)  # stop after the nstop-th reversal
+    if spec.forced:  # at rest, or stopped after a skipped reversal pair
+        run = run * ca.if_else(st["tmiss"] > 0.5, 0.0, 1.0)
     run_m = run * (1.0 - rest) if spec.forced else run
     dz = model.rate(z, m, v, s, q)
     dot = {"xh": run_m * v / p["Ax"], "vh": run_m * acc / p["Av"]}
@@ -289,6 +300,10 @@ def build_integrator(spec: PlantSpec) -> ca.Function:
     zero += [ca.if_else(run_m > 0.5, ind, 1.0) for ind in model.events(z, m, v, s, q)]
     if spec.forced:  # rest thresholds at the error level of the net force: eps times the amplitude
         zero.append(ca.if_else(run * rest > 0.5, EPS_REST * p["Av"] - ca.fabs(acc), 1.0))
+        armed = st["armed"] > 0.5
+        sa_n = s * acc / p["Av"] * p["eps"]  # s a~ relative to the amplitude
+        zero.append(ca.if_else(ca.logic_and(run_m > 0.5, armed), -sa_n, 1.0))  # least speed
+        zero.append(ca.if_else(ca.logic_and(run_m > 0.5, ca.logic_not(armed)), sa_n, 1.0))  # greatest
     dae = {"x": X, "p": P, "u": U, "t": tau, "ode": ode, "zero": ca.vertcat(*zero)}
 
     # transition: the state just after an event
@@ -319,6 +334,7 @@ def build_integrator(spec: PlantSpec) -> ca.Function:
         ch.update(model_changes(zn, mn))
         if spec.forced:
             ch["Wh"] = 0.0
+            ch["armed"] = 1.0
         ch.update(extra)
         return with_(ch)
 
@@ -334,6 +350,8 @@ def build_integrator(spec: PlantSpec) -> ca.Function:
     if spec.forced:
         new_dir = ca.if_else(acc > 0, 1.0, -1.0)
         posts.append(ca.if_else(new_dir != s, reversal(new_dir, {"rest": 0.0}), with_({"rest": 0.0})))
+        posts.append(ca.if_else(s * st["vh"] < 0.0, with_({"tmiss": 1.0 + t_n, "armed": 0.0}), with_({"armed": 0.0})))
+        posts.append(with_({"armed": 1.0}))
     post = posts[-1]
     for k in range(len(posts) - 2, -1, -1):
         post = ca.if_else(idx == k, posts[k], post)

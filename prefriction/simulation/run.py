@@ -109,6 +109,7 @@ class Run:
         if "rest" in ix:
             X[ix["rest"]] = st["rest"]
             X[ix["Wh"]] = st["W"] / a["AE"]
+            X[ix["armed"]], X[ix["tmiss"]] = 1.0, 0.0
         if "Eh" in ix:
             X[ix["Eh"]] = 0.0
         if self.spec.fb == "continuous":
@@ -144,6 +145,8 @@ class Run:
             k = r0 + j * w
             regs.append((c[k], c[k + 1], c[k + 2], c[k + 3] if w == 4 else 0.0))
         out["new"] = regs
+        # a skipped reversal pair stopped the call at the least speed after it (1 + t~ there)
+        out["tmiss"] = c[ix["tmiss"]] - 1.0 if "tmiss" in ix and c[ix["tmiss"]] > 0.5 else None
         out["overflow"] = new > self.spec.K
         out["t"] = regs[-1][0] if out["frozen"] and regs else None
         return out
@@ -213,6 +216,10 @@ class Run:
         xf = call.out.reshape(n_out, L.nx).T
         if not math.isfinite(float(call.out.sum())):
             raise self._failure("the integrator returned non-finite values")
+        tm = L.state.get("tmiss")
+        if n_out > 1 and tm is not None and xf[tm, -1] > 0.5:  # advance integrates such calls again
+            raise self._failure(f"a reversal pair inside one step (least speed at t = {(xf[tm, -1] - 1.0) * self.sc.t:.9g} s) "
+                                f"between two dense sample times; give sample times closer together")
         return xf, a
 
     def _trigger(self, call: BufferedIntegrator) -> None:
@@ -281,8 +288,23 @@ class Run:
             n0 = len(self.rev)
             xf, a = self._call(self.f1, self.L, [t1], nstop)
             out = self._unpack(self.L, xf[:, 0], a, n0, nstop)
+            if out["tmiss"] is not None:  # a reversal pair inside one step: integrate again up to
+                # the least speed after it, where s v < 0 at the end of the last step
+                t1 = self._retry_to(out["tmiss"])
+                xf, a = self._call(self.f1, self.L, [t1], nstop)
+                out = self._unpack(self.L, xf[:, 0], a, n0, nstop)
+                if out["tmiss"] is not None:
+                    raise self._failure(f"a reversal pair inside one step at t = {out['tmiss'] * self.sc.t:.9g} s "
+                                        f"was not resolved by a second pass")
             self._accept(out, t1)
             grow = 1.0 if out["frozen"] or len(self.rev) > n0 else 2.0 * grow
+
+    def _retry_to(self, t_miss: float) -> float:
+        """End of the second pass over a call that skipped a reversal pair: ``t_miss`` (the least
+        speed after the pair, normalised), or, if that is the call's start, ``SolverError``."""
+        if not t_miss > self.st["t"]:
+            raise self._failure("a reversal pair inside the first step of a call could not be located")
+        return t_miss
 
     def _next_break(self, t: float) -> float:
         """Next sample time of a sampled input or reference after normalised time ``t``."""
