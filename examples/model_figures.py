@@ -58,7 +58,7 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
     outdir : str or Path
         Output directory (created if needed).
     quick : bool, default False
-        Fewer reversals (for tests).
+        Fewer reversals and samples, figures at 50 dpi instead of 130 (for tests).
 
     Returns
     -------
@@ -71,6 +71,7 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
     sc = pf.Scales.of(sys_["Dahl"])  # the same units for all four
     colors = dict(zip(sys_, (COLORS[0], COLORS[2], COLORS[1], COLORS[3])))
     n_rev = {"Dahl": 40 if quick else 300, "Maxwell-slip": 12, "GMS": 12, "LuGre": 12}
+    dpi = 50 if quick else 130
     print("model_figures: simulating 4 models", file=sys.stderr)
 
     # ------------------------------------------------------------------ loops
@@ -89,7 +90,7 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
     axes[0, 0].set_ylabel("friction force $F$ [N]")
     add_note(fig, f"m = {MASS:g} kg, sigma = 1e5 N/m, Fc = 1 N for all; released from rest at x = 0, F0 = {F0:g} N; "
                   "first 8 reversals.")
-    png_loops = save(fig, outdir, "model_loops.png")
+    png_loops = save(fig, outdir, "model_loops.png", dpi=dpi)
 
     # ------------------------------------------------------------------ decay over reversals and time
     tables = {name: pf.simulate(s, 0.0, F0=F0, reversals=n_rev[name], rtol=1e-10).reversals for name, s in sys_.items()}
@@ -113,7 +114,7 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
         ax.legend(loc="lower left", fontsize=8)
     add_note(fig, "Dahl decays algebraically; Maxwell-slip and GMS stop dissipating once no element slips "
                   "(undamped); LuGre's bristle damping (damping ratio 0.5 here) decays geometrically.")
-    png = save(fig, outdir, "model_decay.png")
+    png = save(fig, outdir, "model_decay.png", dpi=dpi)
 
     # ------------------------------------------------------------------ LuGre energy split
     lugre = sys_["LuGre"]
@@ -148,7 +149,7 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
     add_note(fig, f"E_0 = {rep.E_0 * 1e6:.4g} uJ; viscous {rep.total_viscous / rep.E_0:.1%}, hysteretic "
                   f"{rep.total_hysteretic / rep.E_0:.1%} of E_0; balance residual {rep.residual:.1e} (Simpson on "
                   f"{res.t.size} samples).")
-    png_energy = save(fig, outdir, "model_lugre_energy.png")
+    png_energy = save(fig, outdir, "model_lugre_energy.png", dpi=dpi)
     return {"tables": tables, "loops": loops, "lugre": rep, "png": png, "pngs": [png_loops, png, png_energy]}
 
 
