@@ -323,3 +323,16 @@ def test_example_writes_its_figures(ex, tmp_path):
     out = ex.main(tmp_path, quick=True)
     assert len(out["pngs"]) == 5 and all(p.stat().st_size > 20_000 for p in out["pngs"])
     assert out["bench"] is None
+
+
+def test_initial_bristle_force_up_to_fs():
+    """``simulate`` accepts a LuGre bristle force ``Fc < |F0| <= Fs`` (max_hysteretic_force) and
+    refuses one above ``Fs``; released from rest at ``F0 = 1.4 N`` against the reference."""
+    system = pf.Oscillator(pf.LuGre(**PAPER), 1.0)
+    assert system.friction.max_hysteretic_force == FS and pf.Dahl(1e4, 2.0).max_hysteretic_force == 2.0
+    res = pf.simulate(system, 0.0, F0=1.4, reversals=4, rtol=RTOL)
+    _, _, revs = radau(lambda t, y: 0.0, 0.1, [0.0], y0=(0.0, 0.0, 1.4 / S0), scale=(2e-5, 3e-3))
+    np.testing.assert_allclose(res.reversals.t, revs[:4, 0], rtol=10 * RTOL)
+    np.testing.assert_allclose(res.reversals.x, revs[:4, 1], rtol=0, atol=10 * RTOL * 1.4 / S0)
+    with pytest.raises(ValueError, match=r"F0 must lie in \[-1.5, 1.5\] N \(the model's max_hysteretic_force, LuGre\), got 1.6"):
+        pf.simulate(system, 0.0, F0=1.6, reversals=2)

@@ -34,7 +34,7 @@ def test_unknown_keyword_raises_type_error() -> None:
         ({"reversals": 3, "rtol": 0.0}, ValueError, "rtol must be finite and > 0"),
         ({"reversals": 3, "atol": 1.0}, ValueError, "atol must lie in"),
         ({"reversals": 3, "method": "cvodes"}, ValueError, "method must be one of"),
-        ({"reversals": 3, "F0": 1.5}, ValueError, r"F0 must lie in \[-Fc, Fc\]"),
+        ({"reversals": 3, "F0": 1.5}, ValueError, r"F0 must lie in \[-1.0, 1.0\] N \(the model.s max_hysteretic_force, Dahl\), got 1.5"),
         ({"reversals": 3, "F0": 1.0}, ValueError, "reaches only asymptotically"),
         ({"reversals": 3, "x0": float("nan")}, ValueError, "x0 must be finite"),
         ({"reversals": 3, "feedback": "pid"}, TypeError, "feedback must be"),
@@ -53,6 +53,10 @@ def test_invalid_system_and_v0() -> None:
         pf.simulate(pf.Dahl(1.0, 1.0), 1.0, reversals=2)  # type: ignore[arg-type]
     with pytest.raises(TypeError, match="v0 must be a real number"):
         pf.simulate(SYS, "fast", reversals=2)  # type: ignore[arg-type]
+    # a denormal v0 (reversal times were 12 % wrong) or one whose scaled states leave the double range
+    for v0 in (5e-324, 1e-300, -1e-200):
+        with pytest.raises(ValueError, match=rf"v0 = {v0!r} m/s .* must be 0 or >= 1e-150, that is \|v0\| >= 1e-152 m/s"):
+            pf.simulate(SYS, v0, reversals=2)
 
 
 def test_forced_needs_t_end_and_rest_needs_t_end() -> None:

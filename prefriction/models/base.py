@@ -108,6 +108,12 @@ class FrictionModel(ABC):
     """Reference force [N] of the normalised units (the Coulomb force for Dahl)."""
 
     @property
+    def max_hysteretic_force(self) -> float:
+        """Largest friction force [N] of the model's state at rest: ``simulate`` accepts an initial
+        force ``|F0|`` up to it. Default ``Fc`` (Dahl: the Coulomb force)."""
+        return self.Fc
+
+    @property
     def k_min(self) -> float:
         """Least tangent stiffness on an unloading branch [N/m], for the bound (2.12)."""
         return self.sigma

@@ -123,6 +123,12 @@ class LuGre(FrictionModel):
     def n_states(self) -> int:
         return 1
 
+    @property
+    def max_hysteretic_force(self) -> float:  # type: ignore[override]
+        """The static force ``Fs`` [N]: the bristle force ``sigma0 z`` stays within
+        ``[-g(v), g(v)]`` for a bristle state that starts there, and ``g(v) <= Fs``."""
+        return self.Fs
+
     def structure_key(self) -> Hashable:
         return ("LuGre", "one bristle state")
 

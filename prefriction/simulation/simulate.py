@@ -57,6 +57,9 @@ METHODS = ("erk",)
 _K = 2  # reversals recorded per integrator call (register length; forced or dense runs)
 _MIN_ORDER = 2  # continuous controllers are padded to this order (one plant for P, PD, PID)
 _ZERO = Constant(0.0)  # the input of a sampled loop without an input force (the hold is added)
+MIN_AMPLITUDE = 1e-150
+"""Least nonzero amplitude of the motion (normalised units) that :func:`simulate` accepts: the
+energies, ``A^2``, and the scaled states stay normal doubles."""
 _CAL = 0.1  # calibration of the run-time tolerance eps: global error over 50 reversals ~ 0.7 rtol
 
 
@@ -87,9 +90,11 @@ def simulate(
         (compiled once per function).
     v0 : float
         Initial velocity [m/s]. If ``v0 = 0`` the motion starts in direction ``-sign(F0)``
-        (unforced) or ``sign(u(0) - F0)`` (forced); with no net force the mass rests.
+        (unforced) or ``sign(u(0) - F0)`` (forced); with no net force the mass rests. A motion
+        smaller than :data:`MIN_AMPLITUDE` normalised units (e.g. a denormal ``v0``) is refused.
     x0, F0 : float, default 0.0
-        Initial position [m] and friction force [N], ``|F0| <= Fc``.
+        Initial position [m] and friction force [N], ``|F0| <= max_hysteretic_force`` of the
+        model (Dahl: ``Fc``; LuGre: ``Fs``).
     reversals : int, optional
         Stop at this many reversals (>= 1).
     t_end : float, optional
@@ -138,8 +143,10 @@ def simulate(
     x0 = check_finite("x0", x0)
     F0 = check_finite("F0", F0)
     Fc = system.friction.Fc
-    if abs(F0) > Fc:
-        raise ValueError(f"F0 must lie in [-Fc, Fc] = [{-Fc!r}, {Fc!r}], got {F0!r}")
+    F_max = system.friction.max_hysteretic_force
+    if abs(F0) > F_max:
+        raise ValueError(f"F0 must lie in [-{F_max!r}, {F_max!r}] N (the model's max_hysteretic_force, "
+                         f"{type(system.friction).__name__}), got {F0!r}")
     if reversals is None and t_end is None:
         raise ValueError("give reversals (number of reversals) or t_end (end time [s]) or both; got neither")
     n_target = math.inf if reversals is None else check_count("reversals", reversals, 1)
@@ -188,6 +195,7 @@ def simulate(
     run.snap = rtol
     run.P0 = run._constant_params(run.L)
     run.force_scale = applied_force_scale(system, feedback, x0, t_end_si) / Fc if forced else 0.0
+    _check_amplitude(v0, F0, run.force_scale, sc)
 
     xc0 = np.array(feedback.xc0, dtype=float) if feedback is not None else np.zeros(0)
     run.st, s0 = _initial_state(run, x0, v0, F0, xc0, stops=forced or t_end is not None)
@@ -219,6 +227,21 @@ def simulate(
     stats = RunStats(wall_time=wall, setup_time=run.setup_time, calls=run.calls, steps=run.steps, jit=run.mode)
     extra = _samples_si(run, samples, u_hist, times_si, n_user) if samples else {}
     return SimulationResult(reversals=table, status=status, message=message, stats=stats, work_input=W_r, **extra)
+
+
+def _check_amplitude(v0: float, F0: float, force_scale: float, sc: Scales) -> None:
+    """``ValueError`` if the motion is nonzero but smaller than :data:`MIN_AMPLITUDE` (normalised
+    initial velocity ``v0`` [m/s], force ``F0`` [N] and applied force scale): its scaled states, energies and steps
+    would leave the double-precision range (a denormal ``v0 = 5e-324`` m/s gave reversal times
+    12 % wrong, ``1e-300`` m/s a failed integrator)."""
+    amplitude = max(math.hypot(v0 / sc.v, F0 / sc.F), force_scale)
+    if 0.0 < amplitude < MIN_AMPLITUDE:
+        raise ValueError(
+            f"v0 = {v0!r} m/s and F0 = {F0!r} N (with the applied force) give a motion of "
+            f"{amplitude:.3g} normalised units, too small to simulate in double precision: the amplitude "
+            f"hypot(v0 / (Fc/sqrt(m sigma)), F0 / Fc) must be 0 or >= {MIN_AMPLITUDE:g}, that is "
+            f"|v0| >= {MIN_AMPLITUDE * sc.v:.3g} m/s or |F0| >= {MIN_AMPLITUDE * sc.F:.3g} N"
+        )
 
 
 def _dense_times(dense: Any, t_end: float) -> np.ndarray:
