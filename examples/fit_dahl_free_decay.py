@@ -9,7 +9,7 @@ the reversals located in the data, with IPOPT; the figure shows the data, the fi
 residuals and the located reversals against the exact ones. With the mass free as well, the
 fit warns that a free decay cannot tell ``m``, ``sigma`` and ``Fc`` apart.
 
-Run: ``python examples/fit_dahl_free_decay.py [outdir]``.
+Run: ``python examples/fit_dahl_free_decay.py [outdir] [--quick]``.
 """
 
 from __future__ import annotations
@@ -82,4 +82,5 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
 
 
 if __name__ == "__main__":
-    main(sys.argv[1] if len(sys.argv) > 1 else ".")
+    args = [a for a in sys.argv[1:] if a != "--quick"]
+    main(args[0] if args else ".", quick="--quick" in sys.argv[1:])

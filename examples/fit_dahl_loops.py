@@ -6,7 +6,7 @@ fit, residuals); then the same fit over ``seeds`` noise draws counts how often e
 interval holds the true value. A second figure panel shows pre-sliding loops, from which ``Fc``
 cannot be identified (``IdentifiabilityWarning``).
 
-Run: ``python examples/fit_dahl_loops.py [outdir]``.
+Run: ``python examples/fit_dahl_loops.py [outdir] [--quick]``.
 """
 
 from __future__ import annotations
@@ -84,4 +84,5 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
 
 
 if __name__ == "__main__":
-    main(sys.argv[1] if len(sys.argv) > 1 else ".")
+    args = [a for a in sys.argv[1:] if a != "--quick"]
+    main(args[0] if args else ".", quick="--quick" in sys.argv[1:])
