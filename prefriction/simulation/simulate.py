@@ -39,7 +39,7 @@ import numpy as np
 
 from prefriction.signals import Constant, compiled_form
 from prefriction.simulation.feedback import LinearFeedback
-from prefriction.simulation.dense import dense_loop
+from prefriction.simulation.dense import SampleBuffer, dense_loop, samples_si
 from prefriction.simulation.run import N_DENSE, Run
 from prefriction.simulation.plant import Layout, PlantSpec
 from prefriction.simulation.force_scale import applied_force_scale
@@ -225,7 +225,7 @@ def simulate(
 
     table, W_r = _reversal_table(run.rev[: int(min(len(run.rev), n_target))], system, s0, v0, F0)
     stats = RunStats(wall_time=wall, setup_time=run.setup_time, calls=run.calls, steps=run.steps, jit=run.mode)
-    extra = _samples_si(run, samples, u_hist, times_si, n_user) if samples else {}
+    extra = samples_si(run, samples, u_hist, times_si, n_user) if len(samples) else {}
     return SimulationResult(reversals=table, status=status, message=message, stats=stats, work_input=W_r, **extra)
 
 
@@ -283,12 +283,12 @@ def _initial_state(run: Run, x0: float, v0: float, F0: float, xc0: np.ndarray, *
     return st, s0
 
 
-def _sampled_loop(run: Run, xc0: np.ndarray, t_end: float, n_target: float) -> tuple[list, list]:
+def _sampled_loop(run: Run, xc0: np.ndarray, t_end: float, n_target: float) -> tuple[SampleBuffer, list]:
     """Closed loop with a sampled controller: hold its output over each period ``Ts`` up to the
     normalised time ``t_end`` or ``n_target`` reversals; returns the samples at ``k Ts`` and the
     total applied force there [N]."""
     system, feedback, sc = run.system, run.fb, run.sc
-    samples: list = []
+    samples = SampleBuffer(len(xc0))
     u_hist: list = []
     Ts = feedback.Ts / sc.t
     xc = xc0.copy()
@@ -345,32 +345,3 @@ def _padded(fb: LinearFeedback, order: int) -> LinearFeedback:
     C[:, :n] = fb.C
     xc0 = np.concatenate([fb.xc0, np.zeros(order - n)])
     return LinearFeedback(A=A, B=B, C=C, D=fb.D, Ts=fb.Ts, reference=fb.reference, xc0=xc0)
-
-
-def _samples_si(run: Run, samples: list, u_hist: list, times_si: Optional[np.ndarray], n_user: int) -> dict:
-    """The samples ``(t~, x~, v~, F~, E_f~, xc)`` of ``run`` as the SI fields of :class:`SimulationResult`;
-    ``times_si`` are the requested sample times [s] (None: every ``DENSE_STEP``)."""
-    system, feedback, sc = run.system, run.fb, run.sc
-    S = list(zip(*samples))
-    ts = np.array(S[0]) * sc.t
-    if run.spec.energy and times_si is not None:
-        ts = times_si[: len(ts)].copy()  # the requested times exactly (no unit round trip)
-    extra = {
-        "t": ts, "x": np.array(S[1]) * sc.x, "v": np.array(S[2]) * sc.v, "F": np.array(S[3]) * sc.F,
-    }
-    extra["E_k"] = 0.5 * system.mass * extra["v"] ** 2
-    if run.spec.energy:
-        extra["E_f"] = np.array(S[4]) * sc.E
-    if system.forced or feedback is not None:
-        if feedback is not None and feedback.sampled:
-            extra["u"] = np.array(u_hist)
-        else:
-            uu = np.asarray(system.u(ts), dtype=float) if system.forced else np.zeros_like(ts)
-            if feedback is not None:
-                xcs = np.array(S[5]).reshape(len(ts), -1)
-                e = np.asarray(feedback.reference(ts), dtype=float) - extra["x"]
-                uu = uu + (xcs @ feedback.C[0] if run.spec.n_c else 0.0) + feedback.D[0, 0] * e
-            extra["u"] = uu
-    if feedback is not None:
-        extra["xc"] = np.array(S[5]).reshape(len(ts), -1)[:, :n_user]
-    return extra
