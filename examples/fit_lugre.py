@@ -69,7 +69,7 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
 
     res = identify.fit(START, data(0))
     print(res.report())
-    seeds = 2 if quick else 20
+    seeds = 1 if quick else 20
     inside = np.zeros(truth.size, dtype=int)
     for seed in range(seeds):
         r = identify.fit(START, data(100 + seed))

@@ -87,6 +87,10 @@ def test_fit_maxwell_slip_example(tmp_path):
     assert res.statistics.sigma_hat == pytest.approx(ex.NOISE, rel=0.15)
     # elements 2 and 3 with one slip deflection: only their sums are determined
     assert set(r["tied"].unidentifiable) == {"stiffness[2]", "stiffness[3]", "slip_force[2]", "slip_force[3]"}
+    # one sub-step per sample is the stop operator itself: noise-free data give the truth to round-off
+    t, x = r["t"], r["x"]
+    exact = identify.fit(ex.START, identify.ForceDisplacement(t, x, maxwell_slip_force(ex.TRUE, x)))
+    np.testing.assert_allclose(exact.estimates, np.concatenate([ex.TRUE.stiffness, ex.TRUE.slip_force]), rtol=1e-7)
 
 
 def test_lugre_reference_matches_the_closed_form_at_constant_velocity():

@@ -62,11 +62,16 @@ class _Series:
 
 
 def substeps_for(model: FrictionModel, data: ForceDisplacement, requested: int | None) -> int:
-    """RK4 sub-steps per sample interval: ``requested``, or enough that one sub-step moves at
-    most 0.25 (a quarter of the force unit ``Fc / sigma``) at the start values, times a margin
-    of 4 for the fit to move, between 1 and 64."""
+    """RK4 sub-steps per sample interval: ``requested``; 1 for Maxwell-slip, whose element rates
+    are constant up to the slip event that ``on_event`` applies exactly (one step is the stop
+    operator); otherwise enough that one sub-step moves at most 0.25 (a quarter of the force unit
+    ``Fc / sigma``) at the start values, times a margin of 4 for the fit to move, between 1 and 64."""
+    from prefriction.models.maxwell_slip import MaxwellSlip
+
     if requested is not None:
         return requested
+    if isinstance(model, MaxwellSlip):
+        return 1
     step = float(np.max(np.abs(np.diff(data.x)))) * model.sigma / model.Fc
     return int(min(64, max(2, math.ceil(4.0 * step / 0.25))))
 
