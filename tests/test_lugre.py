@@ -336,3 +336,21 @@ def test_initial_bristle_force_up_to_fs():
     np.testing.assert_allclose(res.reversals.x, revs[:4, 1], rtol=0, atol=10 * RTOL * 1.4 / S0)
     with pytest.raises(ValueError, match=r"F0 must lie in \[-1.5, 1.5\] N \(the model's max_hysteretic_force, LuGre\), got 1.6"):
         pf.simulate(system, 0.0, F0=1.6, reversals=2)
+
+
+def test_first_dense_sample_is_the_force_at_the_initial_velocity():
+    """A rate-dependent model's friction force at t = 0 includes the damping of the initial
+    velocity: ``F(0) = F0 + sigma1 z'(0) + sigma2 v0`` with ``z'(0) = v0 (1 - |v0| F0 / (v0 g(v0)))``
+    (the paper's (1)-(3)), not the bristle force ``F0`` alone; the samples after it follow the
+    reference."""
+    system = pf.Oscillator(pf.LuGre(**PAPER), 1.0, u=0.2)  # the forced dense plant of the experiments
+    v0, F0 = 5e-3, 0.3
+    times = np.linspace(0.0, 2e-3, 21)
+    res = pf.simulate(system, v0, F0=F0, t_end=2e-3, dense=times, rtol=RTOL)
+    g = FC + (FS - FC) * math.exp(-((v0 / VS) ** 2))
+    F_0 = F0 + S1 * (v0 - abs(v0) * F0 / g) + S2 * v0
+    assert F_0 > 1.4  # the damping term dominates: far from F0
+    assert res.F[0] == pytest.approx(F_0, rel=1e-12)
+    Y, F, _ = radau(lambda t, y: 0.2, 2e-3, times, y0=(0.0, v0, F0 / S0), scale=(1e-5, 5e-3))
+    e = errors(res.x, res.v, res.F, Y, F)
+    assert max(e) <= 10 * RTOL, e

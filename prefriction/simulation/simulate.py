@@ -278,7 +278,10 @@ def _initial_state(run: Run, x0: float, v0: float, F0: float, xc0: np.ndarray, *
         if not stops:
             raise ValueError("v0 = 0 and F0 = 0 without input: the mass rests, no reversal will come; give t_end")
     z, m = model.initial_state(F0 / Fc, s0)
-    st = {"x": x0 / sc.x, "v": v0 / sc.v, "F": F0 / sc.F, "z": list(z), "m": list(m),
+    # the friction force at t = 0: for a rate-dependent model (LuGre: sigma1 z' + sigma2 v) it
+    # differs from the state's force F0 when v0 != 0
+    F = float(model.force(list(z), list(m), v0 / sc.v, s0, run.q))
+    st = {"x": x0 / sc.x, "v": v0 / sc.v, "F": F, "z": list(z), "m": list(m),
           "t": 0.0, "s": s0, "rest": rest, "W": 0.0, "Ef": 0.0, "xc": xc0, "uhold": 0.0}
     return st, s0
 
