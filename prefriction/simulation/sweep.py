@@ -27,8 +27,10 @@ from typing import Any, Hashable, Iterable, Optional, Sequence, Sized, Union
 
 import numpy as np
 
+from prefriction._validation import check_bool, check_choice, check_count, check_finite, check_positive
 from prefriction.models import Oscillator
-from prefriction.simulation.simulate import simulate
+from prefriction.simulation.feedback import LinearFeedback
+from prefriction.simulation.simulate import METHODS, simulate
 
 __all__ = ["MAX_SYSTEMS", "SweepResult", "sweep"]
 
@@ -158,10 +160,14 @@ def sweep(
     TypeError
         Before any run: for a keyword that :func:`prefriction.simulate` does not take, an entry
         of ``systems`` that is not an :class:`prefriction.Oscillator` (the message names
-        ``systems[i]``), a non-real ``v0`` or an ``executor`` without ``submit``.
+        ``systems[i]``), a non-real ``v0``, an ``executor`` without ``submit``, or a keyword of
+        the wrong type (``reversals``, ``t_end``, ``rtol``, ``atol``, ``x0``, ``F0``,
+        ``method``, ``jit``, ``feedback``).
     ValueError
-        Before any run: for no systems, more than :data:`MAX_SYSTEMS`, or a ``v0`` sequence whose
-        length differs from the number of systems or that holds a non-finite value.
+        Before any run: for no systems, more than :data:`MAX_SYSTEMS`, a ``v0`` sequence whose
+        length differs from the number of systems or that holds a non-finite value, or one of
+        those keywords out of its range (``reversals >= 1``; ``t_end``, ``rtol``, ``atol`` > 0;
+        ``x0``, ``F0`` finite; ``method`` in :data:`prefriction.simulation.simulate.METHODS`).
 
     Warns
     -----
@@ -172,9 +178,11 @@ def sweep(
     Notes
     -----
     Runs are deterministic: the same system and settings give bitwise the same result serially
-    or on any executor. Arguments that are invalid for :func:`prefriction.simulate` (a negative
-    ``reversals``, a forced system without ``t_end``, ...) are not checked up front: those runs
-    fail and their exceptions sit in their places.
+    or on any executor. Keywords that are invalid whatever the system (a negative ``reversals``,
+    ``method="euler"``, ...) raise before any run; what depends on the system (``|F0| > Fc``, a
+    forced system without ``t_end``, ``rtol`` beyond the simulator's range, ...) is checked by
+    :func:`prefriction.simulate` in each run: those runs fail and their exceptions sit in their
+    places.
 
     A structure group is what decides the generated code: the friction model's class and
     ``structure_key()``, the input's ``key`` (or type), whether samples are requested
@@ -209,8 +217,9 @@ def sweep(
     start = time.perf_counter()
     kwargs = _check_kwargs(simulate_kwargs)
     executor = _check_executor(executor)
-    if progress is not None and not isinstance(progress, bool):
-        raise TypeError(f"progress must be None, True or False, got {progress!r} of type {type(progress).__name__}")
+    if progress is not None and not isinstance(progress, (bool, np.bool_)):
+        raise TypeError(f"progress must be None, True or False, got {_short_repr(progress)} of type "
+                        f"{type(progress).__name__}")
     systems = _check_systems(systems)
     v0s = _check_v0(v0, len(systems))
 
@@ -377,7 +386,28 @@ def _check_kwargs(kwargs: dict) -> dict:
             f"prefriction.simulate, which takes {', '.join(allowed)} (systems and v0 are given "
             f"to sweep directly; sweep's own are executor and progress)"
         )
+    _check_shared(kwargs)
     return dict(kwargs)
+
+
+def _check_shared(kwargs: dict) -> None:
+    """Check the keywords whose validity does not depend on the system (types and basic ranges, as
+    :func:`prefriction.simulate` documents them), so that a bad one fails once, before any run."""
+    optional = {"reversals": lambda n, v: check_count(n, v, 1), "t_end": check_positive, "atol": check_positive}
+    for name, check in optional.items():
+        if kwargs.get(name) is not None:
+            check(name, kwargs[name])
+    for name in ("x0", "F0"):
+        if name in kwargs:
+            check_finite(name, kwargs[name])
+    if "rtol" in kwargs:
+        check_positive("rtol", kwargs["rtol"])
+    if "method" in kwargs:
+        check_choice("method", kwargs["method"], METHODS)
+    if "jit" in kwargs:
+        check_bool("jit", kwargs["jit"])
+    if kwargs.get("feedback") is not None and not isinstance(kwargs["feedback"], LinearFeedback):
+        raise TypeError(f"feedback must be a prefriction LinearFeedback or None, got {_short_repr(kwargs['feedback'])}")
 
 
 def _check_executor(executor: Any) -> Optional[cf.Executor]:
