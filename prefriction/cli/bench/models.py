@@ -11,25 +11,27 @@ rtol 1e-12 with restarts.
 
 Targets, printed as PASS/FAIL: every model within 10x rtol over the ladder; at the loosest
 tolerance where ``simulate`` reaches error <= 1e-7, at least 10x faster than the fastest scipy
-method that reaches the same error in the same run.
+method that reaches the same error in the same run (``docs/bench.md#models``).
 """
 
 from __future__ import annotations
 
+import csv
 import math
-import sys
 import time
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Callable, Optional
 
 import numpy as np
 
+from prefriction.cli.bench.timing import min_time, progress
 from prefriction.models import FrictionModel, MaxwellSlip, Oscillator
 from prefriction.simulation.simulate import simulate
 from prefriction.testing import reference_reversals
 from prefriction.units import Scales
 
-__all__ = ["LADDER", "ModelCase", "ModelRow", "model_cases", "run"]
+__all__ = ["LADDER", "ModelCase", "ModelRow", "main", "model_cases", "run", "table", "targets"]
 
 LADDER = (1e-4, 1e-6, 1e-8, 1e-10)
 PEERS = ("Radau", "BDF", "LSODA", "DOP853")
@@ -100,23 +102,12 @@ def _error(rows: np.ndarray, ref: np.ndarray) -> float:
     return float(max(et.max(), ex.max(), eF.max()))
 
 
-def _timed(fn: Callable[[], np.ndarray], budget: float) -> tuple[np.ndarray, float]:
-    """Result and minimum wall time over repeated calls within ``budget`` seconds (>= 1 call)."""
-    best, spent, out = math.inf, 0.0, None
-    while out is None or (spent < budget and best < 0.05):
-        t0 = time.perf_counter()
-        out = fn()
-        dt = time.perf_counter() - t0
-        best, spent = min(best, dt), spent + dt
-    return out, best
-
-
 def run(cases: list[ModelCase], ladder: tuple[float, ...] = LADDER, peers: tuple[str, ...] = PEERS,
         budget: float = 0.3) -> list[ModelRow]:
     """Measure every case: simulate and the scipy peers over ``ladder``; progress on stderr."""
     rows: list[ModelRow] = []
     for k, case in enumerate(cases, 1):
-        print(f"  ... models [{k}/{len(cases)}]: {case.name}", file=sys.stderr, flush=True)
+        progress(f"models [{k}/{len(cases)}]: {case.name}")
         system = Oscillator(case.model, mass=1.0)
         sc = Scales.of(system)
         if case.exact is not None:
@@ -130,7 +121,7 @@ def run(cases: list[ModelCase], ladder: tuple[float, ...] = LADDER, peers: tuple
                 tab = simulate(system, case.v0 * sc.v, reversals=case.n, rtol=tol).reversals
                 return np.column_stack([tab.t / sc.t, tab.x / sc.x, tab.F / sc.F])
 
-            got, sec = _timed(sim, budget)
+            got, sec = min_time(sim, most=math.inf, fill=budget, stop_best=0.05)
             rows.append(ModelRow(case.name, "simulate[erk]", tol, _error(got, ref), sec))
         for method in peers:
             for tol in ladder:
@@ -138,11 +129,11 @@ def run(cases: list[ModelCase], ladder: tuple[float, ...] = LADDER, peers: tuple
                     return reference_reversals(case.model, case.v0, case.n, rtol=tol, method=method)[0]
 
                 try:
-                    got, sec = _timed(peer, 0.0)
+                    got, sec = min_time(peer)
                     err = _error(got, ref)
                 except (RuntimeError, ValueError) as exc:  # a peer that fails is reported, not fatal
-                    print(f"  ... {method} at {tol:g} failed: {exc}", file=sys.stderr)
-                    got, sec, err = None, math.nan, math.inf
+                    progress(f"{method} at {tol:g} failed: {exc}")
+                    sec, err = math.nan, math.inf
                 rows.append(ModelRow(case.name, f"scipy {method} +events", tol, err, sec))
                 if sec > 5.0:  # tighter tolerances would only take longer
                     break
@@ -185,3 +176,36 @@ def targets(rows: list[ModelRow]) -> list[str]:
                      f"at tol {best.tol:g}, err {best.error:.1e}; {peer.solver} {peer.seconds * 1e3:.1f} ms at "
                      f"tol {peer.tol:g}, err {peer.error:.1e})")
     return lines
+
+
+def main(out: Path, quick: bool) -> int:
+    """``prefriction bench --models``: print the table and the target lines, write ``models.csv``.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        Output directory, created if missing.
+    quick : bool
+        The first case only, two tolerances, DOP853 only, a 0.05 s timing budget.
+
+    Returns
+    -------
+    int
+        0 if every target passes, else 1.
+    """
+    start = time.perf_counter()
+    cases = model_cases()
+    rows = run(cases[:1] if quick else cases, ladder=LADDER[:2] if quick else LADDER,
+               peers=("DOP853",) if quick else PEERS, budget=0.05 if quick else 0.3)
+    print("Friction models: error over the first reversals against the reference, warm run time\n")
+    print(table(rows))
+    lines = targets(rows)
+    print()
+    print("\n".join(lines))
+    out.mkdir(parents=True, exist_ok=True)
+    with (out / "models.csv").open("w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["case", "solver", "tol", "max_rel_error", "warm_run_s"])
+        w.writerows([r.case, r.solver, r.tol, r.error, r.seconds] for r in rows)
+    print(f"\nwrote {out / 'models.csv'} ({time.perf_counter() - start:.0f} s)")
+    return 0 if all("PASS" in line for line in lines) else 1

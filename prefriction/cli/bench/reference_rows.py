@@ -1,4 +1,4 @@
-"""Stability rows of ``prefriction bench`` checked against independent references.
+"""Rows of ``prefriction bench`` checked against independent references (``docs/bench.md#reference-rows``).
 
 Each row runs :func:`prefriction.simulate` over the tolerances 1e-6 ... 1e-10 on a Dahl
 oscillator with ``sigma = 1e4`` N/m, ``Fc = 1`` N, ``m = 1`` kg (small-oscillation frequency
@@ -7,7 +7,7 @@ within 10x rtol. The references are independent of the simulator:
 
 - scipy ``solve_ivp(method="DOP853")`` at ``rtol = 1e-13`` (``atol = 1e-15``) in normalised units
   (``docs/mathematics.md#normalised-units``), restarted at every reversal and every saturation
-  (:func:`prefriction.cli.bench_sweep.scipy_reversals`);
+  (:func:`prefriction.cli.bench.restarts.scipy_reversals`);
 - for gamma = 0 below saturation (the Prandtl stop stays elastic, ``docs/mathematics.md#prandtl-stop``)
   the conservation of energy: every reversal has ``F^2 / (2 sigma) = m v0^2 / 2``.
 
@@ -22,20 +22,20 @@ reversal forces relative to the largest reversal force).
 from __future__ import annotations
 
 import math
-import sys
 import warnings
 from dataclasses import dataclass
 from typing import Optional
 
 import numpy as np
 
-from prefriction.cli.bench_sweep import scipy_reversals
+from prefriction.cli.bench.restarts import scipy_reversals
+from prefriction.cli.bench.timing import progress
 from prefriction.models import Dahl, Oscillator
 from prefriction.signals import Sine
 from prefriction.simulation.simulate import simulate
 from prefriction.units import Scales
 
-__all__ = ["LADDER", "QUICK_LADDER", "RowCase", "RowResult", "format_rows", "row_cases", "measure"]
+__all__ = ["LADDER", "QUICK_LADDER", "RowCase", "RowResult", "format_rows", "measure", "row_cases", "run"]
 
 SIGMA, FC, MASS = 1e4, 1.0, 1.0  # N/m, N, kg
 W0 = math.sqrt(SIGMA / MASS)  # small-oscillation angular frequency [rad/s]
@@ -178,7 +178,7 @@ def run(quick: bool = False) -> list[RowResult]:
     cases = row_cases(quick)
     out = []
     for k, case in enumerate(cases, 1):
-        print(f"  ... stability rows [{k}/{len(cases)}]: {case.name}", file=sys.stderr, flush=True)
+        progress(f"stability rows [{k}/{len(cases)}]: {case.name}")
         out.append(measure(case, QUICK_LADDER if quick else LADDER))
     return out
 
