@@ -7,8 +7,11 @@
 - :class:`FrictionDescribingFunction`, :class:`PlantDescribingFunction`: the same as
   python-control ``DescribingFunctionNonlinearity`` objects (with ``at(omega)`` for
   rate-dependent blocks);
-- :func:`friction_loop`, :func:`predict_limit_cycle`, :func:`measure_limit_cycle`: predicted
-  against simulated limit cycles.
+- :func:`velocity_loop`, :class:`VelocityDescribingFunction`: friction as a nonlinearity of the
+  velocity, ``G(s) = s / (m s^2 + C(s))``;
+- :func:`friction_loop`, :func:`predict_limit_cycle` (with Loeb's stability test),
+  :func:`measure_limit_cycle`, :func:`trace_unstable_cycle`: predicted against simulated limit
+  cycles.
 
 See ``docs/describing.md``.
 """
@@ -23,6 +26,8 @@ from prefriction.describing.limit_cycle import (
     predict_limit_cycle,
 )
 from prefriction.describing.nonlinearity import FrictionDescribingFunction, PlantDescribingFunction
+from prefriction.describing.trace import TracedCycle, trace_unstable_cycle
+from prefriction.describing.velocity import VelocityDescribingFunction, velocity_loop
 
 __all__ = [
     "DahlDescribingFunction",
@@ -30,6 +35,8 @@ __all__ = [
     "LimitCycle",
     "MeasuredCycle",
     "PlantDescribingFunction",
+    "TracedCycle",
+    "VelocityDescribingFunction",
     "dahl_cycle",
     "dahl_describing_function",
     "friction_describing_function",
@@ -37,4 +44,6 @@ __all__ = [
     "measure_limit_cycle",
     "plant_describing_function",
     "predict_limit_cycle",
+    "trace_unstable_cycle",
+    "velocity_loop",
 ]

@@ -19,6 +19,7 @@ import numpy as np
 from scipy.optimize import root
 
 from prefriction._validation import check_count, check_interval, check_positive
+from prefriction.describing.velocity import controller_tf
 from prefriction.models import Oscillator, check_oscillator
 
 __all__ = ["LimitCycle", "MeasuredCycle", "friction_loop", "measure_limit_cycle", "predict_limit_cycle"]
@@ -39,12 +40,18 @@ class LimitCycle:
         Describing function there.
     iterations : int
         Frequency iterations with python-control before the final solve.
+    stable : bool
+        Loeb's criterion (quasi-static amplitude dynamics): with ``D = 1/H(i omega) + N(A, omega)
+        = R + i X``, the cycle attracts nearby amplitudes if ``R_A X_omega - X_A R_omega > 0``
+        (partial derivatives by central differences). An unstable cycle separates motions that
+        decay from motions that grow (``docs/describing.md#stability``).
     """
 
     amplitude: float
     omega: float
     N: complex
     iterations: int
+    stable: bool
 
     @property
     def period(self) -> float:
@@ -56,12 +63,14 @@ class LimitCycle:
         return abs(self.N) * self.amplitude
 
     def summary(self) -> str:
-        """One line: amplitude, frequency, period, output amplitude."""
-        return (f"predicted limit cycle: input amplitude {self.amplitude:.6g}, omega {self.omega:.6g} rad/s, "
+        """One line: stability, amplitude, frequency, period, output amplitude."""
+        kind = "stable" if self.stable else "unstable"
+        return (f"predicted {kind} limit cycle: input amplitude {self.amplitude:.6g}, omega {self.omega:.6g} rad/s, "
                 f"period {self.period:.6g} s, output amplitude {self.output_amplitude():.6g}")
 
     def __repr__(self) -> str:
-        return f"LimitCycle(amplitude={self.amplitude:.6g}, omega={self.omega:.6g}, period={self.period:.6g})"
+        return (f"LimitCycle(amplitude={self.amplitude:.6g}, omega={self.omega:.6g}, period={self.period:.6g}, "
+                f"stable={self.stable})")
 
 
 @dataclass(frozen=True)
@@ -114,9 +123,7 @@ def friction_loop(system: Oscillator, controller: Any) -> control.TransferFuncti
         ``H`` [m/N].
     """
     check_oscillator(system, "friction_loop")
-    C = controller.tf() if hasattr(controller, "tf") and not isinstance(controller, control.LTI) else control.tf(controller)
-    if not C.isctime():
-        raise ValueError(f"controller must be continuous-time, got dt = {C.dt!r}")
+    C = controller_tf(controller)
     num, den = np.asarray(C.num[0][0], float), np.asarray(C.den[0][0], float)
     m = np.polymul([system.mass, 0.0, 0.0], den)
     return control.tf(den, np.polyadd(m, num), inputs="F", outputs="x", name="H")
@@ -194,10 +201,13 @@ def predict_limit_cycle(H: Any, block: Any, amplitudes: Any, *, omega: Optional[
 
 
 def _solve(H: Any, N: Any, a: float, w: float, its: int, rtol: float) -> LimitCycle:
-    """``1 + H(i w) N(a, w) = 0`` in ``(ln a, ln w)`` from python-control's estimate."""
-    def eq(p: np.ndarray) -> list:
+    """``1 + H(i w) N(a, w) = 0`` in ``(ln a, ln w)`` from python-control's estimate, and Loeb's test."""
+    def D(p: np.ndarray) -> complex:  # 1/H + N: zero on the cycle, analytic in the frequency
         amp, om = math.exp(p[0]), math.exp(p[1])
-        r = 1.0 + complex(H(1j * om)) * N(amp, om)
+        return 1.0 / complex(H(1j * om)) + N(amp, om)
+
+    def eq(p: np.ndarray) -> list:
+        r = D(p) * complex(H(1j * math.exp(p[1])))
         return [r.real, r.imag]
 
     sol = root(eq, [math.log(a), math.log(w)], method="hybr", options={"xtol": rtol})
@@ -206,8 +216,12 @@ def _solve(H: Any, N: Any, a: float, w: float, its: int, rtol: float) -> LimitCy
             f"predict_limit_cycle: 1 + H N = 0 not solved from A = {a!r}, omega = {w!r} rad/s ({sol.message}; "
             f"residual {sol.fun!r}); try other amplitudes or a finer omega_grid"
         )
+    h = 1e-4  # central differences in ln A and ln omega (the criterion's sign is scale-free)
+    dA = (D(sol.x + [h, 0.0]) - D(sol.x - [h, 0.0])) / (2.0 * h)
+    dw = (D(sol.x + [0.0, h]) - D(sol.x - [0.0, h])) / (2.0 * h)
     amp, om = math.exp(sol.x[0]), math.exp(sol.x[1])
-    return LimitCycle(amplitude=amp, omega=om, N=complex(N(amp, om)), iterations=its)
+    return LimitCycle(amplitude=amp, omega=om, N=complex(N(amp, om)), iterations=its,
+                      stable=bool(dA.real * dw.imag - dA.imag * dw.real > 0.0))
 
 
 def measure_limit_cycle(t: Any, y: Any, *, t_start: float) -> MeasuredCycle:
