@@ -110,3 +110,33 @@ def test_no_reversal_pair_missed_under_a_sine() -> None:
     for rtol in (1e-6, 1e-8):
         got = normalised(pf.simulate(system, 0.0, t_end=2.5133, rtol=rtol))
         assert error(got, ref) <= 10 * rtol
+
+
+def test_gamma_0_below_saturation_conserves_energy() -> None:
+    """gamma = 0 below saturation is the linear oscillator ``x~'' = -F~``, ``F~' = v~``: from
+    ``x = F = 0`` the reversals are at ``t~ = (k - 1/2) pi`` with ``x~ = F~ = +-v0~`` (energy
+    conserved). 500 reversals within 10 rtol at rtol 1e-6 (integrated, the energy drifted by
+    17 rtol over 500 reversals and 340 rtol over 1e4); with ``t_end`` inside a half-cycle the
+    reversals before it."""
+    system = pf.Oscillator(pf.Dahl(SIGMA, 1.0, 0.0), MASS)
+    v0 = 0.5  # normalised: 0.005 m/s
+    k = np.arange(1, 501)
+    exact = np.column_stack([(k - 0.5) * math.pi, v0 * (-1.0) ** (k + 1), v0 * (-1.0) ** (k + 1)])
+    for rtol in (1e-6, 1e-10):
+        got = normalised(pf.simulate(system, v0 / 100.0, reversals=500, rtol=rtol))
+        assert error(got, exact) <= 10 * rtol
+        assert np.max(np.abs(got[:, 2] ** 2 / v0 ** 2 - 1.0)) <= rtol
+    got = normalised(pf.simulate(system, v0 / 100.0, t_end=(20.3 * math.pi) / 100.0, rtol=1e-6))
+    assert error(got, exact[:20]) <= 1e-5
+
+
+def test_gamma_0_saturating_and_from_a_force() -> None:
+    """gamma = 0 with a saturating first excursion (``v0~ = 2``), and released from ``F0 = 0.7 Fc``
+    at rest: 200 reversals against the closed forms of ``exact_reversals`` within rtol."""
+    system = pf.Oscillator(pf.Dahl(SIGMA, 1.0, 0.0), MASS)
+    for v0, F0 in ((0.02, 0.0), (0.0, 0.7)):
+        ex = pf.exact_reversals(system, v0, 200, F0=F0)
+        exact = np.column_stack([ex.t * 100.0, ex.x * SIGMA, ex.F])
+        for rtol in (1e-6, 1e-10):
+            got = normalised(pf.simulate(system, v0, F0=F0, reversals=200, rtol=rtol))
+            assert error(got, exact) <= rtol

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, ClassVar, Hashable, Sequence
+from typing import TYPE_CHECKING, Any, ClassVar, Hashable, Optional, Sequence
 
 import numpy as np
 
@@ -185,6 +185,27 @@ class FrictionModel(ABC):
         ``snap`` is the relative tolerance of the run: an event whose indicator is within
         ``snap`` of zero at the reversal may be taken as coinciding with it.
         """
+
+    def free_branch(self, z: Sequence[float], m: Sequence[float], v: float, s: float, q: Any,
+                    horizon: float) -> Optional[tuple[float, float, list[float], list[float], float]]:
+        """Closed-form unforced motion on the current branch, if the model has one (floats).
+
+        The normalised oscillator ``x~'' = -F~`` (unit mass, no input) from the state
+        ``(z, m)``, velocity ``v`` and direction ``s``, followed for at most ``horizon`` time
+        units and no further than the next reversal. The unforced simulation (compact model)
+        takes this instead of integrating: a motion without truncation error, e.g. a linear
+        branch, whose integration error would otherwise accumulate over the cycles.
+
+        Returns
+        -------
+        tuple or None
+            ``(dt, v1, z1, m1, dx)``: the time taken (``dt < horizon``: a reversal at ``dt``,
+            ``v1 = 0``, the state before :meth:`reverse`), the velocity, the state and the
+            displacement at its end. ``None`` (the default) if there is no closed form for this
+            state: the simulator integrates. A branch with an event (:meth:`events`) before
+            its end must return ``None``.
+        """
+        return None
 
     def travel(self, z0: Sequence[float], z1: Sequence[float], s: float, q: Any) -> float:
         """Normalised displacement between states ``z0`` and ``z1`` of one branch (if

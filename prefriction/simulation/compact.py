@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
+from prefriction.models.base import FrictionModel
 from prefriction.simulation.integrator import INTEGRATOR_FAILED
 
 if TYPE_CHECKING:
@@ -44,7 +45,22 @@ def advance_compact(self: "Run", t_target: float, n_target: float) -> bool:
     calls = 0
     t_stop = t_target * (1 - 1e-15) if t_target < math.inf else math.inf
     n = len(rev)
+    # a model with closed-form branches (free_branch: e.g. Dahl gamma = 0 below saturation)
+    free = model.free_branch if type(model).free_branch is not FrictionModel.free_branch else None
     while n < n_target and t < t_stop:
+        exact = free(z, m, v, s, q, t_target - t) if free is not None else None
+        if exact is not None:  # no integration: the branch in closed form
+            dt, v, z, m, dx = exact
+            x += dx
+            if dt < t_target - t:  # a reversal
+                t += dt
+                n += 1
+                s = -s
+                z, m = reverse(z, m, s, q, snap)
+                rev.append((t, x, float(force(z, m, 0.0, s, q)), 0.0))
+            else:
+                t = t_target
+            continue
         F = float(force(z, m, v, s, q))
         if n >= 2:  # the next half-cycle about as long as the last one, with a margin
             chunk = 2.0 * (rev[-1][0] - rev[-2][0]) * grow
