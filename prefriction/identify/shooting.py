@@ -10,10 +10,7 @@ normalised units (``docs/models.md#protocol``) by RK4 sub-steps between the samp
 reversal to the first sample, possibly backwards by a fraction of a sample: near a reversal
 the velocity is small and the branch direction matters only at fourth order in the time
 offset). Continuity at every reversal: position, zero velocity, and the state after
-``reverse``. The objective is the sum of squared position residuals; IPOPT gets the
-Gauss-Newton Hessian ``J^T J`` of the residuals instead of the exact Hessian of the Lagrangian
-(constrained Gauss-Newton: the curvature of the continuity constraints is dropped), which
-halves the build and, on the Dahl free decay, the iterations.
+``reverse``. The objective is the sum of squared position residuals.
 
 The nonlinear program depends on the model structure, the free parameters, the number of
 samples and the segment layout; the data, start values and fixed values are its parameters,
@@ -114,15 +111,10 @@ class _ShootingProblem:
         g = ca.vertcat(*cons) if cons else ca.SX(0, 1)
         self.n_w, self.n_g, self.n_theta, self.nz = w.shape[0], g.shape[0], nf, nz
         nlp = {"x": w, "p": p, "f": 0.5 * ca.sumsqr(r / P["xs"]), "g": g}
-        J = ca.jacobian(r, w)
-        # Gauss-Newton Hessian of the Lagrangian (objective only; lam_g unused by design)
-        lam_f, lam_g = ca.SX.sym("lam_f"), ca.SX.sym("lam_g", g.shape[0])
-        Js = J / P["xs"]
-        hess = ca.Function("hess_lag", [w, p, lam_f, lam_g], [ca.triu(lam_f * ca.mtimes(Js.T, Js))])
         opts = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes", "ipopt.max_iter": max_iter,
-                "ipopt.tol": tol, "hess_lag": hess}
+                "ipopt.tol": tol}
         self.solver = ca.nlpsol("motion_fit", "ipopt", nlp, opts)
-        self.parts = ca.Function("parts", [w, p], [r, J, g, ca.jacobian(g, w),
+        self.parts = ca.Function("parts", [w, p], [r, ca.jacobian(r, w), g, ca.jacobian(g, w),
                                                    ca.vertcat(*pred), sigma, Fc, T])
         self.param_names = list(P)
 
