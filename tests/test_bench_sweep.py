@@ -13,8 +13,8 @@ import pytest
 
 import prefriction as pf
 from prefriction.cli.bench import main as bench_main
-from prefriction.cli.bench_sweep import (SweepRow, format_table, main, matched_rtol, reversal_error, run_child,
-                                         scipy_reversals, sweep_cases, targets, worker, write_csv, _exact_tables)
+from prefriction.cli.bench.sweep import (SweepRow, exact_tables, format_table, main, matched_rtol, reversal_error,
+                                         run_child, scipy_reversals, sweep_cases, targets, worker, write_csv)
 from prefriction.simulation.compiled import cache_dir
 
 SPEC = {"case": "gamma_ge1", "n": 2, "reference": None}
@@ -38,7 +38,7 @@ def test_warm_child_process_compiles_nothing(monkeypatch) -> None:
 
 def test_matched_scipy_rtol_reaches_the_target() -> None:
     case = sweep_cases(2)[0]
-    refs = _exact_tables(case)
+    refs = exact_tables(case)
     rtol, matched, tried = matched_rtol(case, refs, 1e-8)
     assert matched and tried[-1] == (rtol, tried[-1][1]) and tried[-1][1] <= 1e-8
     assert all(err > 1e-8 for _, err in tried[:-1])  # the loosest rtol that matches

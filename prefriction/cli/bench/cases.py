@@ -86,7 +86,8 @@ def table_error(t: np.ndarray, x: np.ndarray, F: np.ndarray, ref_t: np.ndarray, 
     Returns
     -------
     float
-        The largest relative error, or ``inf`` if the numbers of reversals differ.
+        The largest relative error; ``inf`` if the numbers of reversals differ or a value is not
+        finite.
     """
     t, x, F = (np.asarray(a, dtype=float) for a in (t, x, F))
     ref_t, ref_x, ref_F = (np.asarray(a, dtype=float) for a in (ref_t, ref_x, ref_F))
@@ -95,7 +96,7 @@ def table_error(t: np.ndarray, x: np.ndarray, F: np.ndarray, ref_t: np.ndarray, 
     et = np.abs(t - ref_t) / np.abs(ref_t)
     ex = np.abs(x - ref_x) / np.maximum(np.abs(ref_x), x_scale)
     eF = np.abs(F - ref_F) / np.abs(ref_F)
-    err = float(max(et.max(), ex.max(), eF.max()))
+    err = float(np.max([et.max(), ex.max(), eF.max()]))  # np.max: a NaN stays NaN (max() would drop it)
     return err if math.isfinite(err) else math.inf
 
 

@@ -92,14 +92,16 @@ def model_cases() -> list[ModelCase]:
 
 
 def _error(rows: np.ndarray, ref: np.ndarray) -> float:
-    """Max relative error of reversal times, positions (relative to max(|x|, 1)) and forces."""
+    """Max relative error of reversal times, positions (relative to max(|x|, 1)) and forces (inf if
+    reversals are missing or a value is not finite)."""
     if len(rows) < len(ref):
         return math.inf
     rows = rows[: len(ref)]
     et = np.abs(rows[:, 0] - ref[:, 0]) / np.abs(ref[:, 0])
     ex = np.abs(rows[:, 1] - ref[:, 1]) / np.maximum(np.abs(ref[:, 1]), 1.0)
     eF = np.abs(rows[:, 2] - ref[:, 2]) / np.maximum(np.abs(ref[:, 2]), 1e-300)
-    return float(max(et.max(), ex.max(), eF.max()))
+    err = float(np.max([et.max(), ex.max(), eF.max()]))  # np.max: a NaN stays NaN (max() would drop it)
+    return err if math.isfinite(err) else math.inf
 
 
 def run(cases: list[ModelCase], ladder: tuple[float, ...] = LADDER, peers: tuple[str, ...] = PEERS,
