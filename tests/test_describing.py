@@ -16,6 +16,7 @@ import prefriction as pf
 from prefriction.describing import (
     DahlDescribingFunction,
     FrictionDescribingFunction,
+    VelocityDescribingFunction,
     dahl_cycle,
     dahl_describing_function,
     friction_describing_function,
@@ -23,6 +24,8 @@ from prefriction.describing import (
     measure_limit_cycle,
     plant_describing_function,
     predict_limit_cycle,
+    trace_unstable_cycle,
+    velocity_loop,
 )
 
 SIGMA, FC = 1e4, 2.0
@@ -128,6 +131,14 @@ def test_dahl_under_pid_no_intersection_and_the_loop_converges():
     assert np.all(np.diff(e) <= 1e-15) and e[-1] < 0.9 * e[0] and e[-1] < 1e-3 * 0.01
 
 
+def _harmonic(t, y, a, b):
+    """First-harmonic phasor (relative to sin) of samples ``y`` over one period ``[a, b]``."""
+    sel = (t >= a) & (t <= b)
+    w = 2.0 * math.pi / (b - a)
+    ts, ys = t[sel], y[sel]
+    return 2.0 / (b - a) * complex(np.trapezoid(ys * np.sin(w * ts), ts), np.trapezoid(ys * np.cos(w * ts), ts))
+
+
 def test_lugre_under_pid_hunts_and_the_friction_df_misses_it():
     lugre = pf.Oscillator(pf.LuGre(1e5, 1e5 ** 0.5, 0.4, 1.0, 1.5, 1e-3), mass=1.0)
     with warnings.catch_warnings():
@@ -141,12 +152,87 @@ def test_lugre_under_pid_hunts_and_the_friction_df_misses_it():
     H = friction_loop(lugre, PID)
     Hw = np.array([complex(H(1j * w)) for w in np.logspace(-2, 4, 400)])
     assert not np.any((Hw.real < 0) & (Hw.imag > 0))
-    assert predict_limit_cycle(H, FrictionDescribingFunction(lugre, 2.0 * math.pi / cyc.period, method="LSODA"),
-                               [1e-3, 4e-3], iterations=1) is None
-    # the plant block jumps at breakaway: stuck just below, sliding just above the force amplitude
     w = 2.0 * math.pi / cyc.period
+    assert predict_limit_cycle(H, FrictionDescribingFunction(lugre, w, method="LSODA"), [1e-3, 4e-3],
+                               iterations=1) is None
+    # why: the harmonics of the simulated cycle obey the linear part exactly, F1 / V1 = -1/G(i w),
+    # whose equivalent stiffness k = -w Im(F1/V1) = m w^2 - kp is negative (sticking); the friction
+    # under a sinusoidal velocity has k > 0 and damping Re N_v >= sigma2
+    up = np.nonzero((res.x[:-1] < cyc.mean) & (res.x[1:] >= cyc.mean) & (res.t[1:] > 6.0))[0]
+    a, b = res.t[up[-2]], res.t[up[-1]]  # the last full period
+    Neff = _harmonic(res.t, res.F, a, b) / _harmonic(res.t, res.v, a, b)
+    G = velocity_loop(lugre, PID)
+    we = 2.0 * math.pi / (b - a)
+    assert abs(Neff + 1.0 / complex(G(1j * we))) < 2e-2 * abs(Neff)
+    assert -we * Neff.imag < -50.0  # m w^2 - kp = -98 N/m
+    for Av in (1e-3, 1e-2):
+        Nv = VelocityDescribingFunction(lugre, w, method="LSODA").describing_function(Av)
+        assert Nv.real >= 0.4 and -w * Nv.imag > 0.0
+    # the plant block jumps at breakaway: stuck just below, sliding just above the force amplitude
     below = plant_describing_function(lugre, 1.47, w)
     above = plant_describing_function(lugre, 1.49, w)
     assert abs(below) < 1e-4 and abs(above) > 1e-2
     u = measure_limit_cycle(res.t, res.u, t_start=6.0)
     assert 1.47 * 0.97 < u.half_range < 1.49  # the loop's force peaks at the breakaway amplitude (3 %)
+
+
+class _CoulombViscous(control.DescribingFunctionNonlinearity):
+    """``F = Fc sign(v) + c v`` as a nonlinearity of the velocity: ``N(A) = c + 4 Fc / (pi A)``."""
+
+    def __init__(self, Fc, c):
+        super().__init__()
+        self.Fc, self.c = Fc, c
+
+    def __call__(self, v):
+        return self.Fc * np.sign(v) + self.c * v
+
+    def describing_function(self, A):
+        return self.c + 4.0 * self.Fc / (math.pi * A)
+
+
+class _Relay(control.DescribingFunctionNonlinearity):
+    def __call__(self, x):
+        return np.sign(x)
+
+    def describing_function(self, A):
+        return 4.0 / (math.pi * A)
+
+
+def test_predicted_cycles_and_their_stability_against_closed_forms():
+    # relay around K / (s (s + 1)^2): omega = 1, |H| = K / 2, A = 4 / (pi N) = 2 K / pi; stable (textbook)
+    K = 4.0
+    cyc = predict_limit_cycle(control.tf([K], [1.0, 2.0, 1.0, 0.0]), _Relay(), np.logspace(-1, 2, 31))
+    assert abs(cyc.omega - 1.0) < 1e-8 and abs(cyc.amplitude - 2.0 * K / math.pi) < 1e-8 and cyc.stable
+    # Coulomb + viscous damper in a PID loop (no derivative filter), G = s^2 / (m s^3 + kd s^2 + kp s + ki):
+    # Im G = 0 at omega^2 = kp / m, balance at N = c* = m ki / kp - kd, so A = 4 Fc / (pi (c* - c));
+    # more damping stabilises this loop and N falls with A: the cycle is unstable
+    m, kp, ki, kd, Fc, c = 1.0, 100.0, 300.0, 1.0, 1.0, 0.4
+    G = velocity_loop(pf.Oscillator(pf.Dahl(1e5, Fc), mass=m), control.tf([kd, kp, ki], [1.0, 0.0]))
+    cyc = predict_limit_cycle(G, _CoulombViscous(Fc, c), np.logspace(-2, 1, 31))
+    cstar = m * ki / kp - kd
+    assert abs(cyc.omega - math.sqrt(kp / m)) < 1e-7 * cyc.omega
+    assert abs(cyc.amplitude - 4.0 * Fc / (math.pi * (cstar - c))) < 1e-7 * cyc.amplitude
+    assert not cyc.stable and "unstable" in cyc.summary()
+
+
+PID_UNSTABLE = controllers.PID(kp=100.0, ki=300.0, kd=1.0)  # ki > kd kp / m: the linear loop is unstable
+
+
+def test_lugre_unstable_pid_loop_predicted_cycle_against_simulation():
+    """docs/describing.md#unstable-loop: LuGre's velocity DF at the harmonic balance against bisection."""
+    lugre = pf.Oscillator(pf.LuGre(1e5, 1e5 ** 0.5, 0.4, 1.0, 1.5, 1e-3), mass=1.0)
+    G = velocity_loop(lugre, PID_UNSTABLE)
+    block = VelocityDescribingFunction(lugre, 10.0, method="LSODA", rtol=1e-7, tol=1e-5)
+    cyc = predict_limit_cycle(G, block, [0.3, 1.0, 3.0], omega=10.0, iterations=2)
+    assert not cyc.stable
+    # far above vs = 1 mm/s LuGre slides like Coulomb + viscous (the closed form above, within 1 %)
+    ref = 4.0 / (math.pi * (3.0 - 1.0 - 0.4))
+    assert abs(cyc.amplitude / ref - 1.0) < 1e-2 and abs(cyc.omega / 10.0 - 1.0) < 1e-2
+    # simulated: runs from the predicted sinusoid scaled by 0.95 decay, by 1.05 grow; bisection between
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        tr = trace_unstable_cycle(lugre, PID_UNSTABLE, cyc, bracket=(0.95, 1.05), steps=6, periods=12)
+    assert tr.periods >= 2
+    e_amp, e_T = tr.errors()
+    assert abs(e_amp) < 0.05 and abs(e_T) < 0.02  # measured: +1.4 % and -0.34 % (30 steps)
+    assert "unstable cycle" in tr.summary() and "TracedCycle" in repr(tr)
