@@ -126,19 +126,9 @@ def reversal_error(t: np.ndarray, x: np.ndarray, F: np.ndarray, ref_t: np.ndarra
                    ref_F: np.ndarray, x_scale: float = FC / SIGMA) -> float:
     """:func:`prefriction.cli.bench.cases.table_error` with the sweeps' least position scale.
 
-    Parameters
-    ----------
-    t, x, F : numpy.ndarray
-        Reversal times [s], positions [m] and forces [N] to check.
-    ref_t, ref_x, ref_F : numpy.ndarray
-        The reference reversals, same units.
-    x_scale : float, optional
-        Least position scale [m], default ``Fc / sigma = 1e-4`` m.
-
-    Returns
-    -------
-    float
-        The largest relative error, or ``inf`` if the numbers of reversals differ.
+    The arguments are those of ``table_error`` (reversals [s, m, N] and the reference); only
+    ``x_scale`` has a default, ``Fc / sigma = 1e-4`` m. Returns the largest relative error, or
+    ``inf`` if the numbers of reversals differ or a value is not finite.
     """
     return table_error(t, x, F, ref_t, ref_x, ref_F, x_scale)
 
