@@ -98,18 +98,36 @@ def test_loop_residual_error_and_settling_time_against_central_differences():
     pid = controllers.PID(kp=100.0, ki=300.0, kd=5.0)
     res = sensitivities(system, controller=pid, reference=0.01, t_end=1.0, parameters=("ki", "Fs"))
     assert res.settling_time is not None and 0.0 < res.settling_time < 1.0
+
+    def measures(p, name):
+        """Residual error and settling time by prefriction.simulate (rtol 1e-12); the crossing
+        |x - x(1)| = 0.02 |x(1)| by the secant method on simulated points."""
+        c = dataclasses.replace(pid, ki=p) if name == "ki" else pid
+        s = pf.Oscillator(dataclasses.replace(lugre, Fs=p), 1.0) if name == "Fs" else system
+        C = c.ss()
+        fb = pf.LinearFeedback(A=C.A, B=C.B, C=C.C, D=C.D, reference=0.01)
+
+        def x(t):
+            return pf.simulate(s, 0.0, t_end=t, rtol=1e-12, dense=np.array([0.0, t]), feedback=fb).x[-1]
+
+        xf = x(1.0)
+        f = lambda t: abs(x(t) - xf) - 0.02 * abs(xf)  # noqa: E731
+        t0, t1 = res.settling_time - 1e-4, res.settling_time + 1e-4
+        f0, f1 = f(t0), f(t1)
+        for _ in range(12):
+            t0, t1, f0 = t1, t1 - f1 * (t1 - t0) / (f1 - f0), f1
+            f1 = f(t1)
+            if abs(t1 - t0) < 1e-13:
+                break
+        return 0.01 - xf, t1
+
     for j, name in enumerate(("ki", "Fs")):
         b = res.values[j]
         h = 1e-5 * b
-
-        def err(p, name=name):
-            c = dataclasses.replace(pid, ki=p) if name == "ki" else pid
-            s = pf.Oscillator(dataclasses.replace(lugre, Fs=p), 1.0) if name == "Fs" else system
-            C = c.ss()
-            fb = pf.LinearFeedback(A=C.A, B=C.B, C=C.C, D=C.D, reference=0.01)
-            return 0.01 - pf.simulate(s, 0.0, t_end=1.0, rtol=1e-12, dense=np.array([0.0, 1.0]), feedback=fb).x[-1]
-        cd = (err(b + h) - err(b - h)) / (2 * h)
-        assert abs(cd - res.d_residual_error[j]) < 1e-4 * abs(cd)
+        (e_hi, ts_hi), (e_lo, ts_lo) = measures(b + h, name), measures(b - h, name)
+        cd_e, cd_ts = (e_hi - e_lo) / (2 * h), (ts_hi - ts_lo) / (2 * h)
+        assert abs(cd_e - res.d_residual_error[j]) < 2e-5 * abs(cd_e)  # measured 3e-7 (ki), 1e-8 (Fs)
+        assert abs(cd_ts - res.d_settling_time[j]) < 2e-5 * abs(cd_ts)  # measured 1e-6 (ki), 3e-8 (Fs)
 
 
 def test_bad_arguments():

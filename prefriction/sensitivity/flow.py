@@ -57,6 +57,7 @@ class Flow:
         y0, p = ca.MX.sym("y0", ny), ca.MX.sym("p", self.nP + 2)
         yf = phi(x0=y0, p=p)["xf"]
         self.step = ca.Function("step", [y0, p], [yf, ca.jacobian(yf, y0), ca.jacobian(yf, p)])
+        self.end = ca.Function("end", [y0, p], [yf])  # without sensitivities: Newton iterations
         self.rhs = ca.Function("rhs", [y, P, s], [f])
         zs, q, sn = ca.SX.sym("z", self.nz), P[3:3 + self.nq], ca.SX.sym("s")
         zr, _ = model.reverse([zs[i] for i in range(self.nz)], [], sn, [q[i] for i in range(self.nq)], 1e-300)
@@ -138,8 +139,7 @@ def parameter_jacobian(flow: Flow, system: Oscillator, pid: Any, v0: float, name
 def _newton(flow: Flow, y: np.ndarray, Pn: np.ndarray, T: float, s: float, where: str) -> float:
     """Duration ``T`` of the branch until ``v = 0`` (Newton from the simulator's guess)."""
     for it in range(12):
-        yf, _, _ = flow.step(y, np.r_[Pn, T, s])
-        yf = np.asarray(yf).ravel()
+        yf = np.asarray(flow.end(y, np.r_[Pn, T, s])).ravel()
         acc = float(flow.rhs(yf, Pn, s)[1])
         if acc == 0.0:
             break
@@ -213,7 +213,7 @@ def settling(out: dict, t_guess: float, band: float) -> tuple[float, np.ndarray]
     y, S, s, t0, dt0 = out["starts"][k]
     T = t_guess / sc.t - t0
     for it in range(12):
-        yT = np.asarray(flow.step(y, np.r_[Pn, T, s])[0]).ravel()
+        yT = np.asarray(flow.end(y, np.r_[Pn, T, s])).ravel()
         side = math.copysign(1.0, yT[0] - xf)
         c = side * (yT[0] - xf) - band * abs(xf)
         dT = -c / (side * yT[1])
