@@ -10,6 +10,12 @@ at reversal ``i`` is ``(Fc^2/sigma) H(-a)`` with ``H(f) = -f - ln(1 - f)``, and 
 stores the same energy on the loading side, ``H(a') = H(-a)`` (energy balance (2.3), (2.9)).
 :func:`next_amplitude` solves it to about 1e-15 relative for every ``a`` in (0, 1];
 :func:`next_amplitude_paper` is the paper's explicit approximation (3.11)-(3.13).
+
+Every function checks its arguments first: ``TypeError`` for ``None``, strings, booleans,
+complex numbers or ragged arrays, ``ValueError`` for non-finite entries, values outside the
+documented range, shapes that do not broadcast, ``sigma`` and ``Fc`` whose units ``Fc/sigma``,
+``Fc^2/sigma`` leave the double-precision range, and results that would overflow; each message
+names the argument, its value and the allowed range.
 """
 
 from __future__ import annotations
@@ -148,6 +154,12 @@ def branch_force(x: Any, x_i: Any, F_i: Any, sigma: float, Fc: float, direction:
     -------
     numpy.ndarray
         Friction force [N].
+
+    Raises
+    ------
+    ValueError
+        If ``x`` lies behind the reversal (``direction (x - x_i) < 0``), ``|F_i| > Fc``, or the
+        shapes of ``x``, ``x_i``, ``F_i`` do not broadcast.
     """
     sigma, Fc = _as_sigma_fc(sigma, Fc)
     s = _direction(direction)
@@ -191,6 +203,11 @@ def zero_crossing(x_i: Any, F_i: Any, sigma: float, Fc: float, direction: int = 
     -------
     numpy.ndarray
         Zero-crossing position [m].
+
+    Raises
+    ------
+    ValueError
+        If ``direction F_i >= Fc`` (a branch that starts at the Coulomb force never crosses zero).
     """
     sigma, Fc = _as_sigma_fc(sigma, Fc)
     s = _direction(direction)
