@@ -11,6 +11,8 @@
 - :func:`lugre_loops`: the LuGre force along a smooth prescribed motion with known velocity
   reversals, from scipy's ``solve_ivp`` (Radau, ``rtol = 1e-9``) restarted at each reversal,
   where ``|v|`` has its kink.
+- :func:`lugre_free_decay`: the unforced oscillator (2.1) with LuGre friction, from Radau with
+  the velocity reversals located as terminal events and the integration restarted there.
 
 Gaussian noise of a given standard deviation is added to the measured signal.
 """
@@ -31,8 +33,8 @@ from prefriction.models.lugre import LuGre
 from prefriction.models.maxwell_slip import MaxwellSlip
 from prefriction.models.oscillator import Oscillator
 
-__all__ = ["dahl_free_decay", "dahl_loops", "dahl_loop_force", "lugre_force", "lugre_loops", "maxwell_slip_force",
-           "maxwell_slip_loops"]
+__all__ = ["dahl_free_decay", "dahl_loops", "dahl_loop_force", "lugre_force", "lugre_free_decay", "lugre_loops",
+           "maxwell_slip_force", "maxwell_slip_loops"]
 
 
 def dahl_loop_force(model: Dahl, x: np.ndarray) -> np.ndarray:
@@ -253,3 +255,67 @@ def lugre_loops(model: LuGre, t: Any, position: Callable[[Any], Any], velocity: 
     t = np.asarray(t, dtype=float)
     F = lugre_force(model, t, velocity, reversals)
     return ForceDisplacement(t, position(t), F + noise * rng.standard_normal(F.size))
+
+
+def lugre_free_decay(model: LuGre, mass: float, v0: float, t: Any, noise: float, rng: np.random.Generator,
+                     rtol: float = 1e-9) -> tuple[Motion, np.ndarray]:
+    """Free-decay positions of the oscillator (2.1) with LuGre friction, from ``x = z = 0`` and ``v0``.
+
+    ``m x'' = -F``, ``F = sigma0 z + sigma1 z' + sigma2 v``, ``z' = v - sigma0 |v| z / g(v)``
+    (Canudas de Wit et al. 1995), integrated by scipy's Radau. Each velocity reversal is a
+    terminal event (``v`` crossing zero against the current direction), where the integration
+    restarts, so no step straddles the kink of ``|v|``.
+
+    Parameters
+    ----------
+    model : LuGre
+        The true model.
+    mass : float
+        Mass [kg].
+    v0 : float
+        Initial velocity [m/s], non-zero.
+    t : array_like
+        Sample times [s], from 0.
+    noise : float
+        Standard deviation of the position noise [m].
+    rng : numpy.random.Generator
+        Source of the noise.
+    rtol : float, default 1e-9
+        Relative tolerance of Radau.
+
+    Returns
+    -------
+    (Motion, numpy.ndarray)
+        The data (``u = 0``, the known ``mass``) and the reversal times [s] inside the record.
+    """
+    t = np.asarray(t, dtype=float)
+    m = model
+
+    def rhs(_t: float, y: np.ndarray) -> list[float]:
+        v, z = y[1], y[2]
+        g = m.Fc + (m.Fs - m.Fc) * np.exp(-(v / m.vs) ** 2)
+        dz = v - m.sigma0 * abs(v) * z / g
+        return [v, -(m.sigma0 * z + m.sigma1 * dz + m.sigma2 * v) / mass, dz]
+
+    x = np.empty_like(t)
+    y0, t0, s = [0.0, float(v0), 0.0], float(t[0]), float(np.sign(v0))
+    reversals: list[float] = []
+    while True:
+        def reversal(_t: float, y: np.ndarray) -> float:
+            return y[1]
+        reversal.terminal = True  # type: ignore[attr-defined]
+        reversal.direction = -s   # type: ignore[attr-defined]
+        sol = solve_ivp(rhs, (t0, float(t[-1])), y0, method="Radau", rtol=rtol, atol=1e-12 * m.Fc / m.sigma0,
+                        events=reversal, dense_output=True)
+        if not sol.success or (sol.status == 1 and not sol.t[-1] > t0):
+            raise SolverError(f"Radau stopped at t = {sol.t[-1]!r} s, state {sol.y[:, -1]!r} ({sol.message}); "
+                              f"try a looser rtol than {rtol!r}")
+        sel = (t >= t0) & (t <= sol.t[-1])
+        if np.any(sel):
+            x[sel] = sol.sol(t[sel])[0]
+        if sol.status != 1:
+            break
+        t0, s = float(sol.t[-1]), -s
+        y0 = [float(sol.y[0, -1]), 0.0, float(sol.y[2, -1])]
+        reversals.append(t0)
+    return Motion(t, x + noise * rng.standard_normal(t.size), 0.0, mass), np.array(reversals)
