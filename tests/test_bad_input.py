@@ -96,8 +96,8 @@ def time_guard(seconds: float = GUARD_SECONDS):
 
 def names_argument(message: str, name: str) -> bool:
     """True if ``message`` names ``name`` as an argument (``v0 must``, ``--rows:``, ``stiffness[2] =``,
-    ``system.friction must``), not merely as a letter inside other words."""
-    pattern = (rf"(?:^|[\s(`'\"\-,]){re.escape(name)}(?:\[[^\]]*\]|\.\w+)?['\"`]?"
+    ``system.friction must``, ``ReversalTable.x has``), not merely as a letter inside other words."""
+    pattern = (rf"(?:^|[\s(`'\"\-,.]){re.escape(name)}(?:\[[^\]]*\]|\.\w+)?['\"`]?"
                rf"(?=\s*(?:must|=|has|is|holds|samples?|:|\(|and|or|,|\[|<|>|lies|gives|needs|exceeds|of))")
     return re.search(pattern, message) is not None
 
