@@ -3,9 +3,9 @@
 References independent of the fitter: the Dahl closed-form branches (the data of
 ``fit_dahl_loops``); for Maxwell-slip the stop operators of ``prefriction.identify.synthetic``,
 checked here against the closed-form virgin curve ``sum_i min(k_i x, W_i)``, Masing's first
-unloading branch and its return to the virgin curve; for LuGre scipy's Radau (``synthetic.lugre_force``), checked here against the
-closed-form response at a constant velocity. The examples are imported from their files, as a
-fresh clone runs them.
+unloading branch and its return to the virgin curve; for LuGre scipy's Radau
+(``synthetic.lugre_force``), checked here against the closed-form response at a constant
+velocity. The examples are imported from their files, as a fresh clone runs them.
 """
 
 from __future__ import annotations

@@ -19,8 +19,8 @@ __all__ = ["fit"]
 
 def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequence[str] | None = None,
         fixed: Sequence[str] | None = None, bounds: dict[str, tuple[float, float]] | None = None,
-        mass0: float | None = None, reversals: Sequence[float] | None = None, substeps: int | None = None, max_iter: int = 200, tol: float = 1e-10,
-        identifiability_limit: float = 0.5) -> FitResult:
+        mass0: float | None = None, reversals: Sequence[float] | None = None, substeps: int | None = None,
+        max_iter: int = 200, tol: float = 1e-10, identifiability_limit: float = 0.5) -> FitResult:
     """Fit a friction model's parameters to measured data.
 
     Parameters
@@ -53,7 +53,8 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
         sample interval of every reversal, so refits with the same reversal layout reuse it.
     substeps : int, optional
         Runge-Kutta sub-steps per sample interval (1 to 64); default: chosen from the data and
-        the start values.
+        the start values (1 for Maxwell-slip on force-displacement data, where one step is the
+        exact stop operator).
     max_iter : int, default 200
         Most solver iterations (function evaluations for force-displacement data).
     tol : float, default 1e-10
