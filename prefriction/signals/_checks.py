@@ -1,0 +1,33 @@
+"""Argument checks shared by the signal kinds: real numbers with a unit and a rule."""
+
+from __future__ import annotations
+
+import math
+from numbers import Real
+from typing import Any, Callable
+
+import numpy as np
+
+UNIT = "signal units"
+"""Unit of signal values in messages (a signal may be a force [N], a position [m], ...)."""
+
+
+def is_real(value: Any) -> bool:
+    """True for a real number (Python or numpy), False for booleans and everything else."""
+    return not isinstance(value, (bool, np.bool_)) and isinstance(value, (Real, np.floating, np.integer))
+
+
+def number(name: str, value: Any, unit: str, rule: str = "", ok: Callable[[float], bool] = lambda v: True) -> float:
+    """``value`` as a finite float satisfying ``ok``; messages name ``name``, the value and ``rule``."""
+    allowed = f"a finite real number{(' ' + rule) if rule else ''} [{unit}]"
+    if not is_real(value):
+        raise TypeError(f"{name} must be {allowed}, got {value!r} of type {type(value).__name__}")
+    v = float(value)
+    if not (math.isfinite(v) and ok(v)):
+        raise ValueError(f"{name} must be {allowed}, got {v!r}")
+    return v
+
+
+def time_end(t_end: Any) -> float:
+    """``t_end`` [s] of a signal's :meth:`~prefriction.signals.Signal.bound` as a float ``>= 0``."""
+    return number("t_end", t_end, "s", ">= 0", lambda v: v >= 0.0)
