@@ -331,8 +331,7 @@ FB_BASE = dict(A=[[0.0]], B=[[1.0]], C=[[1.0]], D=1.0, Ts=None, reference=0.0, x
 ROWS += rows_for("LinearFeedback", pf.LinearFeedback, FB_BASE, dict(
     A=bad_array | st.sampled_from([np.zeros((2, 2)), [[1.0, 2.0]]]), B=bad_array, C=bad_array, D=bad_array,
     Ts=bad_positive.filter(lambda v: v is not None), reference=BAD_SAMPLES | st.sampled_from([NAN, "fast", 1 + 1j]),
-    xc0=bad_array.filter(lambda v: v is not None) | st.sampled_from([[0.0, 0.0]])),
-    owner=dict.fromkeys(["A", "B", "C", "D", "xc0"], "prefriction/simulation/feedback.py"))
+    xc0=bad_array.filter(lambda v: v is not None) | st.sampled_from([[0.0, 0.0]])))
 SWEEP = "prefriction/simulation/sweep.py"
 ROWS += rows_for("sweep", pf.sweep, dict(systems=[SYSTEM, SYSTEM], v0=0.01, reversals=5, progress=False), dict(
     systems=st.sampled_from([None, 3, "ab", SYSTEM, [], [SYSTEM, 3], [DAHL], iter([])]),

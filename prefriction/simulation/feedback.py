@@ -28,7 +28,7 @@ from typing import Any, Callable, Optional, Union
 
 import numpy as np
 
-from prefriction._validation import check_positive
+from prefriction._validation import check_positive, check_real_array
 
 Reference = Union[float, Callable[[Any], Any], tuple]
 
@@ -69,17 +69,22 @@ def sample_count(t_end: float, Ts: float, periods: float) -> int:
     return k + 1
 
 
-def _as_matrix(name: str, value: Any, shape: tuple[int, int]) -> np.ndarray:
-    """Return ``value`` as a read-only float matrix of ``shape``; ``ValueError`` otherwise."""
-    arr = np.array(value, dtype=float, ndmin=2)
+def _as_matrix(name: str, value: Any, shape: tuple[int, int], why: str = "") -> np.ndarray:
+    """Return ``value`` as a read-only float matrix of ``shape`` (an empty value: zeros of
+    ``shape``); ``TypeError``/``ValueError`` naming ``name`` otherwise (``why`` explains the shape)."""
+    arr = np.array(check_real_array(name, value), ndmin=2)
     if arr.size == 0:
         arr = np.zeros(shape)
     if arr.shape != shape:
-        raise ValueError(f"{name} must have shape {shape}, got {arr.shape}")
-    if not np.all(np.isfinite(arr)):
-        raise ValueError(f"{name} must be finite (every entry), got {arr.tolist()!r}")
+        raise ValueError(f"{name} must have shape {shape}{why}, got an array of shape {arr.shape}")
     arr.setflags(write=False)
     return arr
+
+
+def _state_count(A: Any) -> int:
+    """Number of controller states: the rows of ``A`` (0 if ``A`` is empty)."""
+    arr = check_real_array("A", A)
+    return 0 if arr.size == 0 else np.array(arr, ndmin=2).shape[0]
 
 
 @dataclass(frozen=True, eq=False)
@@ -106,9 +111,12 @@ class LinearFeedback:
 
     Raises
     ------
+    TypeError
+        If a matrix or ``xc0`` is not real numbers (``None``, strings, booleans, complex,
+        ragged nesting), ``Ts`` is not a real number, or ``reference`` is of no accepted kind.
     ValueError
-        If a matrix has the wrong shape or non-finite entries, ``Ts`` is not positive, or the
-        reference samples are malformed.
+        If a matrix or ``xc0`` has the wrong shape or a non-finite entry, ``Ts`` is not
+        positive, or the reference samples are malformed.
     """
 
     A: Any = field(default_factory=lambda: np.zeros((0, 0)))
@@ -120,20 +128,21 @@ class LinearFeedback:
     xc0: Any = None
 
     def __post_init__(self) -> None:
-        a = np.array(self.A, dtype=float, ndmin=2) if np.size(self.A) else np.zeros((0, 0))
-        n = a.shape[0]
+        n = _state_count(self.A)
+        why = f" (A is {n} x {n}: n = {n} controller states)"
         object.__setattr__(self, "A", _as_matrix("A", self.A, (n, n)))
-        object.__setattr__(self, "B", _as_matrix("B", self.B, (n, 1)))
-        object.__setattr__(self, "C", _as_matrix("C", self.C, (1, n)))
+        object.__setattr__(self, "B", _as_matrix("B", self.B, (n, 1), why))
+        object.__setattr__(self, "C", _as_matrix("C", self.C, (1, n), why))
         object.__setattr__(self, "D", _as_matrix("D", self.D, (1, 1)))
         if self.Ts is not None:
             object.__setattr__(self, "Ts", check_positive("Ts", self.Ts))
         from prefriction.signals import as_signal
 
         object.__setattr__(self, "reference", as_signal(self.reference, "reference", "m"))
-        xc0 = np.zeros(n) if self.xc0 is None else np.array(self.xc0, dtype=float).reshape(-1)
-        if xc0.shape != (n,) or not np.all(np.isfinite(xc0)):
-            raise ValueError(f"xc0 must be a finite vector of length {n}, got {self.xc0!r}")
+        xc0 = np.zeros(n) if self.xc0 is None else check_real_array("xc0", self.xc0).reshape(-1)
+        if xc0.shape != (n,):
+            got = repr(xc0.tolist()) if xc0.size <= 8 else f"{xc0.size} entries"
+            raise ValueError(f"xc0 must be a vector of length n = {n} (the controller states of A), got {got}")
         xc0.setflags(write=False)
         object.__setattr__(self, "xc0", xc0)
 
