@@ -49,13 +49,7 @@ class Sum(Signal):
         return sum(term.n_piece for term in self.terms)
 
     def params(self) -> np.ndarray:
-        """Run-time parameters of the terms, concatenated.
-
-        Returns
-        -------
-        numpy.ndarray
-            Length :attr:`n_params`.
-        """
+        """Run-time parameters of the terms, concatenated (length :attr:`n_params`)."""
         return np.concatenate([term.params() for term in self.terms])
 
     def linear_piece(self, ta: float, tb: float) -> Optional[tuple[float, float]]:
@@ -69,18 +63,7 @@ class Sum(Signal):
         return a, b
 
     def piece(self, ta: float, tb: float) -> np.ndarray:
-        """Per-interval numbers of the terms, concatenated.
-
-        Parameters
-        ----------
-        ta, tb : float
-            Start and end [s] of the interval, with no :meth:`breaks` strictly inside.
-
-        Returns
-        -------
-        numpy.ndarray
-            Length :attr:`n_piece`.
-        """
+        """Per-interval numbers of the terms on ``[ta, tb]`` [s], concatenated (length :attr:`n_piece`)."""
         return np.concatenate([np.zeros(0)] + [term.piece(ta, tb) for term in self.terms])
 
     def _expr(self, t: Any, theta: Any, piece: Any, ops: Any) -> Any:
@@ -92,44 +75,16 @@ class Sum(Signal):
         return total
 
     def __call__(self, t: Any) -> Union[float, np.ndarray]:
-        """Numeric value: the sum of the terms' values.
-
-        Parameters
-        ----------
-        t : float or array_like
-            Time(s) [s].
-
-        Returns
-        -------
-        float or numpy.ndarray
-            Shaped like ``t`` (a float for a scalar ``t``).
-        """
+        """Numeric value at the time(s) ``t`` [s]: the sum of the terms' values, shaped like ``t``."""
         value = sum(np.asarray(term(t), dtype=float) for term in self.terms)
         return float(value) if np.ndim(value) == 0 else value
 
     def breaks(self) -> np.ndarray:
-        """Union of the terms' breaks.
-
-        Returns
-        -------
-        numpy.ndarray
-            Sorted unique times [s].
-        """
+        """Union of the terms' breaks: sorted unique times [s]."""
         return np.unique(np.concatenate([np.zeros(0)] + [term.breaks() for term in self.terms]))
 
     def bound(self, t_end: float) -> float:
-        """Sum of the terms' bounds.
-
-        Parameters
-        ----------
-        t_end : float
-            End [s] of the time range ``[0, t_end]``.
-
-        Returns
-        -------
-        float
-            Bound [signal units].
-        """
+        """Sum of the terms' bounds over ``[0, t_end]`` [signal units] (:meth:`Signal.bound`)."""
         return float(sum(term.bound(t_end) for term in self.terms))
 
     def __repr__(self) -> str:

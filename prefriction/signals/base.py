@@ -236,21 +236,16 @@ class Analytic(Signal):
         return {n: getattr(self, n) for n in self._names}
 
 
-class LinearPieces(Signal):
-    """A signal compiled as one line per interval: ``a + b (t - tl)`` from the per-interval
-    numbers ``(tl, a, b)`` of :meth:`piece`; no run-time parameters."""
+class NoParams(Signal):
+    """A signal without run-time parameters: its numbers are per-interval (:meth:`piece`) or
+    compiled into its structure."""
 
     __slots__ = ()
 
     @property
     def n_params(self) -> int:
-        """No run-time parameters: the numbers come per interval from :meth:`piece`."""
+        """No run-time parameters."""
         return 0
-
-    @property
-    def n_piece(self) -> int:
-        """Three per-interval numbers ``(tl, a, b)``."""
-        return 3
 
     def params(self) -> np.ndarray:
         """Run-time parameters (none).
@@ -261,6 +256,18 @@ class LinearPieces(Signal):
             Empty array.
         """
         return np.zeros(0)
+
+
+class LinearPieces(NoParams):
+    """A signal compiled as one line per interval: ``a + b (t - tl)`` from the per-interval
+    numbers ``(tl, a, b)`` of :meth:`piece`; no run-time parameters."""
+
+    __slots__ = ()
+
+    @property
+    def n_piece(self) -> int:
+        """Three per-interval numbers ``(tl, a, b)``."""
+        return 3
 
     def _expr(self, t: Any, theta: Any, piece: Any, ops: Any) -> Any:
         return piece[1] + piece[2] * (t - piece[0])

@@ -43,18 +43,7 @@ class Sine(Analytic):
         return theta[3] + theta[0] * ops.sin(2.0 * math.pi * theta[1] * t + theta[2])
 
     def bound(self, t_end: float) -> float:
-        """Bound of the magnitude.
-
-        Parameters
-        ----------
-        t_end : float
-            End [s] of the time range ``[0, t_end]``.
-
-        Returns
-        -------
-        float
-            ``|offset| + |amplitude|`` [signal units].
-        """
+        """``|offset| + |amplitude|`` [signal units] (:meth:`Signal.bound`)."""
         time_end(t_end)
         return abs(self.offset) + abs(self.amplitude)
 
@@ -98,27 +87,10 @@ class Chirp(Analytic):
         return a * ops.sin(2.0 * math.pi * cycles)
 
     def breaks(self) -> np.ndarray:
-        """End of the sweep (the chirp rate jumps there).
-
-        Returns
-        -------
-        numpy.ndarray
-            ``[duration]`` [s].
-        """
+        """``[duration]`` [s]: the end of the sweep (the chirp rate jumps there)."""
         return np.array([self.duration])
 
     def bound(self, t_end: float) -> float:
-        """Bound of the magnitude.
-
-        Parameters
-        ----------
-        t_end : float
-            End [s] of the time range ``[0, t_end]``.
-
-        Returns
-        -------
-        float
-            ``|amplitude|`` [signal units].
-        """
+        """``|amplitude|`` [signal units] (:meth:`Signal.bound`)."""
         time_end(t_end)
         return abs(self.amplitude)

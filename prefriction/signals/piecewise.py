@@ -40,18 +40,7 @@ class Constant(Analytic):
         return self.value, 0.0
 
     def bound(self, t_end: float) -> float:
-        """Magnitude of the value.
-
-        Parameters
-        ----------
-        t_end : float
-            End [s] of the time range ``[0, t_end]``.
-
-        Returns
-        -------
-        float
-            ``|value|`` [signal units].
-        """
+        """``|value|`` [signal units] (:meth:`Signal.bound`)."""
         time_end(t_end)
         return abs(self.value)
 
@@ -87,28 +76,12 @@ class Step(Analytic):
         return (self.after if 0.5 * (ta + tb) >= self.time else self.before), 0.0
 
     def breaks(self) -> np.ndarray:
-        """Switching time.
-
-        Returns
-        -------
-        numpy.ndarray
-            ``[time]`` [s].
-        """
+        """``[time]`` [s]: the switching time."""
         return np.array([self.time])
 
     def bound(self, t_end: float) -> float:
-        """Largest magnitude over ``[0, t_end]``.
-
-        Parameters
-        ----------
-        t_end : float
-            End [s] of the time range.
-
-        Returns
-        -------
-        float
-            ``max(|before|, |after|)``, or ``|before|`` if the step comes after ``t_end``.
-        """
+        """Largest magnitude over ``[0, t_end]`` [signal units] (:meth:`Signal.bound`):
+        ``max(|before|, |after|)``, or ``|before|`` if the step comes after ``t_end`` [s]."""
         if time_end(t_end) < self.time:
             return abs(self.before)
         return max(abs(self.before), abs(self.after))
@@ -147,27 +120,11 @@ class Ramp(Analytic):
         return self.offset, 0.0
 
     def breaks(self) -> np.ndarray:
-        """Start of the ramp.
-
-        Returns
-        -------
-        numpy.ndarray
-            ``[time]`` [s].
-        """
+        """``[time]`` [s]: the start of the ramp."""
         return np.array([self.time])
 
     def bound(self, t_end: float) -> float:
-        """Largest magnitude over ``[0, t_end]`` (exact: the value is monotonic).
-
-        Parameters
-        ----------
-        t_end : float
-            End [s] of the time range.
-
-        Returns
-        -------
-        float
-            ``max(|offset|, |offset + slope max(t_end - time, 0)|)`` [signal units].
-        """
+        """Largest magnitude over ``[0, t_end]`` [signal units] (:meth:`Signal.bound`; exact, the
+        value is monotonic): ``max(|offset|, |offset + slope max(t_end - time, 0)|)``."""
         end = self.offset + self.slope * max(time_end(t_end) - self.time, 0.0)
         return max(abs(self.offset), abs(end))

@@ -122,44 +122,16 @@ class Samples(LinearPieces):
         return np.array([ts[k], us[k], slope])
 
     def __call__(self, t: Any) -> Union[float, np.ndarray]:
-        """Numeric value, linear between samples and held outside them.
-
-        Parameters
-        ----------
-        t : float or array_like
-            Time(s) [s].
-
-        Returns
-        -------
-        float or numpy.ndarray
-            ``numpy.interp(t, self.t, self.u)``.
-        """
+        """Numeric value at the time(s) ``t`` [s]: ``numpy.interp(t, self.t, self.u)``, shaped like ``t``."""
         value = np.interp(check_real_array("t", t, "s"), self._t, self._u)
         return float(value) if np.ndim(value) == 0 else value
 
     def breaks(self) -> np.ndarray:
-        """Sample times, where the slope jumps.
-
-        Returns
-        -------
-        numpy.ndarray
-            Copy of :attr:`t` [s].
-        """
+        """Copy of the sample times :attr:`t` [s], where the slope jumps."""
         return self._t.copy()
 
     def bound(self, t_end: float) -> float:
-        """Largest magnitude over ``[0, t_end]`` (exact).
-
-        Parameters
-        ----------
-        t_end : float
-            End [s] of the time range.
-
-        Returns
-        -------
-        float
-            ``max |value|`` over ``[0, t_end]`` [signal units].
-        """
+        """Largest magnitude over ``[0, t_end]`` [signal units] (:meth:`Signal.bound`; exact)."""
         t_end = time_end(t_end)
         inside = (self._t >= 0.0) & (self._t <= t_end)
         ends = np.abs(np.interp([0.0, t_end], self._t, self._u))

@@ -12,12 +12,12 @@ import numpy as np
 
 from prefriction.signals._checks import time_end
 from prefriction.signals._ops import CasadiOps, MathOps
-from prefriction.signals.base import Signal
+from prefriction.signals.base import NoParams, Signal
 
 __all__ = ["Traced"]
 
 
-class Traced(Signal):
+class Traced(NoParams):
     """Arbitrary Python function of time, traced into CasADi.
 
     Unlike the parametric kinds, the function *is* the structure: the key is
@@ -96,21 +96,6 @@ class Traced(Signal):
         """``("Traced", fun)``: each function object is its own structure."""
         return ("Traced", self.fun)
 
-    @property
-    def n_params(self) -> int:
-        """No run-time parameters."""
-        return 0
-
-    def params(self) -> np.ndarray:
-        """Run-time parameters (none).
-
-        Returns
-        -------
-        numpy.ndarray
-            Empty array.
-        """
-        return np.zeros(0)
-
     def _expr(self, t: Any, theta: Any, piece: Any, ops: Any) -> Any:
         if isinstance(t, ca.SX):
             value = self.fun(t)
@@ -123,18 +108,8 @@ class Traced(Signal):
         return np.asarray(self._f(flat), dtype=float).reshape(t.shape) if flat.size else np.zeros(t.shape)
 
     def bound(self, t_end: float) -> float:
-        """Estimate of the magnitude from 1025 evenly spaced values (NaN ignored).
-
-        Parameters
-        ----------
-        t_end : float
-            End [s] of the time range ``[0, t_end]``.
-
-        Returns
-        -------
-        float
-            ``max |value|`` over the sample points [signal units].
-        """
+        """Estimate of the magnitude over ``[0, t_end]`` [signal units] (:meth:`Signal.bound`): the
+        largest of 1025 evenly spaced values (NaN ignored)."""
         values = np.abs(self(np.linspace(0.0, time_end(t_end), 1025)))
         return float(np.max(values, initial=0.0, where=~np.isnan(values)))
 
