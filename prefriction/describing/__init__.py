@@ -10,7 +10,7 @@
 - :func:`velocity_loop`, :class:`VelocityDescribingFunction`: friction as a nonlinearity of the
   velocity, ``G(s) = s / (m s^2 + C(s))``;
 - :func:`friction_loop`, :func:`predict_limit_cycle` (with Loeb's stability test),
-  :func:`measure_limit_cycle`, :func:`trace_unstable_cycle`: predicted against simulated limit
+  :func:`measure_limit_cycle`, :func:`trace_unstable_cycle`, :func:`simulate_from_cycle`: predicted against simulated limit
   cycles.
 
 See ``docs/describing.md``.
@@ -26,7 +26,7 @@ from prefriction.describing.limit_cycle import (
     predict_limit_cycle,
 )
 from prefriction.describing.nonlinearity import FrictionDescribingFunction, PlantDescribingFunction
-from prefriction.describing.trace import TracedCycle, trace_unstable_cycle
+from prefriction.describing.trace import TracedCycle, simulate_from_cycle, trace_unstable_cycle
 from prefriction.describing.velocity import VelocityDescribingFunction, velocity_loop
 
 __all__ = [
@@ -44,6 +44,7 @@ __all__ = [
     "measure_limit_cycle",
     "plant_describing_function",
     "predict_limit_cycle",
+    "simulate_from_cycle",
     "trace_unstable_cycle",
     "velocity_loop",
 ]

@@ -24,7 +24,7 @@ from prefriction.describing.limit_cycle import LimitCycle
 from prefriction.describing.velocity import controller_tf
 from prefriction.models import Oscillator, check_oscillator
 
-__all__ = ["TracedCycle", "trace_unstable_cycle"]
+__all__ = ["TracedCycle", "simulate_from_cycle", "trace_unstable_cycle"]
 
 _SAMPLES = 256  # dense samples per period
 _AGREE = 0.01  # the two bracketing runs are on the cycle while their peaks agree to 1 %
@@ -97,6 +97,28 @@ def _run(system: Oscillator, controller: Any, X: float, omega: float, scale: flo
     t = T * np.arange(periods * _SAMPLES + 1) / _SAMPLES
     return simulate(system, scale * X * omega, t_end=t[-1], dense=t, rtol=rtol,
                     feedback=_feedback(controller, X, omega, scale))
+
+
+def simulate_from_cycle(system: Oscillator, controller: Any, cycle: LimitCycle, scale: float, *, periods: int = 12,
+                        variable: str = "velocity", rtol: float = 1e-9) -> Any:
+    """The loop ``u = C(s)(0 - x)`` started on the predicted sinusoid scaled by ``scale``.
+
+    Start: ``x = 0``, ``v = scale omega X``, ``F = 0``, controller states ``scale`` times those of
+    the sinusoidal steady state ``x = X sin(omega t)``, with ``X`` the predicted position amplitude.
+    Parameters as in :func:`trace_unstable_cycle`; ``0 <= scale <= 10``.
+
+    Returns
+    -------
+    prefriction.SimulationResult
+        With ``256`` dense samples per predicted period over ``periods`` periods.
+    """
+    check_oscillator(system, "simulate_from_cycle")
+    scale = check_interval("scale", scale, 0.0, 10.0)
+    periods = check_count("periods", periods, minimum=1, maximum=200)
+    variable = check_choice("variable", variable, ("velocity", "position"))
+    rtol = check_interval("rtol", rtol, 1e-13, 1e-6)
+    X = cycle.amplitude / cycle.omega if variable == "velocity" else cycle.amplitude
+    return _run(system, controller, X, cycle.omega, scale, periods, rtol)
 
 
 def _peaks(res: Any, periods: int) -> np.ndarray:
