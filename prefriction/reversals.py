@@ -3,8 +3,11 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
+
+from prefriction._validation import check_nonnegative
 
 
 @dataclass(frozen=True, eq=False)
@@ -29,6 +32,16 @@ class ReversalTable:
     E_0 : float
         Energy of the initial state [J]: kinetic energy plus the potential energy of the
         initial force on the initial branch.
+
+    Raises
+    ------
+    TypeError
+        If a column is not an array of real numbers or ``E_0`` not a real number.
+    ValueError
+        If a column is not 1-D or its length differs from that of ``t``, ``t`` is not finite
+        and strictly increasing, ``x`` or ``F`` has a non-finite entry, ``E_p`` or ``E_d`` an
+        infinite one (NaN marks them undefined, as for rate-dependent models), or ``E_0`` is
+        not finite and ``>= 0``.
     """
 
     t: np.ndarray
@@ -39,11 +52,19 @@ class ReversalTable:
     E_0: float
 
     def __post_init__(self) -> None:
-        n = len(self.t)
-        for name in ("x", "F", "E_p", "E_d"):
-            arr = getattr(self, name)
-            if len(arr) != n:
-                raise ValueError(f"ReversalTable.{name} has length {len(arr)}, expected {n}")
+        t = _column("t", self.t, finite=True)
+        if np.any(np.diff(t) <= 0.0):
+            i = int(np.flatnonzero(np.diff(t) <= 0.0)[0])
+            raise ValueError(f"table.t must be strictly increasing, got t[{i + 1}] = {float(t[i + 1])!r} "
+                             f"<= t[{i}] = {float(t[i])!r}")
+        object.__setattr__(self, "t", t)
+        for name, finite in (("x", True), ("F", True), ("E_p", False), ("E_d", False)):
+            arr = _column(name, getattr(self, name), finite=finite)
+            if arr.size != t.size:
+                raise ValueError(f"table.{name} has length {arr.size} and table.t has length {t.size}: "
+                                 "every column needs one entry per reversal")
+            object.__setattr__(self, name, arr)
+        object.__setattr__(self, "E_0", check_nonnegative("E_0", self.E_0))
 
     def __len__(self) -> int:
         return len(self.t)
@@ -92,3 +113,26 @@ class ReversalTable:
             )
             prev = i
         return "\n".join(lines)
+
+
+def _column(name: str, values: Any, *, finite: bool) -> np.ndarray:
+    """``values`` as a 1-D float array; ``TypeError`` unless real numbers, ``ValueError`` for a
+    non-finite entry (``finite``) or an infinite one (NaN allowed: the quantity is not defined)."""
+    allowed = "a 1-D array of real numbers"
+    if values is None or isinstance(values, (str, bytes, dict, set)):
+        raise TypeError(f"table.{name} must be {allowed}, got {values!r} of type {type(values).__name__}")
+    try:
+        raw = np.asarray(values)
+    except (ValueError, TypeError):  # ragged nesting
+        raise TypeError(f"table.{name} must be {allowed}, got ragged or mixed nesting") from None
+    if raw.dtype.kind not in "iuf":
+        raise TypeError(f"table.{name} must be {allowed}, got an array of dtype {raw.dtype}")
+    if raw.ndim != 1:
+        raise ValueError(f"table.{name} must be {allowed}, got an array of shape {raw.shape}")
+    arr = raw.astype(float)
+    bad = ~np.isfinite(arr) if finite else np.isinf(arr)
+    if np.any(bad):
+        i = int(np.flatnonzero(bad)[0])
+        kind = "finite" if finite else "finite or NaN (not defined)"
+        raise ValueError(f"table.{name} must be {kind}, got a non-finite entry at index {i} (reversal {i + 1})")
+    return arr

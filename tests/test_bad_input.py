@@ -344,8 +344,7 @@ ROWS += [Row("sweep-unknown-keyword", lambda **kw: pf.sweep([SYSTEM], 0.01, reve
 ROWS += rows_for("ReversalTable", pf.ReversalTable,
                  dict(t=[1.0, 2.0], x=[0.1, -0.1], F=[0.5, -0.4], E_p=[0.1, 0.05], E_d=[0.1, 0.05], E_0=0.3),
                  dict(t=st.sampled_from([[2.0, 1.0], [1.0, NAN], [1.0], "ab", None]),
-                      x=st.sampled_from([[0.1], [NAN, 0.0], None]), E_0=bad_real | st.sampled_from([-1.0])),
-                 owner=dict.fromkeys(["t", "x", "E_0"], "prefriction/reversals.py"))
+                      x=st.sampled_from([[0.1], [NAN, 0.0], None]), E_0=bad_real | st.sampled_from([-1.0])))
 
 # energy analysis ----------------------------------------------------------------------------
 T = np.linspace(0.0, 1.0, 201)
