@@ -4,6 +4,7 @@ the closed form, python-control's own numerical DF, and predicted against simula
 from __future__ import annotations
 
 import math
+from dataclasses import replace as dataclasses_replace
 import warnings
 
 import control
@@ -236,3 +237,23 @@ def test_lugre_unstable_pid_loop_predicted_cycle_against_simulation():
     e_amp, e_T = tr.errors()
     assert abs(e_amp) < 0.05 and abs(e_T) < 0.02  # measured: +1.4 % and -0.34 % (30 steps)
     assert "unstable cycle" in tr.summary() and "TracedCycle" in repr(tr)
+
+
+def test_velocity_and_trace_bad_arguments():
+    lugre = pf.Oscillator(pf.LuGre(1e5, 1e5 ** 0.5, 0.4, 1.0, 1.5, 1e-3), mass=1.0)
+    with pytest.raises(ValueError, match="needs a frequency"):
+        VelocityDescribingFunction(lugre).describing_function(0.1)
+    with pytest.raises(TypeError, match="controller must be"):
+        velocity_loop(lugre, object())
+    with pytest.raises(ValueError, match="continuous-time"):
+        velocity_loop(lugre, control.tf([1.0], [1.0, 0.5], dt=0.1))
+    stable = predict_limit_cycle(control.tf([4.0], [1.0, 2.0, 1.0, 0.0]), _Relay(), np.logspace(-1, 2, 31))
+    with pytest.raises(ValueError, match="unstable LimitCycle"):
+        trace_unstable_cycle(lugre, PID_UNSTABLE, stable)
+    unstable = dataclasses_replace(stable, stable=False)
+    with pytest.raises(ValueError, match="bracket must be"):
+        trace_unstable_cycle(lugre, PID_UNSTABLE, unstable, bracket=(1.2, 0.8))
+    with pytest.raises(ValueError, match="variable"):
+        trace_unstable_cycle(lugre, PID_UNSTABLE, unstable, variable="force")
+    with pytest.raises(ValueError, match="steps"):
+        trace_unstable_cycle(lugre, PID_UNSTABLE, unstable, steps=1000)
