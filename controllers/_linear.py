@@ -1,9 +1,12 @@
 """Linearised plants, linear closed loops, stability margins and pole-placement designs.
 
-Two linearisations of the stage ``m x'' = u - F`` with Dahl friction (3.2):
+Two linearisations of the stage ``m x'' = u - F`` with any friction model of the protocol
+(:class:`prefriction.models.FrictionModel`: Dahl (3.2), Maxwell-slip, GMS, LuGre):
 
 - pre-sliding (``regime="presliding"``): near a rest point the friction is a spring of rest
-  stiffness ``sigma`` (the slope of (3.2) at ``F = 0``), ``P(s) = 1 / (m s^2 + sigma)``;
+  stiffness ``sigma``, the model's reference stiffness (Dahl: the slope of (3.2) at ``F = 0``;
+  Maxwell-slip: the sum of the element stiffnesses; LuGre: ``sigma0``),
+  ``P(s) = 1 / (m s^2 + sigma)``;
 - sliding (``regime="sliding"``): in gross sliding the friction is the constant ``+-Fc`` and
   drops out of the small-signal model, ``P(s) = 1 / (m s^2)``.
 
@@ -21,7 +24,7 @@ from typing import Optional
 import control
 import numpy as np
 
-from prefriction._validation import check_interval, check_positive
+from prefriction._validation import check_bool, check_interval, check_positive
 from prefriction.models import Oscillator
 
 from ._pid import PID
@@ -132,7 +135,7 @@ def closed_loop(
     Parameters
     ----------
     system : prefriction.Oscillator
-        The stage: mass [kg] and Dahl friction (rest stiffness sigma [N/m]).
+        The stage: mass [kg] and a friction model with rest stiffness ``sigma`` [N/m].
     controller : PID or control.LTI
         Controller from the error ``e = r - x`` [m] to the force ``u`` [N], continuous or discrete.
     regime : {"presliding", "sliding"}, default "presliding"
@@ -144,7 +147,16 @@ def closed_loop(
     -------
     control.StateSpace
         The closed loop ``r -> x`` (discrete with the controller's ``dt`` if it is discrete).
+
+    Raises
+    ------
+    TypeError
+        ``system`` is not an Oscillator, ``controller`` no PID or SISO LTI, ``warn`` not
+        ``True`` or ``False``.
+    ValueError
+        ``regime`` unknown, or a discrete controller without a sample time.
     """
+    warn = check_bool("warn", warn)
     C = as_lti(controller)
     Ts = _sample_time(C)
     P = linear_plant(system, regime, Ts)

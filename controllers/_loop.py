@@ -23,7 +23,7 @@ from prefriction.analysis.branch import force_after_distance
 from prefriction.signals import Signal
 from prefriction.simulation.feedback import LinearFeedback, sample_count
 from prefriction.simulation.loops import LoopStats, run_sampled
-from prefriction._validation import check_positive, check_signal
+from prefriction._validation import check_positive, check_real_array, check_signal
 from prefriction.models import Oscillator
 from prefriction.reversals import ReversalTable
 from prefriction.simulation.simulate import SimulationResult
@@ -203,6 +203,27 @@ def _evaluate(reference: Reference, t: np.ndarray) -> np.ndarray:
     return np.full(t.shape, float(reference))
 
 
+def _check_reference(reference: Any) -> Reference:
+    """The reference as :func:`check_signal` returns it; samples ``(t, r)`` must be finite real
+    numbers (``TypeError``/``ValueError`` naming the reference otherwise)."""
+    if isinstance(reference, tuple) and len(reference) == 2:
+        for part, letter, unit in zip(reference, ("t", "r"), ("s", "m")):
+            check_real_array(f"reference samples {letter}", part, unit)
+    return check_signal("reference", reference, "m", "r")
+
+
+def _check_t_out(t_out: Any, t_end: float) -> np.ndarray:
+    """``t_out`` as a 1-D float array of strictly increasing times in ``[0, t_end]`` [s]."""
+    times = check_real_array("t_out", t_out, "s", lo=0.0, hi=t_end)
+    if times.ndim != 1 or times.size < 1:
+        raise ValueError(f"t_out must be a 1-D array of at least 1 output time [s], got an array of shape {times.shape}")
+    if np.any(np.diff(times) <= 0.0):
+        i = int(np.flatnonzero(np.diff(times) <= 0.0)[0])
+        raise ValueError(f"t_out must be strictly increasing, got t_out[{i + 1}] = {float(times[i + 1])!r} "
+                         f"<= t_out[{i}] = {float(times[i])!r}")
+    return times
+
+
 def _dc_gain(C: control.StateSpace) -> Optional[float]:
     try:
         with np.errstate(all="ignore"):
@@ -304,7 +325,7 @@ def simulate_loop(
     """
     _check_system(system)
     t_end = check_positive("t_end", t_end)
-    reference = check_signal("reference", reference, "m", "r")
+    reference = _check_reference(reference)
     if Ts is not None:
         Ts = check_positive("Ts", Ts)
     if discretization not in DISCRETIZATIONS:
@@ -349,7 +370,7 @@ def simulate_loop(
                 k_aw=controller.back_calculation_gain() if saturated else None,
             )
     else:
-        dense = np.linspace(0.0, t_end, 2001) if t_out is None else np.asarray(t_out, dtype=float)
+        dense = np.linspace(0.0, t_end, 2001) if t_out is None else _check_t_out(t_out, t_end)
         fb = LinearFeedback(A=C.A, B=C.B, C=C.C, D=C.D, Ts=Ts, reference=fb_reference, xc0=xc0)
         sim = prefriction.simulate(system, v0, x0=x0, F0=F0, t_end=t_end, rtol=rtol, dense=dense, feedback=fb, jit=jit)
     t = sim.t

@@ -403,13 +403,11 @@ ROWS += rows_for("controllers.design_pid", ctl.design_pid, dict(system=STAGE, wn
 ROWS += rows_for("controllers.linear_plant", ctl.linear_plant, dict(system=STAGE, regime="presliding", Ts=None), dict(
     system=bad_system_any, regime=bad_str, Ts=bad_positive.filter(lambda v: v is not None)))
 ROWS += rows_for("controllers.closed_loop", ctl.closed_loop, dict(system=STAGE, controller=PIDC, regime="presliding", warn=True),
-                 dict(system=bad_system_any, controller=st.sampled_from([None, 3, "pid", STAGE]), regime=bad_str, warn=bad_bool),
-                 owner={"warn": "controllers/_linear.py"})
+                 dict(system=bad_system_any, controller=st.sampled_from([None, 3, "pid", STAGE]), regime=bad_str, warn=bad_bool))
 ROWS += rows_for("controllers.margins", ctl.margins, dict(system=STAGE, controller=PIDC, regime="presliding"), dict(
     system=bad_system_any, controller=st.sampled_from([None, 3, "pid", STAGE]), regime=bad_str))
 ROWS += rows_for("controllers.plant_iosys", ctl.plant_iosys, dict(system=STAGE, Ts=None, solve_ivp_kwargs=None), dict(
     system=bad_system_any, Ts=bad_positive.filter(lambda v: v is not None), solve_ivp_kwargs=st.sampled_from([3, "rk", [1]])))
-LOOP = "controllers/_loop.py"
 ROWS += rows_for("controllers.simulate_loop", ctl.simulate_loop,
                  dict(system=STAGE, controller=PIDC, reference=1e-5, t_end=0.01, Ts=None, discretization="zoh",
                       x0=0.0, v0=0.0, F0=0.0, xc0=None, t_out=None, rtol=1e-8, jit=True), dict(
@@ -417,8 +415,7 @@ ROWS += rows_for("controllers.simulate_loop", ctl.simulate_loop,
     reference=BAD_SAMPLES | st.sampled_from([NAN, "fast", 1 + 1j]), t_end=bad_positive,
     Ts=bad_positive.filter(lambda v: v is not None) | st.sampled_from([1e-300, 1e-12]), discretization=bad_str,
     x0=bad_real, v0=bad_real, F0=bad_real | st.sampled_from([2.0]), xc0=bad_array.filter(lambda v: v is not None),
-    t_out=bad_times.filter(lambda v: v is not None), rtol=bad_positive, jit=bad_bool),
-    owner=dict.fromkeys(["reference", "xc0", "t_out"], LOOP))
+    t_out=bad_times.filter(lambda v: v is not None), rtol=bad_positive, jit=bad_bool))
 
 # command line -------------------------------------------------------------------------------
 TABLE_BAD = {
