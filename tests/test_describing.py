@@ -3,8 +3,8 @@ the closed form, python-control's own numerical DF, and predicted against simula
 
 from __future__ import annotations
 
+import dataclasses
 import math
-from dataclasses import replace as dataclasses_replace
 import warnings
 
 import control
@@ -250,7 +250,7 @@ def test_velocity_and_trace_bad_arguments():
     stable = predict_limit_cycle(control.tf([4.0], [1.0, 2.0, 1.0, 0.0]), _Relay(), np.logspace(-1, 2, 31))
     with pytest.raises(ValueError, match="unstable LimitCycle"):
         trace_unstable_cycle(lugre, PID_UNSTABLE, stable)
-    unstable = dataclasses_replace(stable, stable=False)
+    unstable = dataclasses.replace(stable, stable=False)
     with pytest.raises(ValueError, match="bracket must be"):
         trace_unstable_cycle(lugre, PID_UNSTABLE, unstable, bracket=(1.2, 0.8))
     with pytest.raises(ValueError, match="variable"):

@@ -4,7 +4,6 @@ the closed form (Dahl gamma = 1) and against central differences of prefriction.
 from __future__ import annotations
 
 import dataclasses
-import math
 
 import mpmath
 import numpy as np

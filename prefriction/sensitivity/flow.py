@@ -21,9 +21,8 @@ from typing import Any, Optional, Sequence
 import casadi as ca
 import numpy as np
 
-from prefriction._validation import check_count, check_finite, check_interval, check_positive
 from prefriction.errors import SolverError
-from prefriction.models import Oscillator, check_oscillator
+from prefriction.models import Oscillator
 from prefriction.units import Scales
 
 _PID = ("kp", "ki", "kd", "tau")
