@@ -78,7 +78,7 @@ def plot(path: Path, rows: list[Row]) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(8, 5.5))
+    fig, ax = plt.subplots(figsize=(10, 5.5))
     for solver in dict.fromkeys(r.solver for r in rows):
         pts = [(r.seconds, r.error) for r in sorted(rows, key=lambda r: -r.tol)
                if r.solver == solver and math.isfinite(r.error) and math.isfinite(r.seconds)]
@@ -89,7 +89,7 @@ def plot(path: Path, rows: list[Row]) -> None:
     ax.set_ylabel("max relative error of reversal t, x, F [-]")
     ax.set_title("Work-precision, Dahl oscillator, sigma/Fc = 1e4 1/m, m = 1 kg, v0 = 1 m/s")
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))  # beside the axes: covers no point
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
