@@ -27,15 +27,18 @@ SIGMA, MASS = 1e4, 1.0  # Fc = 1 N: the time unit is sqrt(m / sigma) = 0.01 s, t
 
 
 def dahl_reference(gamma: float, v0: float, *, n: int | None = None, t_end: float = math.inf,
-                   amp: float = 0.0, w: float = 1.0, s0: float | None = None) -> np.ndarray:
+                   amp: float = 0.0, w: float = 1.0, s0: float | None = None,
+                   saturations: list | None = None) -> np.ndarray:
     """Reversals ``(t~, x~, F~)`` of ``x~'' = amp sin(w t~) - F~`` from ``x = F = 0``, ``v~ = v0``
     (normalised units); the first ``n`` or those before ``t_end``. ``s0`` is the first direction
-    when ``v0 = 0``."""
+    when ``v0 = 0``. ``saturations``, if given, receives the number of saturations (0 or 1) of
+    each half-cycle, the last one that after the last reversal."""
     e = 1.0 - gamma
     saturating = gamma < 1.0
     s = s0 if s0 is not None else math.copysign(1.0, v0)
     x, v, F, t, sat = 0.0, v0, 0.0, 0.0, False
     rows: list = []
+    sats = [0]
     atol = 1e-15 * max(abs(v0), amp, 1e-300)
     while (n is None or len(rows) < n) and t < t_end:
         def force(y: np.ndarray, s: float = s, sat: bool = sat) -> float:
@@ -69,11 +72,15 @@ def dahl_reference(gamma: float, v0: float, *, n: int | None = None, t_end: floa
         x, v = float(y[0]), float(y[1])
         if i == 1:
             F, sat = s, True
+            sats[-1] += 1
             continue
         F, v = force(y), 0.0
         if s * (amp * math.sin(w * t) - F) < 0.0:  # the net force turns the mass back
             rows.append((t, x, F))
             s, sat = -s, False
+            sats.append(0)
+    if saturations is not None:
+        saturations.extend(sats)
     return np.array(rows).reshape(-1, 3)
 
 

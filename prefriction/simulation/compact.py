@@ -37,10 +37,13 @@ def advance_compact(self: "Run", t_target: float, n_target: float) -> bool:
     iz = [ix[f"z{i}"] for i in range(L.nz)]
     im = [ix[f"m{i}"] for i in range(L.nm)]
     tracks = ixh is None
+    ine = ix.get("ne")  # the model's event count (models with events)
     force, travel, reverse, snap = model.force, model.travel, model.reverse, self.snap
     P[:] = self.P0  # eps and the model's numbers q
     st, rev = self.st, self.rev
     x, v, z, m, s, t = st["x"], st["v"], st["z"], st["m"], st["s"], st["t"]
+    ne = st.get("ne", 0)  # model events since the last reversal
+    rev_events = self.rev_events
     grow = 1.0
     calls = 0
     t_stop = t_target * (1 - 1e-15) if t_target < math.inf else math.inf
@@ -58,6 +61,8 @@ def advance_compact(self: "Run", t_target: float, n_target: float) -> bool:
                 s = -s
                 z, m = reverse(z, m, s, q, snap)
                 rev.append((t, x, float(force(z, m, 0.0, s, q)), 0.0))
+                rev_events.append(ne)
+                ne = 0
             else:
                 t = t_target
             continue
@@ -78,6 +83,8 @@ def advance_compact(self: "Run", t_target: float, n_target: float) -> bool:
             X0[k] = z[i] / AF
         for i, k in enumerate(im):
             X0[k] = m[i]
+        if ine is not None:
+            X0[ine] = ne
         if not tracks:
             X0[ixh] = 0.0
         U[0], U[1] = t1 - t, t
@@ -94,13 +101,15 @@ def advance_compact(self: "Run", t_target: float, n_target: float) -> bool:
         c = out.tolist()
         if not (ok and math.isfinite(math.fsum(c))):
             self.calls += calls
-            st.update(x=x, v=v, z=z, m=m, s=s, t=t, F=F)
+            st.update(x=x, v=v, z=z, m=m, s=s, t=t, F=F, ne=ne)
             raise self._failure(why)
         if self.steps is not None:
             self._count_steps(call)
         z1 = [AF * c[k] for k in iz]
         x = x + travel(z, z1, s, q) if tracks else x + Ax * c[ixh]
         z, m = z1, [c[k] for k in im]
+        if ine is not None:
+            ne = int(c[ine] + 0.5)
         sv = s * c[iv] * eps
         if sv > -0.5:  # no reversal: vh is the velocity
             v = Av * c[iv]
@@ -115,8 +124,10 @@ def advance_compact(self: "Run", t_target: float, n_target: float) -> bool:
             # the force after the model's reset: an event within snap of the reversal is taken
             # as coinciding with it (the reset puts its state on the switching surface)
             rev.append((t, x, float(force(z, m, 0.0, s, q)), 0.0))
+            rev_events.append(ne)
+            ne = 0
             grow = 1.0
     self.calls += calls
-    st.update(x=x, v=v, z=z, m=m, s=s, t=t, F=float(force(z, m, v, s, q)))
+    st.update(x=x, v=v, z=z, m=m, s=s, t=t, F=float(force(z, m, v, s, q)), ne=ne)
     return n >= n_target
 

@@ -163,7 +163,7 @@ def _columns_together(run: "Run", cols: np.ndarray, pts: np.ndarray, is_sample: 
     L = run.L
     if new is not None:
         for j in np.flatnonzero(new[:-1]):
-            run.rev.extend(run._unpack(L, cols[:, j], a, len(run.rev), nstop)["new"])
+            run._record(run._unpack(L, cols[:, j], a, len(run.rev), nstop))
     run._accept(run._unpack(L, cols[:, -1], a, len(run.rev), nstop), float(pts[-1]))
     if is_sample.all():
         sel: "slice | np.ndarray" = slice(None)

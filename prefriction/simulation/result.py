@@ -28,6 +28,10 @@ class RunStats:
         Number of accepted integrator steps (None for compiled code, which keeps no statistics).
     jit : str
         ``"compiled"``, ``"cached"`` (compiled code loaded from disk or memory) or ``"interpreted"``.
+    events : int or None
+        Model events located in the whole run (element slips, Dahl's saturation; see
+        :attr:`SimulationResult.events`), including those after the last reversal; None if
+        the run does not count them.
     """
 
     wall_time: float
@@ -35,6 +39,7 @@ class RunStats:
     calls: int
     steps: Optional[int]
     jit: str
+    events: Optional[int] = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -65,6 +70,13 @@ class SimulationResult:
         Total applied force (input plus feedback) [N] at the sample times.
     xc : numpy.ndarray or None
         Controller states at the sample times, shape ``(len(t), n)`` (feedback only).
+    events : numpy.ndarray or None
+        Model events located on the half-cycle that ends at each reversal (int, aligned with
+        ``reversals``): each event counts the flags it changes, e.g. the elements of
+        Maxwell-slip or GMS that start to slip (two at once count 2), or Dahl's saturation
+        for gamma < 1. An event that coincides with the reversal (within ``rtol``, the model's
+        ``snap``) is taken as the reversal and not counted. The total, with the events after
+        the last reversal, is ``stats.events``. None if the run does not count them.
     """
 
     reversals: ReversalTable
@@ -80,7 +92,7 @@ class SimulationResult:
     E_f: Optional[np.ndarray] = None
     u: Optional[np.ndarray] = None
     xc: Optional[np.ndarray] = None
-
+    events: Optional[np.ndarray] = None
 
     @property
     def success(self) -> bool:
@@ -96,6 +108,8 @@ class SimulationResult:
         if self.t is not None:
             lines.append(f"samples: {len(self.t)} in [{self.t[0]:.6g}, {self.t[-1]:.6g}] s")
         st = self.stats
+        if st.events:
+            lines.append(f"model events: {st.events} (per half-cycle: events)")
         lines.append(f"run: {st.wall_time * 1e3:.3g} ms in {st.calls} integrator calls ({st.jit}), "
                      f"setup {st.setup_time:.3g} s")
         return "\n".join(lines)

@@ -127,7 +127,8 @@ def simulate(
     Returns
     -------
     SimulationResult
-        Reversal table (SI), stop status, run statistics and, if requested, samples.
+        Reversal table (SI), stop status, run statistics, the model events per half-cycle
+        (``events``; total ``stats.events``) and, if requested, samples.
 
     Raises
     ------
@@ -223,10 +224,16 @@ def simulate(
         status, message = 0, f"reached t_end = {t_end_si:.9g} s"
     wall = time.perf_counter() - start
 
-    table, W_r = _reversal_table(run.rev[: int(min(len(run.rev), n_target))], system, s0, v0, F0)
-    stats = RunStats(wall_time=wall, setup_time=run.setup_time, calls=run.calls, steps=run.steps, jit=run.mode)
+    n_rev = int(min(len(run.rev), n_target))
+    table, W_r = _reversal_table(run.rev[:n_rev], system, s0, v0, F0)
+    events = np.array(run.rev_events[:n_rev], dtype=int)
+    # after the last reversal: the events up to t_end (a run stopped at its reversal has none)
+    total = int(events.sum()) + (int(run.st.get("ne", 0)) if len(run.rev) <= n_rev else 0)
+    stats = RunStats(wall_time=wall, setup_time=run.setup_time, calls=run.calls, steps=run.steps, jit=run.mode,
+                     events=total)
     extra = samples_si(run, samples, u_hist, times_si, n_user) if len(samples) else {}
-    return SimulationResult(reversals=table, status=status, message=message, stats=stats, work_input=W_r, **extra)
+    return SimulationResult(reversals=table, status=status, message=message, stats=stats, work_input=W_r,
+                            events=events, **extra)
 
 
 def _check_amplitude(v0: float, F0: float, force_scale: float, sc: Scales) -> None:
@@ -282,7 +289,7 @@ def _initial_state(run: Run, x0: float, v0: float, F0: float, xc0: np.ndarray, *
     # differs from the state's force F0 when v0 != 0
     F = float(model.force(list(z), list(m), v0 / sc.v, s0, run.q))
     st = {"x": x0 / sc.x, "v": v0 / sc.v, "F": F, "z": list(z), "m": list(m),
-          "t": 0.0, "s": s0, "rest": rest, "W": 0.0, "Ef": 0.0, "xc": xc0, "uhold": 0.0}
+          "t": 0.0, "s": s0, "rest": rest, "W": 0.0, "Ef": 0.0, "xc": xc0, "uhold": 0.0, "ne": 0}
     return st, s0
 
 
