@@ -1,12 +1,13 @@
-"""Closed-loop simulation of a python-control controller around the reversal-aware Dahl stage.
+"""Closed-loop simulation of a python-control controller around the reversal-aware friction stage.
 
 :func:`simulate_loop` turns any SISO, proper python-control LTI controller (error ``e = r - x``
 [m] to force ``u`` [N]) into a :class:`prefriction.simulation.feedback.LinearFeedback`. A
 sampled controller runs in compiled code, many samples per call
 (:func:`prefriction.simulation.loops.run_sampled`); a continuous one, or a sampled one with a
 disturbance input, through :func:`prefriction.simulate`. Both integrate ``m x'' = u - F`` with
-the friction model and land on every velocity reversal (inside the sample intervals too)
-(``docs/controllers.md``).
+the stage's friction model (any model of the protocol :class:`prefriction.models.FrictionModel`:
+Dahl, Maxwell-slip, GMS, LuGre) and land on every velocity reversal and model event (inside
+the sample intervals too) (``docs/controllers.md``).
 """
 
 from __future__ import annotations
@@ -19,19 +20,22 @@ import control
 import numpy as np
 
 import prefriction
-from prefriction.analysis.branch import force_after_distance
 from prefriction.signals import Signal
 from prefriction.simulation.feedback import LinearFeedback, sample_count
 from prefriction.simulation.loops import LoopStats, run_sampled
-from prefriction._validation import check_positive, check_real_array, check_signal
+from prefriction._validation import check_count, check_positive, check_real_array, check_signal
 from prefriction.models import Oscillator
 from prefriction.reversals import ReversalTable
 from prefriction.simulation.simulate import SimulationResult
 
+from ._friction_loop import friction_curve
 from ._linear import _check_system, _sample_time, as_lti, closed_loop
 from ._pid import PID
 
 Reference = Union[float, Callable[[Any], Any], tuple]
+
+MAX_CURVE_POINTS = 10_000_000
+"""Most points of :meth:`LoopResult.friction_loop` (160 MB of positions and forces)."""
 
 DISCRETIZATIONS = ("zoh", "foh", "tustin", "bilinear", "backward_diff", "forward_diff", "euler", "gbt", "matched")
 
@@ -39,6 +43,11 @@ DISCRETIZATIONS = ("zoh", "foh", "tustin", "bilinear", "backward_diff", "forward
 @dataclass(frozen=True, eq=False)
 class LoopResult:
     """Result of :func:`simulate_loop`, SI units.
+
+    The energy balance of the run, with the work of the controller's force counted, is
+    ``prefriction.energy.analyze_result(loop)`` (potential energy at the reversals,
+    dissipation per half-cycle, the input's work ``int u v dt``; a sampled controller's force
+    held between the samples).
 
     Attributes
     ----------
@@ -65,7 +74,7 @@ class LoopResult:
         The stage that was simulated.
     kp : float or None
         Static gain of the controller at ``s = 0`` (or ``z = 1``) if it is finite and
-        positive (PD), ``None`` otherwise: then ``Fc / kp`` bounds the residual error.
+        positive (PD), ``None`` otherwise: then :attr:`error_bound` bounds the residual error.
     simulation : prefriction.simulation.simulate.SimulationResult
         The raw simulation result (run statistics, work of the input): of
         :func:`prefriction.simulate` for a continuous loop or a loop with a disturbance input,
@@ -93,7 +102,8 @@ class LoopResult:
 
     @property
     def Fc(self) -> float:
-        """Coulomb force of the stage [N]."""
+        """Reference force of the stage's friction model [N] (Dahl, LuGre: the Coulomb force;
+        Maxwell-slip: the sum of the slip forces)."""
         return self.system.friction.Fc
 
     @property
@@ -103,33 +113,47 @@ class LoopResult:
 
     @property
     def error_bound(self) -> Optional[float]:
-        """``Fc / kp`` [m], the bound of the residual error of a PD loop at rest; ``None`` otherwise."""
-        return None if self.kp is None else self.Fc / self.kp
+        """``F_max / kp`` [m], the bound of the residual error of a PD loop at rest; ``None`` otherwise.
+
+        At rest the control force ``kp e`` balances the friction force, at most the model's
+        largest force at rest ``F_max`` (``max_hysteretic_force``: ``Fc`` for Dahl and
+        Maxwell-slip, the static force ``Fs`` for LuGre)."""
+        return None if self.kp is None else self.system.friction.max_hysteretic_force / self.kp
 
     def friction_loop(self, points_per_branch: int = 200) -> tuple[np.ndarray, np.ndarray]:
-        """Friction force-displacement curve ``F(x)`` [m, N] through every reversal, exact between them.
+        """Friction force-displacement curve ``F(x)`` [m, N] from the first output sample through
+        every reversal to the last one.
 
-        The Dahl model is rate-independent: between two reversals ``F`` is the branch (3.4)/(3.5)
-        through the previous reversal as a function of ``x`` alone. The curve joins the initial
-        state, each reversal of :attr:`reversals` and the final state along these branches, so
-        it is exact however coarse the output samples are (e.g. 10 kHz samples of a stage whose
-        half-cycles last a fraction of a millisecond).
+        Dahl and Maxwell-slip are rate-independent with closed-form branches: between two
+        reversals ``F`` is a function of ``x`` alone (Dahl: the branch (3.4)/(3.5) through the
+        previous reversal; Maxwell-slip: every element a stop operator ``clip(F_i + k_i dx,
+        -W_i, W_i)`` from the virgin state of the initial force), so the curve is exact however
+        coarse the output samples are (e.g. 10 kHz samples of a stage whose half-cycles last a
+        fraction of a millisecond). For the other models (LuGre, GMS, any other model of the
+        protocol) the force depends on the velocity too: the curve is the output samples with
+        the reversals inserted in time order, exact at the reversals only.
+
+        Parameters
+        ----------
+        points_per_branch : int, default 200
+            Points on each branch between two reversals (Dahl and Maxwell-slip), ``>= 2``; at
+            most :data:`MAX_CURVE_POINTS` points in all.
+
+        Returns
+        -------
+        (numpy.ndarray, numpy.ndarray)
+            Positions ``x`` [m] and friction forces ``F`` [N] along the curve.
+
+        Raises
+        ------
+        TypeError, ValueError
+            ``points_per_branch`` not an integer ``>= 2``, or more than
+            :data:`MAX_CURVE_POINTS` points in all.
         """
-        sigma, Fc, gamma = self.system.friction.sigma, self.Fc, self.system.friction.gamma
-        xs = np.concatenate(([self.x[0]], self.reversals.x, [self.x[-1]]))
-        Fs = np.concatenate(([self.F[0]], self.reversals.F, [self.F[-1]]))
-        cx, cF = [xs[:1]], [Fs[:1]]
-        frac = np.linspace(0.0, 1.0, max(int(points_per_branch), 2))[1:]
-        for i in range(len(xs) - 1):
-            dx = xs[i + 1] - xs[i]
-            if dx == 0.0:
-                continue
-            s = 1.0 if dx > 0 else -1.0
-            xi = np.abs(dx) * frac * sigma / Fc
-            f = force_after_distance(np.full(xi.shape, s * Fs[i] / Fc), xi, gamma)
-            cx.append(xs[i] + dx * frac)
-            cF.append(s * Fc * f)
-        return np.concatenate(cx), np.concatenate(cF)
+        branches = len(self.reversals) + 1
+        points_per_branch = check_count("points_per_branch", points_per_branch, 2,
+                                        max(MAX_CURVE_POINTS // branches, 2), why=f"memory: {branches} branches")
+        return friction_curve(self.system, self.t, self.x, self.F, self.reversals, points_per_branch)
 
     @property
     def settling_time(self) -> float:
@@ -166,7 +190,8 @@ class LoopResult:
                 f"{self.residual_error:.4e} m, {len(self.reversals)} reversals)")
 
     def summary(self) -> str:
-        """A few readable lines: controller, settling, residual error (against ``Fc/kp``), reversals."""
+        """A few readable lines: controller, settling, residual error (against the PD bound
+        :attr:`error_bound`), reversals."""
         kind = f"sampled, Ts = {self.Ts:.4g} s" if self.Ts is not None else "continuous"
         lines = [
             f"closed loop ({kind}), t_end = {self.t[-1]:.6g} s, {len(self.t)} output samples",
@@ -177,7 +202,8 @@ class LoopResult:
         ]
         if self.error_bound is not None:
             ratio = abs(self.residual_error) / self.error_bound
-            lines.append(f"  PD bound Fc/kp          {self.error_bound: .6e} m  (|e| / bound = {ratio:.4f})")
+            name = "Fc/kp" if self.system.friction.max_hysteretic_force == self.Fc else "F_max/kp"
+            lines.append(f"  {'PD bound ' + name:<24}{self.error_bound: .6e} m  (|e| / bound = {ratio:.4f})")
         lines += [
             f"  friction force at t_end {self.F[-1]: .6e} N  (|F|/Fc = {abs(self.F[-1]) / self.Fc:.4f})",
             f"  peak control force      {np.max(np.abs(self.u)): .6e} N",
@@ -251,17 +277,19 @@ def simulate_loop(
     rtol: float = 1e-8,
     jit: bool = True,
 ) -> LoopResult:
-    """Simulate the positioning loop ``u = C(r - x)`` around the Dahl stage, every reversal located.
+    """Simulate the positioning loop ``u = C(r - x)`` around a friction stage, every reversal located.
 
-    The plant is :func:`prefriction.simulate`'s: ``m x'' = u - F`` with Dahl friction (3.2),
-    integrated in normalised units, with each velocity reversal located (inside a sample
-    interval too) and the hysteresis branch switched there.
+    The plant is :func:`prefriction.simulate`'s: ``m x'' = u - F`` with the stage's friction
+    model (Dahl (3.2), Maxwell-slip, GMS, LuGre or any other model of the protocol
+    :class:`prefriction.models.FrictionModel`), integrated in normalised units, with each
+    velocity reversal and model event (e.g. an element that starts to slip) located, inside a
+    sample interval too, and the model's state switched there.
 
     Parameters
     ----------
     system : prefriction.Oscillator
-        The stage: mass [kg] and :class:`prefriction.Dahl` friction. An input force of the
-        oscillator (``system.u``) acts as a disturbance added to the control force.
+        The stage: mass [kg] and friction model. An input force of the oscillator
+        (``system.u``) acts as a disturbance added to the control force.
     controller : controllers.PID or control.TransferFunction or control.StateSpace
         SISO, proper controller from the error ``e = r - x`` [m] to the force ``u`` [N].
         Continuous (its states are integrated with the plant) or discrete with ``dt > 0``
@@ -286,11 +314,13 @@ def simulate_loop(
     discretization : str, default "zoh"
         ``control.c2d`` method used when a continuous controller is given with ``Ts``.
     x0, v0, F0 : float, default 0.0
-        Initial position [m], velocity [m/s] and friction force [N] (``|F0| <= Fc``).
+        Initial position [m], velocity [m/s] and friction force [N] (``|F0|`` at most the
+        model's ``max_hysteretic_force``: ``Fc`` for Dahl, ``Fs`` for LuGre).
     xc0 : array_like, optional
-        Initial controller state (zeros by default).
+        Initial controller state, one finite real number per controller state (zeros by
+        default).
     t_out : array_like, optional
-        Output times [s] of a continuous loop, increasing in ``[0, t_end]`` (default 2001
+        Output times [s] of a continuous loop, strictly increasing in ``[0, t_end]`` (default 2001
         equally spaced). Not allowed with a sampled controller (its outputs are at ``k Ts``).
     rtol : float, default 1e-8
         Relative tolerance of the simulator, ``1e-13 <= rtol <= 1e-2``.
@@ -305,9 +335,11 @@ def simulate_loop(
     Raises
     ------
     ValueError
-        Non-positive or non-finite ``t_end`` or ``Ts``; more than ``MAX_SAMPLES`` samples; ``Ts`` different from the discrete
-        controller's ``dt``; malformed reference samples (lengths differ, not increasing,
-        not finite); an improper or non-SISO controller; ``t_out`` with a sampled controller.
+        Non-positive or non-finite ``t_end`` or ``Ts``; more than ``MAX_SAMPLES`` samples;
+        ``Ts`` different from the discrete controller's ``dt``; malformed reference samples
+        (lengths differ, not increasing, not finite); an improper or non-SISO controller;
+        ``t_out`` with a sampled controller, not 1-D, not strictly increasing or outside
+        ``[0, t_end]``; ``xc0`` of the wrong length or not finite.
     TypeError
         Wrong argument types, unknown keyword arguments, a reference callable that cannot be
         traced in a continuous loop.
