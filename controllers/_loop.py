@@ -13,203 +13,25 @@ the sample intervals too) (``docs/controllers.md``).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import Any, Callable, Optional, Union
 
 import control
 import numpy as np
 
 import prefriction
+from prefriction._validation import check_positive, check_real_array, check_signal
+from prefriction.models import Oscillator
 from prefriction.signals import Signal
 from prefriction.simulation.feedback import LinearFeedback, sample_count
-from prefriction.simulation.loops import LoopStats, run_sampled
-from prefriction._validation import check_count, check_positive, check_real_array, check_signal
-from prefriction.models import Oscillator
-from prefriction.reversals import ReversalTable
-from prefriction.simulation.simulate import SimulationResult
+from prefriction.simulation.loops import run_sampled
 
-from ._friction_loop import friction_curve
 from ._linear import _check_system, _sample_time, as_lti, closed_loop
+from ._loop_result import LoopResult
 from ._pid import PID
 
 Reference = Union[float, Callable[[Any], Any], tuple]
 
-MAX_CURVE_POINTS = 10_000_000
-"""Most points of :meth:`LoopResult.friction_loop` (160 MB of positions and forces)."""
-
 DISCRETIZATIONS = ("zoh", "foh", "tustin", "bilinear", "backward_diff", "forward_diff", "euler", "gbt", "matched")
-
-
-@dataclass(frozen=True, eq=False)
-class LoopResult:
-    """Result of :func:`simulate_loop`, SI units.
-
-    The energy balance of the run, with the work of the controller's force counted, is
-    ``prefriction.energy.analyze_result(loop)`` (potential energy at the reversals,
-    dissipation per half-cycle, the input's work ``int u v dt``; a sampled controller's force
-    held between the samples).
-
-    Attributes
-    ----------
-    t : numpy.ndarray
-        Output times [s]: the sample instants ``k Ts`` (sampled controller) or the requested
-        output times (continuous controller).
-    reference : numpy.ndarray
-        Reference ``r(t)`` [m].
-    x, v, F : numpy.ndarray
-        Position [m], velocity [m/s], friction force [N].
-    u : numpy.ndarray
-        Control force [N] (for a sampled controller the value held from ``t[k]`` on).
-    error : numpy.ndarray
-        ``r - x`` [m].
-    xc : numpy.ndarray
-        Controller states, shape ``(len(t), n)``.
-    reversals : prefriction.ReversalTable
-        Every velocity reversal, located by the simulator (times, positions, forces, energies).
-    Ts : float or None
-        Sample time of the controller [s]; ``None`` for a continuous controller.
-    controller : control.StateSpace
-        The controller that ran (after ``c2d`` if the loop discretised it).
-    system : prefriction.Oscillator
-        The stage that was simulated.
-    kp : float or None
-        Static gain of the controller at ``s = 0`` (or ``z = 1``) if it is finite and
-        positive (PD), ``None`` otherwise: then :attr:`error_bound` bounds the residual error.
-    simulation : prefriction.simulation.simulate.SimulationResult
-        The raw simulation result (run statistics, work of the input): of
-        :func:`prefriction.simulate` for a continuous loop or a loop with a disturbance input,
-        of the compiled loop :func:`prefriction.simulation.loops.run_sampled` otherwise.
-    loop_stats : prefriction.simulation.loops.LoopStats or None
-        Blocks, integrated and resting periods of the compiled sampled loop; ``None`` for the
-        other paths.
-    """
-
-    t: np.ndarray
-    reference: np.ndarray
-    x: np.ndarray
-    v: np.ndarray
-    F: np.ndarray
-    u: np.ndarray
-    error: np.ndarray
-    xc: np.ndarray
-    reversals: ReversalTable
-    Ts: Optional[float]
-    controller: control.StateSpace
-    system: Oscillator
-    kp: Optional[float]
-    simulation: SimulationResult
-    loop_stats: Optional[LoopStats] = None
-
-    @property
-    def Fc(self) -> float:
-        """Reference force of the stage's friction model [N] (Dahl, LuGre: the Coulomb force;
-        Maxwell-slip: the sum of the slip forces)."""
-        return self.system.friction.Fc
-
-    @property
-    def residual_error(self) -> float:
-        """Error ``r - x`` at the last output time [m]."""
-        return float(self.error[-1])
-
-    @property
-    def error_bound(self) -> Optional[float]:
-        """``F_max / kp`` [m], the bound of the residual error of a PD loop at rest; ``None`` otherwise.
-
-        At rest the control force ``kp e`` balances the friction force, at most the model's
-        largest force at rest ``F_max`` (``max_hysteretic_force``: ``Fc`` for Dahl and
-        Maxwell-slip, the static force ``Fs`` for LuGre)."""
-        return None if self.kp is None else self.system.friction.max_hysteretic_force / self.kp
-
-    def friction_loop(self, points_per_branch: int = 200) -> tuple[np.ndarray, np.ndarray]:
-        """Friction force-displacement curve ``F(x)`` [m, N] from the first output sample through
-        every reversal to the last one.
-
-        Dahl and Maxwell-slip are rate-independent with closed-form branches: between two
-        reversals ``F`` is a function of ``x`` alone (Dahl: the branch (3.4)/(3.5) through the
-        previous reversal; Maxwell-slip: every element a stop operator ``clip(F_i + k_i dx,
-        -W_i, W_i)`` from the virgin state of the initial force), so the curve is exact however
-        coarse the output samples are (e.g. 10 kHz samples of a stage whose half-cycles last a
-        fraction of a millisecond). For the other models (LuGre, GMS, any other model of the
-        protocol) the force depends on the velocity too: the curve is the output samples with
-        the reversals inserted in time order, exact at the reversals only.
-
-        Parameters
-        ----------
-        points_per_branch : int, default 200
-            Points on each branch between two reversals (Dahl and Maxwell-slip), ``>= 2``; at
-            most :data:`MAX_CURVE_POINTS` points in all.
-
-        Returns
-        -------
-        (numpy.ndarray, numpy.ndarray)
-            Positions ``x`` [m] and friction forces ``F`` [N] along the curve.
-
-        Raises
-        ------
-        TypeError, ValueError
-            ``points_per_branch`` not an integer ``>= 2``, or more than
-            :data:`MAX_CURVE_POINTS` points in all.
-        """
-        branches = len(self.reversals) + 1
-        points_per_branch = check_count("points_per_branch", points_per_branch, 2,
-                                        max(MAX_CURVE_POINTS // branches, 2), why=f"memory: {branches} branches")
-        return friction_curve(self.system, self.t, self.x, self.F, self.reversals, points_per_branch)
-
-    @property
-    def settling_time(self) -> float:
-        """Settling time [s] into a 2 % band (:meth:`settling_time_within` with ``band = 0.02``)."""
-        return self.settling_time_within(0.02)
-
-    def settling_time_within(self, band: float) -> float:
-        """First time [s] after which ``x`` stays within ``band`` of the step around its final value.
-
-        Parameters
-        ----------
-        band : float
-            Relative band [-], ``0 < band < inf`` (0.02 for the usual 2 % settling time).
-
-        Returns
-        -------
-        float
-            The time [s]; the step is ``|x[-1] - x[0]|`` (not the reference: a PD loop with
-            friction stops short); ``nan`` if the position does not move.
-        """
-        band = check_positive("band", band)
-        step = abs(self.x[-1] - self.x[0])
-        if step == 0.0:
-            return math.nan
-        outside = np.nonzero(np.abs(self.x - self.x[-1]) > band * step)[0]
-        if outside.size == 0:
-            return float(self.t[0])
-        k = outside[-1] + 1
-        return float(self.t[min(k, len(self.t) - 1)])
-
-    def __repr__(self) -> str:
-        kind = f"sampled, Ts = {self.Ts:.4g} s" if self.Ts is not None else "continuous"
-        return (f"LoopResult({kind}, {len(self.t)} samples to t = {self.t[-1]:.6g} s, residual error "
-                f"{self.residual_error:.4e} m, {len(self.reversals)} reversals)")
-
-    def summary(self) -> str:
-        """A few readable lines: controller, settling, residual error (against the PD bound
-        :attr:`error_bound`), reversals."""
-        kind = f"sampled, Ts = {self.Ts:.4g} s" if self.Ts is not None else "continuous"
-        lines = [
-            f"closed loop ({kind}), t_end = {self.t[-1]:.6g} s, {len(self.t)} output samples",
-            f"  reference at t_end      {self.reference[-1]: .6e} m",
-            f"  position at t_end       {self.x[-1]: .6e} m",
-            f"  settling time (2 %)     {self.settling_time:.6g} s",
-            f"  residual error r - x    {self.residual_error: .6e} m",
-        ]
-        if self.error_bound is not None:
-            ratio = abs(self.residual_error) / self.error_bound
-            name = "Fc/kp" if self.system.friction.max_hysteretic_force == self.Fc else "F_max/kp"
-            lines.append(f"  {'PD bound ' + name:<24}{self.error_bound: .6e} m  (|e| / bound = {ratio:.4f})")
-        lines += [
-            f"  friction force at t_end {self.F[-1]: .6e} N  (|F|/Fc = {abs(self.F[-1]) / self.Fc:.4f})",
-            f"  peak control force      {np.max(np.abs(self.u)): .6e} N",
-            f"  velocity reversals      {len(self.reversals)}",
-        ]
-        return "\n".join(lines)
 
 
 def _evaluate(reference: Reference, t: np.ndarray) -> np.ndarray:
