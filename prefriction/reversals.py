@@ -119,14 +119,15 @@ def _column(name: str, values: Any, *, finite: bool) -> np.ndarray:
     """``values`` as a 1-D float array; ``TypeError`` unless real numbers, ``ValueError`` for a
     non-finite entry (``finite``) or an infinite one (NaN allowed: the quantity is not defined)."""
     allowed = "a 1-D array of real numbers"
+    text = repr(values) if len(repr(values)) <= 80 else repr(values)[:77] + "..."
     if values is None or isinstance(values, (str, bytes, dict, set)):
-        raise TypeError(f"table.{name} must be {allowed}, got {values!r} of type {type(values).__name__}")
+        raise TypeError(f"table.{name} must be {allowed}, got {text} of type {type(values).__name__}")
     try:
         raw = np.asarray(values)
     except (ValueError, TypeError):  # ragged nesting
-        raise TypeError(f"table.{name} must be {allowed}, got ragged or mixed nesting") from None
+        raise TypeError(f"table.{name} must be {allowed}, got {text} (ragged or mixed nesting)") from None
     if raw.dtype.kind not in "iuf":
-        raise TypeError(f"table.{name} must be {allowed}, got an array of dtype {raw.dtype}")
+        raise TypeError(f"table.{name} must be {allowed}, got {text} (an array of dtype {raw.dtype})")
     if raw.ndim != 1:
         raise ValueError(f"table.{name} must be {allowed}, got an array of shape {raw.shape}")
     arr = raw.astype(float)
@@ -134,5 +135,6 @@ def _column(name: str, values: Any, *, finite: bool) -> np.ndarray:
     if np.any(bad):
         i = int(np.flatnonzero(bad)[0])
         kind = "finite" if finite else "finite or NaN (not defined)"
-        raise ValueError(f"table.{name} must be {kind}, got a non-finite entry at index {i} (reversal {i + 1})")
+        raise ValueError(f"table.{name} must be {kind}, got a non-finite entry at index {i} (reversal {i + 1}): "
+                         f"{float(arr[i])!r}")
     return arr
