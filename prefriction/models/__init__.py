@@ -5,6 +5,9 @@
 - :class:`MaxwellSlip` (``maxwell_slip.py``): N elasto-plastic elements (Iwan; Lampaert et al.);
 - :class:`LuGre` (``lugre.py``): the LuGre model (Canudas de Wit et al. 1995);
 - :class:`GMS` (``gms.py``): the generalised Maxwell-slip model (Al-Bender et al. 2005);
+- ``elements.py``: the element machinery Maxwell-slip and GMS share
+  (:class:`~prefriction.models.elements.ParallelElements`);
+- ``element_curves.py``: the virgin curve of parallel elements and the energies on its branches;
 - :class:`Oscillator` (``oscillator.py``): mass, friction model and input force.
 """
 

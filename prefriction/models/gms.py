@@ -12,14 +12,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from functools import cached_property
-from typing import TYPE_CHECKING, Any, ClassVar, Hashable, Sequence
+from typing import TYPE_CHECKING, Any, ClassVar, Sequence
 
 import casadi as ca
 import numpy as np
 
-from prefriction.models.base import FrictionModel, Parameter
-from prefriction.models.maxwell_slip import TIE, _positive_array, _symbolic, _Virgin
+from prefriction.models.base import Parameter
+from prefriction.models.elements import TIE, ParallelElements, nonnegative_array, symbolic
 
 if TYPE_CHECKING:  # units imports the models
     from prefriction.units import Scales
@@ -28,30 +27,6 @@ __all__ = ["GMS", "ALPHA_SUM_TOL"]
 
 ALPHA_SUM_TOL = 1e-9
 """Allowed deviation of ``sum(alpha)`` from 1."""
-
-
-def _nonnegative_array(name: str, value: Any, n: int, unit: str) -> np.ndarray:
-    """``value`` as a read-only 1-D float array of ``n`` finite entries >= 0, or raise
-    ``TypeError``/``ValueError`` naming ``name``, the offending value and the allowed range."""
-    allowed = f"a 1-D array of {n} finite numbers >= 0 [{unit}] (one per element)"
-    if isinstance(value, (str, bytes, dict)):
-        raise TypeError(f"{name} must be {allowed} or None, got {value!r} of type {type(value).__name__}")
-    try:
-        raw = np.asarray(value)
-    except Exception as exc:  # ragged nested sequences and the like
-        raise TypeError(f"{name} must be {allowed} or None, got {value!r}") from exc
-    if raw.dtype == bool or not (np.issubdtype(raw.dtype, np.integer) or np.issubdtype(raw.dtype, np.floating)):
-        raise TypeError(f"{name} must be {allowed} or None, got {value!r} (dtype {raw.dtype})")
-    arr = np.array(raw, dtype=float)
-    if arr.ndim != 1 or arr.size != n:
-        raise ValueError(f"{name} must be {allowed}, got an array of shape {arr.shape}")
-    bad = ~(np.isfinite(arr) & (arr >= 0.0))
-    if np.any(bad):
-        i = int(np.flatnonzero(bad)[0])
-        raise ValueError(f"{name}[{i}] must be finite and >= 0, got {float(arr[i])!r} "
-                         f"(allowed range: 0 <= {name}[i] < inf [{unit}])")
-    arr.flags.writeable = False
-    return arr
 
 
 def _exp(x: Any) -> Any:
@@ -76,7 +51,7 @@ def _pow(x: Any, y: Any) -> Any:
 
 
 @dataclass(frozen=True, eq=False)
-class GMS(FrictionModel):
+class GMS(ParallelElements):
     """Generalised Maxwell-slip friction (Al-Bender, Lampaert and Swevers 2005).
 
     F. Al-Bender, V. Lampaert, J. Swevers, "The generalized Maxwell-slip model: a novel model
@@ -223,59 +198,27 @@ class GMS(FrictionModel):
     )
     rate_independent: ClassVar[bool] = False
 
-    def __post_init__(self) -> None:
-        self._validate()
+    _stiffness_field: ClassVar[str] = "k"
 
     def _validate(self) -> None:
         """Check the arrays elementwise and their lengths, the scalars against their ranges,
         ``sum(alpha) = 1`` and ``Fs >= Fc``."""
-        k = _positive_array("k", self.k, "N/m")
-        alpha = _positive_array("alpha", self.alpha, "-")
-        if alpha.size != k.size:
-            raise ValueError(f"k and alpha must have the same length (one entry per element), "
-                             f"got {k.size} and {alpha.size}")
+        k, alpha = self._element_arrays(("k", "N/m"), ("alpha", "-"))
         total = math.fsum(alpha.tolist())
         if not abs(total - 1.0) <= ALPHA_SUM_TOL:
             raise ValueError(f"alpha must sum to 1 (the elements' fractions of the Stribeck force; allowed: "
                              f"|sum(alpha) - 1| <= {ALPHA_SUM_TOL:g}), got sum {total!r} from {alpha.tolist()!r}")
-        object.__setattr__(self, "k", k)
-        object.__setattr__(self, "alpha", alpha)
         for par in self.parameters:
             if par.name not in ("k", "alpha", "damping"):
                 object.__setattr__(self, par.name, par.check(getattr(self, par.name)))
         damping = np.zeros(k.size) if self.damping is None else self.damping
-        damping = _nonnegative_array("damping", damping, k.size, "N s/m")
-        damping.flags.writeable = False
+        damping = nonnegative_array("damping", damping, k.size, "N s/m")
         object.__setattr__(self, "damping", damping)
         if not self.Fs >= self.Fc:
             raise ValueError(f"Fs must be a finite number in [Fc, inf) = [{self.Fc!r}, inf) [N] (the static "
                              f"force is at least the Coulomb force Fc), got {self.Fs!r}")
 
-    def __eq__(self, other: object) -> bool:
-        if type(other) is not type(self):
-            return NotImplemented
-        return all(np.array_equal(getattr(self, f), getattr(other, f)) for f in _FIELDS)
-
-    def __hash__(self) -> int:
-        return hash((type(self).__qualname__,) + tuple(
-            tuple(v.tolist()) if isinstance(v, np.ndarray) else v for v in (getattr(self, f) for f in _FIELDS)))
-
-    def __reduce__(self) -> tuple:
-        # rebuilt (and re-validated) from the numbers: the arrays come back read-only
-        return (type(self), tuple(v.tolist() if isinstance(v, np.ndarray) else v
-                                  for v in (getattr(self, f) for f in _FIELDS)))
-
     # --- normalisation ---------------------------------------------------------------------
-    @property
-    def n_elements(self) -> int:
-        """Number of elements ``N``."""
-        return int(self.k.size)
-
-    @property
-    def sigma(self) -> float:  # type: ignore[override]
-        """Rest stiffness ``sum k_i`` [N/m]."""
-        return math.fsum(self.k.tolist())
-
     def stribeck(self, v: Any) -> np.ndarray:
         """Stribeck curve ``S(v) = Fc + (Fs - Fc) exp(-|v / vs|^delta)`` [N] (a magnitude) at the
         velocities ``v`` [m/s] (numpy)."""
@@ -289,22 +232,6 @@ class GMS(FrictionModel):
         return np.sign(v) * self.stribeck(v) + self.sigma2 * v
 
     # --- structure and numbers ------------------------------------------------------------
-    @property
-    def n_states(self) -> int:
-        """``N`` element forces and the retrace guard ``r``."""
-        return self.n_elements + 1
-
-    @property
-    def n_flags(self) -> int:
-        return self.n_elements
-
-    @property
-    def n_events(self) -> int:
-        return self.n_elements
-
-    def structure_key(self) -> Hashable:
-        return ("GMS", self.n_elements)
-
     def runtime_params_for(self, scales: "Scales") -> np.ndarray:
         """``q = (kappa_i, alpha_i, mu_i, Fs/Fc - 1, V/vs, delta/2, C/(sigma V), sigma2 V/Fc)``
         with the velocity unit ``V = scales.v = Fc / sqrt(m sigma)`` of the system (class notes)."""
@@ -318,9 +245,9 @@ class GMS(FrictionModel):
         """The numbers :meth:`runtime_params_for` gives for a unit mass (``m = 1 kg``)."""
         return self.runtime_params_for(_UnitMass(self.Fc / math.sqrt(self.sigma)))
 
-    @cached_property
-    def _virgin(self) -> _Virgin:
-        return _Virgin(self.k / self.sigma, np.array(self.alpha, dtype=float))
+    def _element_fractions(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(k_i / sigma, alpha_i)``: the Maxwell-slip elements with slip forces ``alpha_i Fc``."""
+        return self.k / self.sigma, np.array(self.alpha, dtype=float)
 
     # --- dynamics -------------------------------------------------------------------------
     def _S(self, v: Any, q: Any) -> Any:
@@ -329,36 +256,17 @@ class GMS(FrictionModel):
         r = v * q[3 * n + 1]
         return 1.0 + q[3 * n] * _exp(-_pow(r * r, q[3 * n + 2]))
 
-    def initial_state(self, f0: float, s: float) -> tuple[list[float], list[float]]:
-        """The state on the virgin curve of the Maxwell-slip model with slip forces ``alpha_i Fc``
-        with normalised force ``f0`` (``|f0| <= 1``); elements at their limit slip if ``s`` is
-        the direction of ``f0``."""
-        if not abs(f0) <= 1.0 + 1e-12:
-            raise ValueError(f"f0 must lie in [-1, 1] (F0 within [-Fc, Fc]), got {f0!r}")
-        n = self.n_elements
-        if f0 == 0.0:
-            return [0.0] * (n + 1), [0.0] * n
-        kappa, w = self.k / self.sigma, self.alpha
-        v = self._virgin
-        a = min(abs(f0), 1.0)
-        j = int(v.segment_of_force(np.array(a)))
-        y = float(v.inverse(np.array(a)))
-        order = np.argsort(w / kappa, kind="stable")
-        at_limit = np.zeros(n, dtype=bool)
-        at_limit[order[:j]] = True  # segment j: the j smallest slip deflections are at their limit
-        sg = 1.0 if f0 > 0 else -1.0
-        z = [sg * float(w[i]) if at_limit[i] else sg * float(kappa[i]) * y for i in range(n)]
-        m = [1.0 if (at_limit[i] and s * sg > 0) else 0.0 for i in range(n)]
-        return z + [0.0], m
+    def _virgin_force(self, f0: float) -> float:
+        """``f0`` within ``[-1, 1]``: ``alpha`` sums to 1 only within :data:`ALPHA_SUM_TOL`, so
+        the virgin curve may end above ``Fc``; the initial force stays within ``Fc``."""
+        return math.copysign(min(abs(f0), 1.0), f0)
 
     def rate(self, z: Sequence[Any], m: Sequence[Any], v: Any, s: Any, q: Any) -> list[Any]:
         n = self.n_elements
         S = self._S(v, q)
         C = q[3 * n + 3]
         out = [(1.0 - m[i]) * (q[i] * v) + m[i] * (C * (s - z[i] / (q[n + i] * S))) for i in range(n)]
-        back = -2.0 * s * v  # > 0 only past a reversal inside a trial step of the integrator
-        back = ca.fmax(back, 0.0) if _symbolic(back) else max(back, 0.0)
-        return out + [back]
+        return out + [self._guard_rate(v, s)]
 
     def force(self, z: Sequence[Any], m: Sequence[Any], v: Any, s: Any, q: Any) -> Any:
         n = self.n_elements
@@ -373,17 +281,9 @@ class GMS(FrictionModel):
         n = self.n_elements
         return 1.0 - s * (z[j] + q[j] * z[n]) / (q[n + j] * self._S(v, q))
 
-    def events(self, z: Sequence[Any], m: Sequence[Any], v: Any, s: Any, q: Any) -> list[Any]:
-        sym = _symbolic(z, m, v, s, q)
-        out = []
-        for i in range(self.n_elements):
-            ind = self._indicator(i, z, v, s, q)
-            out.append(ca.if_else(m[i] > 0.5, 1.0, ind) if sym else (1.0 if m[i] > 0.5 else ind))
-        return out
-
     def on_event(self, k: int, z: Sequence[Any], m: Sequence[Any], s: Any, q: Any) -> tuple[list[Any], list[Any]]:
         n = self.n_elements
-        sym = _symbolic(z, m, s, q)
+        sym = symbolic(z, m, s, q)
         mn = list(m)
         mn[k] = 1.0 + 0.0 * q[n + k]
         # the firing element is at its limit: s (z_k + kappa_k r) / alpha_k = S~(v). A sticking
@@ -400,22 +300,10 @@ class GMS(FrictionModel):
         return list(z), mn
 
     def reverse(self, z: Sequence[Any], m: Sequence[Any], s_new: Any, q: Any, snap: Any) -> tuple[list[Any], list[Any]]:
+        """A sticking element within ``snap`` of its limit ``alpha_j S~(0)`` is put on it."""
         n = self.n_elements
-        s_old = -s_new
-        sym = _symbolic(z, m, s_new, q, snap)
         S0 = 1.0 + q[3 * n]  # S~ at v = 0: Fs / Fc
-        zn = []
-        for j in range(n):
-            lim = q[n + j] * S0
-            near = 1.0 - s_old * z[j] / lim < snap  # a sticking element at its limit at the reversal
-            if sym:
-                zn.append(ca.if_else(ca.logic_and(m[j] < 0.5, near), s_old * lim, z[j]))
-            else:
-                zn.append(s_old * float(lim) if (m[j] < 0.5 and near) else z[j])
-        return zn + [0.0 * z[n]], [0.0] * n
-
-
-_FIELDS = ("k", "alpha", "Fc", "Fs", "vs", "C", "sigma2", "damping", "delta")
+        return self._put_on_limits(z, m, s_new, q, snap, [q[n + j] * S0 for j in range(n)], sticking_only=True)
 
 
 @dataclass(frozen=True)
