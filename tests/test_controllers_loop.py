@@ -199,6 +199,16 @@ def test_argument_errors():
         controllers.simulate_loop(system, pd, [0.0, 1e-6], 0.01)
     with pytest.raises(TypeError, match="unexpected keyword argument 'ts'"):
         controllers.simulate_loop(system, pd, 1e-6, 0.01, ts=1e-4)
+    with pytest.raises(ValueError, match=r"t_out must be strictly increasing, got t_out\[2\] = 0.001 <= t_out\[1\] = 0.002"):
+        controllers.simulate_loop(system, pd, 1e-6, 0.01, t_out=[0.0, 0.002, 0.001])
+    with pytest.raises(ValueError, match=r"t_out\[1\] must be finite and in \[0.0, 0.01\] \[s\], got 0.02"):
+        controllers.simulate_loop(system, pd, 1e-6, 0.01, t_out=[0.0, 0.02])
+    with pytest.raises(TypeError, match="reference samples t must be a real number or an array of finite real numbers"):
+        controllers.simulate_loop(system, pd, ("ab", "cd"), 0.01)
+    with pytest.raises(ValueError, match=r"xc0 must be a vector of length n = 1 \(the controller states of A\), got \[0.0, 0.0\]"):
+        controllers.simulate_loop(system, pd, 1e-6, 0.01, xc0=[0.0, 0.0])
+    with pytest.raises(TypeError, match="warn must be True or False, got 'yes'"):
+        controllers.closed_loop(system, pd, warn="yes")
     with pytest.raises(ValueError, match="unspecified sample time"):
         controllers.simulate_loop(system, control.tf([1.0], [1.0, -0.5], True), 1e-6, 0.01)
     limited = controllers.design_pid(system, wn=2 * np.pi * 150, u_max=5.0)
