@@ -147,3 +147,19 @@ def test_gamma_0_saturating_and_from_a_force() -> None:
         for rtol in (1e-6, 1e-10):
             got = normalised(pf.simulate(system, v0, F0=F0, reversals=200, rtol=rtol))
             assert error(got, exact) <= rtol
+
+
+def test_response_far_below_its_forcing() -> None:
+    """``u = 0.5 sin(30 w0 t)`` N from rest: the friction force reaches 1/30 of the forcing (its
+    reversals 1/150 to 1/30). Reversal times within rtol, positions and forces within 10 rtol of their largest
+    values (measured 0.9-1.3 rtol; with the error control relative to the forcing 18-49 rtol)."""
+    w = 30.0  # normalised (w0 = 1)
+    system = pf.Oscillator(pf.Dahl(SIGMA, 1.0, 1.0), MASS, u=Sine(0.5, w * 100.0 / (2.0 * math.pi)))
+    ref = dahl_reference(1.0, 0.0, amp=0.5, w=w, t_end=10.0, s0=1.0)
+    assert len(ref) == 95 and np.max(np.abs(ref[:, 2])) < 0.5 / 25
+    for rtol in (1e-6, 1e-9):
+        got = normalised(pf.simulate(system, 0.0, t_end=0.1, rtol=rtol))
+        assert got.shape == ref.shape
+        assert np.max(np.abs(got[:, 0] / ref[:, 0] - 1.0)) <= rtol
+        for col in (1, 2):
+            assert np.max(np.abs(got[:, col] - ref[:, col])) <= 10 * rtol * np.max(np.abs(ref[:, col]))
