@@ -20,7 +20,7 @@ from prefriction.cli.bench.peers import scipy_events, scipy_noevents
 from prefriction.cli.bench.report import (headline_section, plot, reference_section, stiff_section,
                                           write_csv)
 from prefriction.cli.bench.timing import min_time
-from prefriction.cli.bench.work_precision import simulate_point
+from prefriction.cli.bench.work_precision import peer_rows, simulate_point
 from prefriction.reversals import ReversalTable
 
 
@@ -70,14 +70,28 @@ def test_min_time_stopping_rules(durations: list[float], kwargs: dict, n_calls: 
     assert got == best and last == durations[n_calls - 1]
 
 
-def test_scipy_peers_against_the_exact_table() -> None:
-    """The peers with restarts and on the |v| form (python-control, ~10 s, runs in the bench only)."""
+def test_peers_against_the_exact_table_and_their_rows() -> None:
+    """The peers with restarts and on the |v| form against exact_reversals (python-control, ~10 s,
+    runs in the bench only); a failing peer is a row with an infinite error, a slow one skips its
+    tighter tolerances."""
     case = Case("small", 1e4, 1.0, 1.0, 0.005)  # short first excursion: a short |v|-form span
     ref = pf.exact_reversals(case.system, case.v0, 50)
-    t, x, F = scipy_events(case, 1e-6, "DOP853")
-    assert reversal_error(case, t, x, F, ref) < 1e-5
     t, x, F = scipy_noevents(case, 1e-6, "DOP853")  # across the kinks at v = 0: less accurate
     assert reversal_error(case, t, x, F, ref) < 1e-3
+
+    def broken(tol: float) -> tuple:
+        raise RuntimeError(f"no convergence at {tol:g}")
+
+    solvers = [("scipy DOP853 +events", lambda tol: scipy_events(case, tol, "DOP853")), ("broken", broken)]
+    rows = peer_rows(case, ref, solvers, [1e-6, 1e-9], 1, budget=0.0)
+    assert [r.solver for r in rows] == ["scipy DOP853 +events"] * 2 + ["broken"] * 2
+    assert rows[0].tol == 1e-6 and rows[0].error < 1e-5 and rows[0].seconds > 0
+    assert math.isnan(rows[1].tol) and rows[1].note.startswith("tighter tolerances skipped (run took")
+    assert [(r.tol, r.error, r.note) for r in rows[2:]] == [
+        (1e-6, math.inf, "failed: no convergence at 1e-06"),
+        (1e-9, math.inf, "failed: no convergence at 1e-09")]  # a failure takes no time: no skip
+    text = format_rows(rows)
+    assert "tighter tolerances skipped" in text and "failed: no convergence at 1e-09" in text
 
 
 def test_simulate_rows_and_stability_in_process(headline_ref: ReversalTable) -> None:

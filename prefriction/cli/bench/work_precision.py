@@ -100,6 +100,55 @@ def _peers(case: Case) -> list[tuple[str, Callable[[float], tuple]]]:
     return solvers
 
 
+def peer_rows(case: Case, ref: ReversalTable, solvers: list[tuple[str, Callable[[float], tuple]]],
+              ladder: list[float], repeats: int, budget: float) -> list[Row]:
+    """Work-precision rows of the peers ``solvers`` on ``case`` over ``ladder``.
+
+    A peer that raises is a measured outcome: its row has an infinite error and the reason in its
+    note. Once one run of a peer takes longer than ``budget``, its tighter tolerances are skipped
+    and a note row says so.
+
+    Parameters
+    ----------
+    case : Case
+        The case.
+    ref : ReversalTable
+        Its exact reversals (at least 50).
+    solvers : list of (str, callable)
+        Row name and a function of the tolerance returning the reversal times [s], positions [m]
+        and forces [N].
+    ladder : list of float
+        Tolerances, loosest first.
+    repeats : int
+        Warm repeats per point (one if a call takes 0.5 s or more).
+    budget : float
+        Run time beyond which a peer's tighter tolerances are skipped [s].
+
+    Returns
+    -------
+    list of Row
+        The rows, peer by peer.
+    """
+    rows = []
+    for name, fn in solvers:
+        progress(f"{case.name.split()[0]}: {name}")  # the case's first word ("headline")
+        for tol in ladder:
+            try:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")
+                    res, sec = min_time(lambda: fn(tol), calls=repeats, stop_best=0.5)
+                err = reversal_error(case, res[0], res[1], res[2], ref)
+                rows.append(Row(case.name, name, tol, err, sec))
+            except Exception as exc:  # a peer failing is a measured outcome, not a bench failure
+                rows.append(Row(case.name, name, tol, math.inf, math.nan, note=f"failed: {exc}"[:60]))
+                sec = 0.0
+            if sec > budget:  # tighter tolerances would only take longer
+                rows.append(Row(case.name, name, math.nan, math.nan, math.nan,
+                                note=f"tighter tolerances skipped (run took {sec:.1f} s > {budget:g} s)"))
+                break
+    return rows
+
+
 def headline(ladder: list[float], repeats: int, peers: bool, budget: float) -> list[Row]:
     """Work-precision rows of the headline case for simulate and (if ``peers``) every peer.
 
@@ -123,22 +172,6 @@ def headline(ladder: list[float], repeats: int, peers: bool, budget: float) -> l
     ref = exact(case, N_REV)
     progress(f"headline: simulate over {len(ladder)} tolerances")
     rows = [simulate_point(case, tol, m, ref, 4 * repeats) for m in METHODS for tol in ladder]
-    if not peers:
-        return rows
-    for name, fn in _peers(case):
-        progress(f"headline: {name}")
-        for tol in ladder:
-            try:
-                with warnings.catch_warnings():
-                    warnings.simplefilter("ignore")
-                    res, sec = min_time(lambda: fn(tol), calls=repeats, stop_best=0.5)
-                err = reversal_error(case, res[0], res[1], res[2], ref)
-                rows.append(Row(case.name, name, tol, err, sec))
-            except Exception as exc:  # a peer failing is a measured outcome, not a bench failure
-                rows.append(Row(case.name, name, tol, math.inf, math.nan, note=f"failed: {exc}"[:60]))
-                sec = 0.0
-            if sec > budget:  # tighter tolerances would only take longer
-                rows.append(Row(case.name, name, math.nan, math.nan, math.nan,
-                                note=f"tighter tolerances skipped (run took {sec:.1f} s > {budget:g} s)"))
-                break
+    if peers:
+        rows += peer_rows(case, ref, _peers(case), ladder, repeats, budget)
     return rows
