@@ -13,8 +13,10 @@ import pytest
 
 import prefriction as pf
 from prefriction.cli.bench import main as bench_main
-from prefriction.cli.bench.sweep import (SweepRow, exact_tables, format_table, main, matched_rtol, reversal_error,
-                                         run_child, scipy_reversals, sweep_cases, targets, worker, write_csv)
+from prefriction.cli.bench.sweep import (ChildRun, SweepRow, exact_tables, format_table, main, match_notes,
+                                         matched_rtol, reversal_error, run_child, scipy_reversals, sweep_cases, targets,
+                                         worker, write_csv)
+from prefriction.cli.bench.sweep.measure import _child_row
 from prefriction.simulation.compiled import cache_dir
 
 SPEC = {"case": "gamma_ge1", "n": 2, "reference": None}
@@ -34,6 +36,12 @@ def test_warm_child_process_compiles_nothing(monkeypatch) -> None:
     child = run_child(SPEC, cache_dir())
     assert child.new_libraries == 0 and child.compile_lines == 0
     assert child.report["error"] < 1e-7 and child.report["failed"] == 0
+    # a row of warm children: the least time, the most compiles, a failed value (None) is inf
+    slower = ChildRun(dict(child.report, sweep_s=2 * child.report["sweep_s"], error=None), 1, 1)
+    row = _child_row(sweep_cases(2)[0], "warm", [slower, child], "exact_reversals")
+    assert row.end_to_end_s == child.report["sweep_s"] and (row.compiles, row.compile_lines) == (1, 1)
+    assert row.max_rel_error == math.inf and row.repeats == 2 and row.n_values == 2
+    assert row.jit == ",".join(f"{k}:{v}" for k, v in sorted(child.report["jit"].items()))
 
 
 def test_matched_scipy_rtol_reaches_the_target() -> None:
@@ -77,6 +85,10 @@ def test_targets_table_and_csv(tmp_path) -> None:
     assert "FAIL" in targets(slow, cases, quick=False)[0] and "PASS" in targets(slow, cases, quick=True)[0]
     twice = [dataclasses.replace(r, compiles=2, compile_lines=2) if r.run == "cold" else r for r in good]
     assert all("FAIL" in line for line in targets(twice, cases, quick=False))
+    assert match_notes(good) == []  # scipy's sweep error 5e-9 is within 1e-8
+    loose = [dataclasses.replace(r, scipy_error=3e-8) for r in good]
+    notes = match_notes(loose)
+    assert len(notes) == 3 and all("ratios are lower bounds" in n and "3.0e-08 > 1.0e-08" in n for n in notes)
     text = format_table(good)
     assert all(c.label in text for c in cases) and "30.0x" in text
     write_csv(tmp_path / "sweep.csv", good)
