@@ -8,6 +8,7 @@
 - ``elements.py``: the element machinery Maxwell-slip and GMS share
   (:class:`~prefriction.models.elements.ParallelElements`);
 - ``element_curves.py``: the virgin curve of parallel elements and the energies on its branches;
+- ``stribeck.py``: the Stribeck curve of GMS, in SI units and normalised;
 - :class:`Oscillator` (``oscillator.py``): mass, friction model and input force.
 """
 

@@ -6,6 +6,44 @@ for friction simulation and compensation", IEEE Transactions on Automatic Contro
 (constant slip forces) with a velocity-dependent slip force ``alpha_i S(v)`` and a rate law for
 the slipping elements; it is rate-dependent, so its numbers in normalised units depend on the
 mass (:meth:`GMS.runtime_params_for`). See :class:`GMS` and ``docs/models.md#other-models``.
+
+**The slipping law as written here.** It is quoted from the paper as ``dF_i/dt = sgn(v) C
+(1 - F_i / (alpha_i s(v)))`` with the steady-sliding curve ``s(v)``, which is odd in ``v``
+(``s(v) = sgn(v) S(v)``, so that ``F_i -> alpha_i s(v)`` in steady sliding); with the
+magnitude ``S`` that is ``s C (1 - s F_i / (alpha_i S))``, the form used here. (With a
+positive ``S`` and without the inner ``s``, ``F_i = +alpha_i S`` would be the target in
+both directions, an unstable one for ``v < 0``.) ``C`` is the attraction rate of the element
+*forces*, so its unit is N/s (``sgn(v) C`` is the initial slope ``F_i'`` of an element that
+slips far below its curve); formulations in element deflections ``d_i' = sgn(v) C' (1 -
+k_i d_i / (alpha_i s(v)))`` have ``C' = C / k_i`` [m/s] instead. The Stribeck curve with
+the shape exponent ``delta`` (2 by default, the Gaussian form) is the usual one of GMS.
+
+**Protocol** (the normalised numbers ``kappa_i``, ``mu_i``, ``C~``, ``sigma2~`` and the velocity
+unit ``V`` of the class notes). States ``z_i = F_i / Fc`` and the retrace guard ``r`` of
+:mod:`prefriction.models.elements` (``r' = 2 max(-s v~, 0)``, zero on every branch); flags
+``m_i`` (element ``i`` slips). With ``S~(v~) = 1 + (Fs/Fc - 1) exp(-((v~ V/vs)^2)^(delta/2))``::
+
+    z_i' = (1 - m_i) kappa_i v~ + m_i C~ (s - z_i / (alpha_i S~)),
+    F~   = sum_i (z_i + mu_i z_i') + sigma2~ v~.
+
+One event per element, indicator ``1 - s (z_i + kappa_i r) / (alpha_i S~(v~))`` while it
+sticks (``+1`` while it slips); it depends on the velocity, which ``events`` receives. The
+event sets ``m_i = 1`` and keeps ``z_i`` (``on_event`` does not receive the velocity, and
+the event is located to round-off: ``z_i = s alpha_i S~`` there); a sticking element that
+reaches its limit at the same instant (normalised force ``s z_j / alpha_j`` within
+:data:`~prefriction.models.elements.TIE` of the firing element's) slips with it. A
+reversal keeps every ``z_i``, clears the flags and the guard; a sticking element within
+``snap`` of its limit at the reversal (``S~(0) = Fs/Fc``) is put on it.
+
+``initial_state(f0, s)`` is the state on the virgin curve of the Maxwell-slip model with
+slip forces ``alpha_i Fc`` (elements at their limit slip if they move along ``f0``): below
+``alpha_i S(v)`` for every velocity, so no indicator starts negative, and ``|f0| <= 1``
+(``|F0| <= Fc``) is always reachable.
+
+**Force jumps with micro-damping.** ``sigma_i d_i'`` changes from ``sigma_i v`` to ``sigma_i
+F_i' / k_i`` at a slip, and at a reversal a slipping element's ``F_i'`` does not vanish at ``v =
+0`` (after the reversal it sticks); the reversal table of unforced runs records the force after
+the model's reset, that of forced runs the force before it.
 """
 
 from __future__ import annotations
@@ -19,6 +57,7 @@ import numpy as np
 
 from prefriction.models.base import Parameter
 from prefriction.models.elements import TIE, ParallelElements, nonnegative_array, symbolic
+from prefriction.models.stribeck import StribeckCurve
 
 if TYPE_CHECKING:  # units imports the models
     from prefriction.units import Scales
@@ -29,29 +68,8 @@ ALPHA_SUM_TOL = 1e-9
 """Allowed deviation of ``sum(alpha)`` from 1."""
 
 
-def _exp(x: Any) -> Any:
-    """``exp`` of a float or a CasADi symbol."""
-    return ca.exp(x) if isinstance(x, (ca.SX, ca.MX)) else math.exp(x)
-
-
-def _pow(x: Any, y: Any) -> Any:
-    """``x ** y`` for ``x >= 0`` (0 at ``x = 0``), of floats or CasADi symbols; ``inf`` instead of
-    ``OverflowError``. On symbols the power sits in ``if_else(x > 0, ...)``: the derivative of
-    ``x ** y`` with respect to ``y`` is ``log(x) x^y``, NaN at ``x = 0``, and CasADi's event
-    location differentiates the indicators (a NaN there stops the integrator at ``v = 0``)."""
-    if isinstance(x, (ca.SX, ca.MX)) or isinstance(y, (ca.SX, ca.MX)):
-        return ca.if_else(x > 0.0, x ** y, 0.0)
-    x = float(x)
-    if x <= 0.0:
-        return 0.0
-    try:
-        return x ** float(y)
-    except OverflowError:
-        return math.inf
-
-
 @dataclass(frozen=True, eq=False)
-class GMS(ParallelElements):
+class GMS(StribeckCurve, ParallelElements):
     """Generalised Maxwell-slip friction (Al-Bender, Lampaert and Swevers 2005).
 
     F. Al-Bender, V. Lampaert, J. Swevers, "The generalized Maxwell-slip model: a novel model
@@ -75,17 +93,6 @@ class GMS(ParallelElements):
     ``sigma_i`` (argument ``damping``, default 0) acting on the element deflection rates
     ``d_i' = F_i' / k_i``. In steady sliding every element slips at ``s alpha_i S(v)``:
     ``F = sign(v) S(v) + sigma2 v`` (:meth:`steady_force`).
-
-    **The slipping law as written here.** It is quoted from the paper as ``dF_i/dt = sgn(v) C
-    (1 - F_i / (alpha_i s(v)))`` with the steady-sliding curve ``s(v)``, which is odd in ``v``
-    (``s(v) = sgn(v) S(v)``, so that ``F_i -> alpha_i s(v)`` in steady sliding); with the
-    magnitude ``S`` that is ``s C (1 - s F_i / (alpha_i S))``, the form used here. (With a
-    positive ``S`` and without the inner ``s``, ``F_i = +alpha_i S`` would be the target in
-    both directions, an unstable one for ``v < 0``.) ``C`` is the attraction rate of the element
-    *forces*, so its unit is N/s (``sgn(v) C`` is the initial slope ``F_i'`` of an element that
-    slips far below its curve); formulations in element deflections ``d_i' = sgn(v) C' (1 -
-    k_i d_i / (alpha_i s(v)))`` have ``C' = C / k_i`` [m/s] instead. The Stribeck curve with
-    the shape exponent ``delta`` (2 by default, the Gaussian form) is the usual one of GMS.
 
     Parameters
     ----------
@@ -132,34 +139,15 @@ class GMS(ParallelElements):
     Fc``. The structure is ``N`` alone: one compiled plant serves every GMS with ``N``
     elements, whatever its numbers or mass.
 
-    Protocol: states ``z_i = F_i / Fc`` and the retrace guard ``r`` of
-    :class:`prefriction.MaxwellSlip` (``r' = 2 max(-s v~, 0)``, zero on every branch); flags
-    ``m_i`` (element ``i`` slips). With ``S~(v~) = 1 + (Fs/Fc - 1) exp(-((v~ V/vs)^2)^(delta/2))``::
+    The slipping law as quoted from the paper, and the states, rates, events and reversal map
+    of the protocol: module notes.
 
-        z_i' = (1 - m_i) kappa_i v~ + m_i C~ (s - z_i / (alpha_i S~)),
-        F~   = sum_i (z_i + mu_i z_i') + sigma2~ v~.
-
-    One event per element, indicator ``1 - s (z_i + kappa_i r) / (alpha_i S~(v~))`` while it
-    sticks (``+1`` while it slips); it depends on the velocity, which ``events`` receives. The
-    event sets ``m_i = 1`` and keeps ``z_i`` (``on_event`` does not receive the velocity, and
-    the event is located to round-off: ``z_i = s alpha_i S~`` there); a sticking element that
-    reaches its limit at the same instant (normalised force ``s z_j / alpha_j`` within
-    :data:`~prefriction.models.maxwell_slip.TIE` of the firing element's) slips with it. A
-    reversal keeps every ``z_i``, clears the flags and the guard; a sticking element within
-    ``snap`` of its limit at the reversal (``S~(0) = Fs/Fc``) is put on it.
-
-    ``initial_state(f0, s)`` is the state on the virgin curve of the Maxwell-slip model with
-    slip forces ``alpha_i Fc`` (elements at their limit slip if they move along ``f0``): below
-    ``alpha_i S(v)`` for every velocity, so no indicator starts negative, and ``|f0| <= 1``
-    (``|F0| <= Fc``) is always reachable.
-
-    ``F0`` of :func:`prefriction.simulate` is the elastic force ``sum F_i`` at the start. With
-    micro-damping the force jumps at a slip (``sigma_i d_i'`` changes from ``sigma_i v`` to
-    ``sigma_i F_i' / k_i``) and at a reversal (a slipping element's ``F_i'`` does not vanish at
-    ``v = 0``; after the reversal it sticks); the reversal table of unforced runs records the
-    force after the model's reset, that of forced runs the force before it. Rate-dependent
-    (``rate_independent = False``): the energy analysis refuses the model and the table's
-    ``E_p`` is NaN.
+    ``F0`` of :func:`prefriction.simulate` is the elastic force ``sum F_i`` at the start; with
+    micro-damping the force jumps at slips and reversals (module notes). Rate-dependent
+    (``rate_independent = False``): the table's ``E_p`` is NaN; the energy analysis
+    (:mod:`prefriction.energy`) analyses the model as the equal Maxwell-slip model when ``Fs =
+    Fc`` and there is no damping (next paragraph), and refuses any other configuration with a
+    ``TypeError``.
 
     With ``Fs = Fc`` and no damping (``damping``, ``sigma2`` zero) the model *is*
     :class:`prefriction.MaxwellSlip` with ``W_i = alpha_i Fc`` for every ``C`` and ``vs``: a
@@ -218,19 +206,6 @@ class GMS(ParallelElements):
             raise ValueError(f"Fs must be a finite number in [Fc, inf) = [{self.Fc!r}, inf) [N] (the static "
                              f"force is at least the Coulomb force Fc), got {self.Fs!r}")
 
-    # --- normalisation ---------------------------------------------------------------------
-    def stribeck(self, v: Any) -> np.ndarray:
-        """Stribeck curve ``S(v) = Fc + (Fs - Fc) exp(-|v / vs|^delta)`` [N] (a magnitude) at the
-        velocities ``v`` [m/s] (numpy)."""
-        v = np.asarray(v, dtype=float)
-        return self.Fc + (self.Fs - self.Fc) * np.exp(-np.abs(v / self.vs) ** self.delta)
-
-    def steady_force(self, v: Any) -> np.ndarray:
-        """Friction force [N] in steady sliding at the constant velocity ``v`` [m/s] (numpy):
-        ``sign(v) S(v) + sigma2 v`` (every element slipping at ``sign(v) alpha_i S(v)``)."""
-        v = np.asarray(v, dtype=float)
-        return np.sign(v) * self.stribeck(v) + self.sigma2 * v
-
     # --- structure and numbers ------------------------------------------------------------
     def runtime_params_for(self, scales: "Scales") -> np.ndarray:
         """``q = (kappa_i, alpha_i, mu_i, Fs/Fc - 1, V/vs, delta/2, C/(sigma V), sigma2 V/Fc)``
@@ -250,12 +225,6 @@ class GMS(ParallelElements):
         return self.k / self.sigma, np.array(self.alpha, dtype=float)
 
     # --- dynamics -------------------------------------------------------------------------
-    def _S(self, v: Any, q: Any) -> Any:
-        """Normalised Stribeck curve ``S~(v~) = 1 + (Fs/Fc - 1) exp(-((v~ V/vs)^2)^(delta/2))``."""
-        n = self.n_elements
-        r = v * q[3 * n + 1]
-        return 1.0 + q[3 * n] * _exp(-_pow(r * r, q[3 * n + 2]))
-
     def _virgin_force(self, f0: float) -> float:
         """``f0`` within ``[-1, 1]``: ``alpha`` sums to 1 only within :data:`ALPHA_SUM_TOL`, so
         the virgin curve may end above ``Fc``; the initial force stays within ``Fc``."""
@@ -263,7 +232,7 @@ class GMS(ParallelElements):
 
     def rate(self, z: Sequence[Any], m: Sequence[Any], v: Any, s: Any, q: Any) -> list[Any]:
         n = self.n_elements
-        S = self._S(v, q)
+        S = self._S(v, q, 3 * n)
         C = q[3 * n + 3]
         out = [(1.0 - m[i]) * (q[i] * v) + m[i] * (C * (s - z[i] / (q[n + i] * S))) for i in range(n)]
         return out + [self._guard_rate(v, s)]
@@ -279,7 +248,7 @@ class GMS(ParallelElements):
     def _indicator(self, j: int, z: Sequence[Any], v: Any, s: Any, q: Any) -> Any:
         """Slip indicator of element ``j``: ``1 - s (z_j + kappa_j r) / (alpha_j S~(v))``."""
         n = self.n_elements
-        return 1.0 - s * (z[j] + q[j] * z[n]) / (q[n + j] * self._S(v, q))
+        return 1.0 - s * (z[j] + q[j] * z[n]) / (q[n + j] * self._S(v, q, 3 * n))
 
     def on_event(self, k: int, z: Sequence[Any], m: Sequence[Any], s: Any, q: Any) -> tuple[list[Any], list[Any]]:
         n = self.n_elements
