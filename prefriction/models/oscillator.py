@@ -7,6 +7,7 @@ from typing import Any
 
 from prefriction._validation import check_positive
 from prefriction.models.base import FrictionModel
+from prefriction.signals import as_signal
 
 __all__ = ["Oscillator", "check_oscillator", "check_dahl_oscillator"]
 
@@ -35,8 +36,6 @@ class Oscillator:
     u: Any = field(default=None)
 
     def __post_init__(self) -> None:
-        from prefriction.signals import as_signal  # signals import the models' validation helpers
-
         if not isinstance(self.friction, FrictionModel):
             raise TypeError(
                 f"friction must be a FrictionModel such as prefriction.Dahl, got {self.friction!r} "
