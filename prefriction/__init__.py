@@ -28,7 +28,7 @@ from prefriction.simulation.simulate import SimulationResult, simulate
 from prefriction.simulation.sweep import SweepResult, sweep
 from prefriction.simulation.feedback import LinearFeedback
 from prefriction.analysis import dahl, energy
-from prefriction import describing, identify, sensitivity, signals
+from prefriction import sensitivity, signals
 from prefriction.sensitivity import sensitivities
 from prefriction.analysis.exact import exact_reversals
 
@@ -59,3 +59,15 @@ __all__ = [
     "sweep",
 ]
 __version__ = "0.2.0"
+
+
+_LAZY = ("describing", "identify")  # python-control (1.6 s) and scipy.stats (0.6 s) on first use
+
+
+def __getattr__(name: str):
+    """Import :mod:`prefriction.describing` and :mod:`prefriction.identify` on first use."""
+    if name in _LAZY:
+        import importlib
+
+        return importlib.import_module(f"prefriction.{name}")
+    raise AttributeError(f"module 'prefriction' has no attribute {name!r}")
