@@ -196,15 +196,19 @@ def run(*, t_end: float = 1.0, repeats: int = 3, sweep: int = 100, lengths: tupl
 
 
 def main(argv: Optional[list[str]] = None) -> int:
-    """Command line: ``python -m controllers.benchmark [--t-end 1] [--repeats 3] [--sweep 100] [--lengths 0.1 1 10]``."""
+    """Command line: ``python -m controllers.benchmark [--t-end 1] [--repeats 3] [--sweep 100] [--lengths 0.1 1 10]``.
+
+    Returns 0 when every target passes, 1 when one fails.
+    """
     ap = argparse.ArgumentParser(prog="python -m controllers.benchmark", description=__doc__.splitlines()[0])
     ap.add_argument("--t-end", type=float, default=1.0, help="simulated time of the timed loop [s]")
     ap.add_argument("--repeats", type=int, default=3, help="repeats of the warm timing (the minimum is reported)")
     ap.add_argument("--sweep", type=int, default=100, help="gains in the tuning sweep (0: skip)")
     ap.add_argument("--lengths", type=float, nargs="*", default=[0.1, 1.0, 10.0], help="loop lengths [s] (none: skip)")
     args = ap.parse_args(argv)
-    print(run(t_end=args.t_end, repeats=args.repeats, sweep=args.sweep, lengths=tuple(args.lengths)))
-    return 0
+    table = run(t_end=args.t_end, repeats=args.repeats, sweep=args.sweep, lengths=tuple(args.lengths))
+    print(table)
+    return 1 if " FAIL" in table else 0
 
 
 if __name__ == "__main__":
