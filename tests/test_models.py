@@ -118,3 +118,73 @@ def test_dahl_only_functions_name_what_they_need(call, message):
         call(Oscillator(_Viscous()))
     with pytest.raises(TypeError, match="system must be a prefriction.Oscillator, got 3"):
         call(3)
+
+
+# ------------------------------------------------------ parallel elements (Maxwell-slip, GMS)
+def _phi(y, kappa, w):
+    """The virgin curve sum_i min(kappa_i y, w_i), written here (mpmath)."""
+    import mpmath
+
+    return mpmath.fsum(min(mpmath.mpf(float(k)) * y, mpmath.mpf(float(c))) for k, c in zip(kappa, w))
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_virgin_curve_energies_against_quadrature(seed):
+    """VirginCurve.stored = Phi(phi^-1(f)) and complementary = Phi*(f) = f y - Phi(y) (Legendre,
+    y = phi^-1(f)) against mpmath: the inverse by bisection on phi, Phi by quadrature split at
+    the slip deflections."""
+    import mpmath
+
+    from prefriction.models.element_curves import VirginCurve
+
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(1, 6))
+    kappa = rng.uniform(0.1, 1.0, n)
+    kappa /= kappa.sum()
+    w = rng.uniform(0.1, 1.0, n)
+    w /= w.sum()
+    curve = VirginCurve(kappa, w)
+    deltas = sorted(float(d) for d in w / kappa)
+    for f in rng.uniform(0.0, 1.0, 6):
+        y = mpmath.findroot(lambda yy: _phi(yy, kappa, w) - f, (0.0, deltas[-1]), solver="bisect", tol=1e-30)
+        nodes = [0.0] + [d for d in deltas if d < y] + [y]
+        Phi = mpmath.quad(lambda yy: _phi(yy, kappa, w), nodes)
+        assert float(curve.inverse(np.array(f))) == pytest.approx(float(y), rel=1e-13)
+        assert float(curve.stored(np.array(f))) == pytest.approx(float(Phi), rel=1e-12)
+        assert float(curve.complementary(np.array(f))) == pytest.approx(float(f * y - Phi), rel=1e-12)
+
+
+def _maxwell_slip():
+    return pf.MaxwellSlip([6e4, 3e4, 1e4], [0.3, 0.4, 0.3])
+
+
+def _gms():
+    return pf.GMS([6e4, 3e4, 1e4], [0.2, 0.3, 0.5], 1.0, 1.5, 1e-3, 2e3, damping=[1.0, 0.0, 2.0])
+
+
+@pytest.mark.parametrize("make", [_maxwell_slip, _gms])
+def test_parallel_elements_compare_hash_and_pickle_by_their_numbers(make):
+    import pickle
+
+    model = make()
+    back = pickle.loads(pickle.dumps(model))
+    assert back == model and hash(back) == hash(model) and type(back) is type(model)
+    assert not back.stiffness.flags.writeable if isinstance(back, pf.MaxwellSlip) else not back.k.flags.writeable
+    assert model != 3 and model != (_gms() if isinstance(model, pf.MaxwellSlip) else _maxwell_slip())
+    assert model.structure_key() == (type(model).__name__, 3)
+    assert (model.n_elements, model.n_states, model.n_flags, model.n_events, model.sigma) == (3, 4, 3, 3, 1e5)
+
+
+@pytest.mark.parametrize("make", [_maxwell_slip, _gms])
+def test_parallel_elements_reversal_map(make):
+    """Floats: after a reversal every flag is clear and the guard zero; an element within snap of
+    its limit (Maxwell-slip: w_j; GMS: alpha_j Fs/Fc, sticking ones only) is put on it."""
+    model = make()
+    q = model.runtime_params()
+    n = model.n_elements
+    limit = q[n:2 * n] * (model.Fs / model.Fc if isinstance(model, pf.GMS) else 1.0)
+    z = [limit[0] * (1.0 - 1e-9), 0.5 * limit[1], limit[2] * (1.0 - 1e-9), 0.3]  # moving along +1
+    m = [0.0, 0.0, 1.0]
+    zn, mn = model.reverse(z, m, -1.0, q, 1e-6)
+    assert mn == [0.0] * n and zn[n] == 0.0 and zn[1] == z[1] and zn[0] == limit[0]
+    assert zn[2] == (z[2] if isinstance(model, pf.GMS) else limit[2])

@@ -344,3 +344,32 @@ def test_signals_pickle_for_process_pools():
         t = np.linspace(0.0, 2.5, 11)
         assert back.key == sig.key and type(back) is type(sig)
         np.testing.assert_array_equal(back(t), sig(t))
+
+
+def test_compiled_form_shares_one_structure_for_piecewise_linear_kinds():
+    """Constants, steps, ramps, samples and their sums compile as ``("PiecewiseLinear",)``: one
+    expression on symbols, fed each interval's ``piece``, gives the closed-form value; other
+    kinds compile as they are."""
+    from prefriction.signals import compiled_form
+
+    ts, us = np.array([0.0, 0.7, 1.5, 3.0]), np.array([1.0, -2.0, 0.5, 0.5])
+    cases = [
+        (Constant(2.5), lambda t: np.full_like(t, 2.5)),
+        (Step(1.0, -1.0, 3.0) + Ramp(2.0, 0.5, 0.25), lambda t: np.where(t >= 1.0, 3.0, -1.0)
+         + 0.25 + 0.5 * np.maximum(t - 2.0, 0.0)),
+        (Samples(ts, us) + 1.5, lambda t: np.interp(t, ts, us) + 1.5),
+    ]
+    t_sym, piece_sym = ca.SX.sym("t"), ca.SX.sym("piece", 3)
+    for sig, closed in cases:
+        form = compiled_form(sig)
+        assert form.key == ("PiecewiseLinear",) and (form.n_params, form.n_piece) == (0, 3)
+        assert compiled_form(form) is form
+        f = ca.Function("u", [t_sym, piece_sym], [form.expr(t_sym, ca.SX(0, 1), piece_sym)])
+        edges = np.unique(np.concatenate(([0.0, 4.0], sig.breaks())))
+        for ta, tb in zip(edges[:-1], edges[1:]):
+            t = np.linspace(ta, tb, 7, endpoint=False)  # a step jumps at tb
+            got = np.array([float(f(x, form.piece(ta, tb))) for x in t])
+            np.testing.assert_allclose(got, closed(t), rtol=1e-14, atol=1e-14)
+        np.testing.assert_array_equal(form(T), closed(T))
+    sine = Sine(1.0, 2.0)
+    assert compiled_form(sine) is sine and compiled_form(None) is None
