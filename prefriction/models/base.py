@@ -187,23 +187,24 @@ class FrictionModel(ABC):
         """
 
     def free_branch(self, z: Sequence[float], m: Sequence[float], v: float, s: float, q: Any,
-                    horizon: float) -> Optional[tuple[float, float, list[float], list[float], float]]:
+                    horizon: float) -> Optional[tuple[float, float, list[float], list[float], float, int]]:
         """Closed-form unforced motion on the current branch, if the model has one (floats).
 
         The normalised oscillator ``x~'' = -F~`` (unit mass, no input) from the state
         ``(z, m)``, velocity ``v`` and direction ``s``, followed for at most ``horizon`` time
         units and no further than the next reversal. The unforced simulation (compact model)
         takes this instead of integrating: a motion without truncation error, e.g. a linear
-        branch, whose integration error would otherwise accumulate over the cycles.
+        branch, whose integration error would otherwise accumulate over the cycles, or one
+        across a singular point that a Runge-Kutta step would cross at a reduced order.
 
         Returns
         -------
         tuple or None
-            ``(dt, v1, z1, m1, dx)``: the time taken (``dt < horizon``: a reversal at ``dt``,
-            ``v1 = 0``, the state before :meth:`reverse`), the velocity, the state and the
-            displacement at its end. ``None`` (the default) if there is no closed form for this
-            state: the simulator integrates. A branch with an event (:meth:`events`) before
-            its end must return ``None``.
+            ``(dt, v1, z1, m1, dx, events)``: the time taken (``dt < horizon``: a reversal at
+            ``dt``, ``v1 = 0``, the state before :meth:`reverse`), the velocity, the state and
+            the displacement at its end, and the number of model events on the way (counted as
+            the simulator counts them: the flags they change). ``None`` (the default) if there
+            is no closed form for this state: the simulator integrates.
         """
         return None
 

@@ -188,20 +188,47 @@ class Dahl(FrictionModel):
         return [-(math.log1p(-s_new * F) if type(F) is float else ca.log1p(-s_new * F))], []
 
     def free_branch(self, z: Sequence[float], m: Sequence[float], v: float, s: float, q: Any,
-                    horizon: float) -> Optional[tuple[float, float, list[float], list[float], float]]:
-        """gamma = 0 below saturation: the linear oscillator, in closed form.
+                    horizon: float) -> Optional[tuple[float, float, list[float], list[float], float, int]]:
+        """Closed forms of the unforced branch for gamma < 1 (see :meth:`FrictionModel.free_branch`).
 
-        There ``f = s F~ = p`` and ``(s v~)' = -f``, ``f' = s v~``: the point ``(s v~, f)`` turns
-        on the circle of radius ``a = hypot(s v~, f)`` (energy conserved, ``docs/mathematics.md#prandtl-stop``),
-        ``f = a sin(t~ + theta)``, ``s v~ = a cos(t~ + theta)``, ``theta = atan2(f, s v~)``; the
-        reversal comes at ``t~ = pi/2 - theta`` with ``f = a``. The branch stays below saturation
-        if ``a <= 1`` (at ``a = 1`` saturation coincides with the reversal). Integrating it would
-        let the error of every step drift the energy (300x rtol over 1e4 reversals).
-        ``None`` for other gamma, a saturated state, a mass at rest or ``a > 1``.
+        - gamma = 0 below saturation, the linear oscillator: ``f = s F~ = p``,
+          ``(s v~)' = -f``, ``f' = s v~``, so the point ``(s v~, f)`` turns on the circle of radius
+          ``a = hypot(s v~, f)`` (``docs/mathematics.md#prandtl-stop``): ``f = a sin(t~ + theta)``,
+          ``theta = atan2(f, s v~)``, and the reversal comes at ``t~ = pi/2 - theta`` with
+          ``f = a``, below saturation if ``a <= 1`` (at ``a = 1`` saturation coincides with the
+          reversal). Integrated, the error of every step drifted the energy (300x rtol over
+          1e4 reversals).
+        - 0 < gamma < 1 on a branch that saturates (kinetic energy above the branch energy left
+          to saturation, ``r / e - r^(1/e + 1) / (1 + e)`` with ``r = 1 - e p``, ``e = 1 - gamma``):
+          the half-cycle to its reversal at ``|F| = Fc`` (one saturation event), by the quadrature
+          of ``docs/mathematics.md#saturation`` (``exact_reversals``). The force has the singular
+          term ``(1 - e p)^(1/e)`` at saturation; a Runge-Kutta step across it loses its order,
+          and the located event carried errors of 3-19 rtol into the positions. A saturated
+          state slides at unit deceleration to its reversal.
+
+        ``None`` (integrate) for gamma >= 1, a branch that does not saturate (0 < gamma < 1),
+        ``a > 1`` or a mass at rest (gamma = 0), or a reversal beyond ``horizon``.
         """
-        if q[0] != 0.0 or m[0] > 0.5:
+        gamma = q[0]
+        if gamma >= 1.0:
             return None
-        w, f = s * v, z[0]  # force_of_p(p, 0) = p
+        w = s * v
+        e = 1.0 - gamma
+        if m[0] > 0.5:  # saturated: Coulomb slide at unit deceleration
+            return (w, 0.0, [1.0 / e], [1.0], s * 0.5 * w * w, 0) if w < horizon else None
+        if gamma == 0.0:
+            return self._linear_branch(z[0], w, s, horizon)
+        r = 1.0 - e * z[0]
+        if 0.5 * w * w <= r / e - r ** (1.0 / e + 1.0) / (1.0 + e):  # reverses before saturation
+            return None
+        from prefriction.analysis.exact import _first_segment  # (imports the models)
+
+        dt, dist, _ = _first_segment(float(force_of_p(z[0], gamma)), 0.5 * w * w, gamma)
+        return (dt, 0.0, [1.0 / e], [1.0], s * dist, 1) if dt < horizon else None
+
+    @staticmethod
+    def _linear_branch(f: float, w: float, s: float, horizon: float) -> Optional[tuple]:
+        """gamma = 0 below saturation (:meth:`free_branch`) from ``f = p`` and ``w = s v~``."""
         a = math.hypot(w, f)
         if not 0.0 < a <= 1.0 + 4e-16:
             return None
@@ -209,10 +236,10 @@ class Dahl(FrictionModel):
         to_rev = 0.5 * math.pi - theta
         if to_rev < horizon:
             f1 = min(a, 1.0)
-            return to_rev, 0.0, [f1], [0.0], s * (f1 - f)
+            return to_rev, 0.0, [f1], [0.0], s * (f1 - f), 0
         phase = horizon + theta
         f1 = a * math.sin(phase)
-        return horizon, s * a * math.cos(phase), [f1], [0.0], s * (f1 - f)
+        return horizon, s * a * math.cos(phase), [f1], [0.0], s * (f1 - f), 0
 
     def travel(self, z0: Sequence[float], z1: Sequence[float], s: float, q: Any) -> float:
         """``s (p1 - p0)`` with the branch distances of the log-gaps ``z0``, ``z1`` (gamma >= 1)."""

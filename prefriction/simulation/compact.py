@@ -53,8 +53,9 @@ def advance_compact(self: "Run", t_target: float, n_target: float) -> bool:
     while n < n_target and t < t_stop:
         exact = free(z, m, v, s, q, t_target - t) if free is not None else None
         if exact is not None:  # no integration: the branch in closed form
-            dt, v, z, m, dx = exact
+            dt, v, z, m, dx, n_ev = exact
             x += dx
+            ne += n_ev
             if dt < t_target - t:  # a reversal
                 t += dt
                 n += 1
