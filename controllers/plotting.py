@@ -35,7 +35,7 @@ def _headroom(ax, values: np.ndarray, level: "float | None") -> None:
 def plot_steps(
     results: Mapping[str, LoopResult], path: "str | Path", *, title: str, bound: "float | None" = None
 ) -> Path:
-    """One row per loop: position, control force, friction loop ``F(x)``, and ``|e|`` against ``Fc/kp``.
+    """One row per loop: position, control force, friction loop ``F(x)``, and ``|e|`` against ``error_bound``.
 
     Parameters
     ----------

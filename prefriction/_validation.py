@@ -167,8 +167,8 @@ def check_signal(name: str, value: Any, unit: str, letter: str) -> Any:
     if isinstance(value, tuple):
         if len(value) != 2:
             raise ValueError(f"{name} samples must be a pair (t, {letter}), got a tuple of length {len(value)}")
-        t = np.array(value[0], dtype=float)
-        val = np.array(value[1], dtype=float)
+        t = np.array(check_real_array(f"{name} samples t", value[0]), dtype=float)
+        val = np.array(check_real_array(f"{name} samples {letter}", value[1]), dtype=float)
         if t.ndim != 1 or val.shape != t.shape or t.size < 2:
             raise ValueError(
                 f"{name} samples must be a pair (t, {letter}) of 1-D arrays of equal length >= 2, "

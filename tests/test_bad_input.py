@@ -48,7 +48,8 @@ class ReachedWork(Exception):
 def _no_heavy_work():
     """Replace the compile entry point and the command line's heavy work by sentinels."""
     import prefriction.cli.bench as bench
-    import prefriction.cli.bench_sweep as bench_sweep
+    import prefriction.cli.bench.sweep as bench_sweep
+    import prefriction.cli.bench_loops as bench_loops
     import prefriction.cli.paper as paper
     import prefriction.simulation.run as run
 
@@ -58,7 +59,7 @@ def _no_heavy_work():
     import importlib
 
     patches = [(run, "integrator"), (bench, "headline"), (bench, "_models_main"), (bench_sweep, "main"),
-               (paper, "run_all")]
+               (bench_loops, "run"), (paper, "run_all")]
     for module, name in [("prefriction.simulation.integrator", "build_integrator"),
                          ("prefriction.simulation.loops.compiled_loop", "build_integrator"),
                          ("prefriction.simulation.loops.runner", "compiled")]:
