@@ -354,3 +354,19 @@ def test_first_dense_sample_is_the_force_at_the_initial_velocity():
     Y, F, _ = radau(lambda t, y: 0.2, 2e-3, times, y0=(0.0, v0, F0 / S0), scale=(1e-5, 5e-3))
     e = errors(res.x, res.v, res.F, Y, F)
     assert max(e) <= 10 * RTOL, e
+
+
+def test_sharp_stribeck_curve_after_each_reversal():
+    """``vs = 1e-5`` m/s (100x sharper than Table I): the Stribeck curve is crossed within about
+    1 % of a half-cycle after each reversal. A fixed first step of the integrator spanned it and
+    passed the error test (reversal times 3.8e-6 off, 296 rtol at rtol 1e-8); the first step is
+    now estimated from the right-hand side. 6 reversals within 10 rtol of the reference."""
+    p = (S0, S1, S2, FC, FS, 1e-5)
+    system = pf.Oscillator(pf.LuGre(*p), 1.0)
+    v0 = FC / math.sqrt(S0)  # the velocity unit
+    _, _, revs = radau(lambda t, y: 0.0, 0.1, [0.0], p=p, y0=(0.0, v0, 0.0), scale=(1e-5, v0))
+    for rtol in (1e-6, 1e-8):
+        tab = pf.simulate(system, v0, reversals=6, rtol=rtol).reversals
+        np.testing.assert_allclose(tab.t, revs[:6, 0], rtol=10 * rtol)
+        np.testing.assert_allclose(tab.x, revs[:6, 1], rtol=0, atol=10 * rtol * np.max(np.abs(revs[:6, 1])))
+        assert np.max(np.abs(tab.F - revs[:6, 2])) <= 10 * rtol * np.max(np.abs(revs[:6, 2]))
