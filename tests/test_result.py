@@ -66,3 +66,12 @@ def test_sweep_result_status_success_message() -> None:
     assert bad.message.startswith("1 of 3 runs failed (indices 1)") and "v0 must be finite" in bad.message
     assert repr(bad) == "SweepResult(3 runs, 1 failed, 0.50 s)"
     assert "[1] ValueError: v0 must be finite" in bad.summary()
+
+
+def test_summary_names_the_model_events() -> None:
+    """A saturating Dahl run (gamma = 0.3, one saturation in its first half-cycle) adds one line;
+    ``events`` is an int array aligned with the reversals."""
+    res = pf.simulate(pf.Oscillator(pf.Dahl(1e4, 1.0, 0.3), 1.0), 0.03, reversals=5)
+    assert res.events.tolist() == [1, 0, 0, 0, 0] and res.stats.events == 1
+    lines = res.summary().splitlines()
+    assert len(lines) == 5 and lines[2] == "model events: 1 (per half-cycle: events)"

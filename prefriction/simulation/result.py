@@ -74,9 +74,10 @@ class SimulationResult:
         Model events located on the half-cycle that ends at each reversal (int, aligned with
         ``reversals``): each event counts the flags it changes, e.g. the elements of
         Maxwell-slip or GMS that start to slip (two at once count 2), or Dahl's saturation
-        for gamma < 1. An event that coincides with the reversal (within ``rtol``, the model's
-        ``snap``) is taken as the reversal and not counted. The total, with the events after
-        the last reversal, is ``stats.events``. None if the run does not count them.
+        for gamma < 1. An element that only touches its limit at a reversal (within ``rtol``,
+        the model's ``snap``) may be counted or taken as coinciding with the reversal. The total,
+        with the events after the last reversal, is ``stats.events``. None if the run does not
+        count them (``docs/simulator.md#event-counts``).
     """
 
     reversals: ReversalTable
