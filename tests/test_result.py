@@ -74,4 +74,4 @@ def test_summary_names_the_model_events() -> None:
     res = pf.simulate(pf.Oscillator(pf.Dahl(1e4, 1.0, 0.3), 1.0), 0.03, reversals=5)
     assert res.events.tolist() == [1, 0, 0, 0, 0] and res.stats.events == 1
     lines = res.summary().splitlines()
-    assert len(lines) == 5 and lines[2] == "model events: 1 (per half-cycle: events)"
+    assert len(lines) == 4 and lines[2] == "model events: 1 (per half-cycle: events)"
