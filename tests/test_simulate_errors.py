@@ -6,6 +6,7 @@ import json
 import os
 import subprocess
 import sys
+import re
 import textwrap
 
 import numpy as np
@@ -134,3 +135,21 @@ def test_second_process_reuses_compiled_code(tmp_path) -> None:
     assert runs[1]["setup"] < runs[0]["setup"]
     assert len(list(tmp_path.glob("*.so"))) == 1
     assert runs[0]["F"] == runs[1]["F"]
+
+
+def test_sizes_and_amplitudes_beyond_the_limits_are_refused_before_any_work() -> None:
+    """A huge ``v0``, more reversals than :data:`MAX_REVERSALS`, a sampled controller with more
+    than :data:`MAX_PERIODS` periods and an unconvertible ``dense`` are refused with the limit."""
+    from prefriction.simulation.simulate import MAX_AMPLITUDE, MAX_PERIODS, MAX_REVERSALS
+
+    system = pf.Oscillator(pf.Dahl(1e4, 1.0), 1.0)
+    v_max = MAX_AMPLITUDE * pf.Scales.of(system).v
+    with pytest.raises(ValueError, match=re.escape(f"v0 must satisfy |v0| <= {v_max:.3g} m/s") + r".*got -1e\+200"):
+        pf.simulate(system, -1e200, reversals=2)
+    with pytest.raises(ValueError, match=rf"reversals must be an integer <= {MAX_REVERSALS:_}.*held in memory"):
+        pf.simulate(system, 0.01, reversals=MAX_REVERSALS + 1)
+    with pytest.raises(ValueError, match=r"Ts = 1e-09 s .* 1e\+09 sample periods; allowed at most 10_000_000"):
+        pf.simulate(system, 0.01, t_end=1.0, feedback=pf.LinearFeedback(D=1e3, Ts=1e-9))
+    assert MAX_PERIODS == 10**7
+    with pytest.raises(TypeError, match="dense must be True, False or a 1-D array of sample times"):
+        pf.simulate(system, 0.01, t_end=1.0, dense="fast")

@@ -49,7 +49,8 @@ from prefriction.reversals import ReversalTable
 from prefriction.simulation.result import RunStats, SimulationResult
 from prefriction.units import Scales
 
-__all__ = ["METHODS", "RunStats", "SimulationResult", "simulate"]
+__all__ = ["MAX_AMPLITUDE", "MAX_PERIODS", "MAX_REVERSALS", "METHODS", "MIN_AMPLITUDE", "RunStats", "SimulationResult",
+           "simulate"]
 
 METHODS = ("erk",)
 """Integrator plugins exposed by :func:`simulate` (each tested on the whole case set)."""
@@ -60,6 +61,13 @@ _ZERO = Constant(0.0)  # the input of a sampled loop without an input force (the
 MIN_AMPLITUDE = 1e-150
 """Least nonzero amplitude of the motion (normalised units) that :func:`simulate` accepts: the
 energies, ``A^2``, and the scaled states stay normal doubles."""
+MAX_AMPLITUDE = 1e100
+"""Largest amplitude of the motion (normalised units) that :func:`simulate` accepts: energies
+``A^2`` and first excursions ``~A^2 / 2`` stay far from the double-precision range."""
+MAX_REVERSALS = 10**7
+"""Most reversals of one :func:`simulate` call (the table holds them in memory: about 1 GB)."""
+MAX_PERIODS = 10**7
+"""Most sample periods ``t_end / Ts`` of a sampled controller (one Python step and one sample each)."""
 _CAL = 0.1  # calibration of the run-time tolerance eps: global error over 50 reversals ~ 0.7 rtol
 
 
@@ -91,12 +99,13 @@ def simulate(
     v0 : float
         Initial velocity [m/s]. If ``v0 = 0`` the motion starts in direction ``-sign(F0)``
         (unforced) or ``sign(u(0) - F0)`` (forced); with no net force the mass rests. A motion
-        smaller than :data:`MIN_AMPLITUDE` normalised units (e.g. a denormal ``v0``) is refused.
+        smaller than :data:`MIN_AMPLITUDE` normalised units (e.g. a denormal ``v0``) is refused, and
+        so is ``|v0|`` above :data:`MAX_AMPLITUDE` velocity units ``Fc / sqrt(m sigma)``.
     x0, F0 : float, default 0.0
         Initial position [m] and friction force [N], ``|F0| <= max_hysteretic_force`` of the
         model (Dahl: ``Fc``; LuGre: ``Fs``).
     reversals : int, optional
-        Stop at this many reversals (>= 1).
+        Stop at this many reversals, ``1 <= reversals <=`` :data:`MAX_REVERSALS`.
     t_end : float, optional
         Stop at this time [s] (> 0). At least one of ``reversals`` and ``t_end`` is required;
         a forced system or a closed loop needs ``t_end``.
@@ -119,7 +128,7 @@ def simulate(
     feedback : LinearFeedback, optional
         Closed loop ``u = C xc + D (r - x)`` added to the input force (see
         :class:`prefriction.simulation.feedback.LinearFeedback`). A sampled controller also returns
-        samples at its sample instants.
+        samples at its sample instants; ``t_end / Ts`` at most :data:`MAX_PERIODS`.
     jit : bool, default True
         Compile the integrator with the C compiler (cached on disk); the environment variable
         ``PREFRICTION_NO_JIT=1`` or a missing compiler selects the interpreted integrator.
@@ -150,7 +159,8 @@ def simulate(
                          f"{type(system.friction).__name__}), got {F0!r}")
     if reversals is None and t_end is None:
         raise ValueError("give reversals (number of reversals) or t_end (end time [s]) or both; got neither")
-    n_target = math.inf if reversals is None else check_count("reversals", reversals, 1)
+    n_target = math.inf if reversals is None else check_count(
+        "reversals", reversals, 1, MAX_REVERSALS, "the reversal table is held in memory")
     t_end_si = math.inf if t_end is None else check_positive("t_end", t_end)
     rtol = check_positive("rtol", rtol)
     if not 1e-13 <= rtol <= 1e-2:
@@ -167,6 +177,10 @@ def simulate(
     forced = system.forced or feedback is not None
     if forced and t_end is None:
         raise ValueError("t_end is required for a forced system or a closed loop (a reversal may never come)")
+    if feedback is not None and feedback.sampled and t_end_si / feedback.Ts > MAX_PERIODS:
+        raise ValueError(f"Ts = {feedback.Ts!r} s of the sampled controller gives t_end / Ts = {t_end_si / feedback.Ts:.3g} "
+                         f"sample periods; allowed at most {MAX_PERIODS:_} (one controller step and sample each): "
+                         f"Ts >= {t_end_si / MAX_PERIODS:.3g} s or a shorter t_end")
 
     sc = Scales.of(system)
     fb_kind, n_c = "none", 0
@@ -189,14 +203,15 @@ def simulate(
         fb=fb_plant, n_c=n_c, energy=want_dense, K=_K, n_out=N_DENSE if want_dense else 1,
         method=method, compact=True,
     )
+    force_scale = applied_force_scale(system, feedback, x0, t_end_si) / Fc if forced else 0.0
+    _check_amplitude(v0, F0, force_scale, sc)
     L = Layout(spec)
     # error control on states scaled by amplitude * eps (the plant's run-time tolerance)
     eps = min(rtol, atol) * _CAL * math.sqrt(L.n_active / L.nx)
     run = Run(system, spec, feedback, eps, jit)
     run.snap = rtol
     run.P0 = run._constant_params(run.L)
-    run.force_scale = applied_force_scale(system, feedback, x0, t_end_si) / Fc if forced else 0.0
-    _check_amplitude(v0, F0, run.force_scale, sc)
+    run.force_scale = force_scale
 
     xc0 = np.array(feedback.xc0, dtype=float) if feedback is not None else np.zeros(0)
     run.st, s0 = _initial_state(run, x0, v0, F0, xc0, stops=forced or t_end is not None)
@@ -240,7 +255,13 @@ def _check_amplitude(v0: float, F0: float, force_scale: float, sc: Scales) -> No
     """``ValueError`` if the motion is nonzero but smaller than :data:`MIN_AMPLITUDE` (normalised
     initial velocity ``v0`` [m/s], force ``F0`` [N] and applied force scale): its scaled states, energies and steps
     would leave the double-precision range (a denormal ``v0 = 5e-324`` m/s gave reversal times
-    12 % wrong, ``1e-300`` m/s a failed integrator)."""
+    12 % wrong, ``1e-300`` m/s a failed integrator); or larger than :data:`MAX_AMPLITUDE`."""
+    if abs(v0 / sc.v) > MAX_AMPLITUDE:
+        raise ValueError(f"v0 must satisfy |v0| <= {MAX_AMPLITUDE * sc.v:.3g} m/s ({MAX_AMPLITUDE:g} velocity units "
+                         f"Fc/sqrt(m sigma): energies stay in the double-precision range), got {v0!r}")
+    if force_scale > MAX_AMPLITUDE:
+        raise ValueError(f"the applied force (input u and feedback) must stay below {MAX_AMPLITUDE * sc.F:.3g} N "
+                         f"({MAX_AMPLITUDE:g} Fc), got a force scale of {force_scale * sc.F:.3g} N")
     amplitude = max(math.hypot(v0 / sc.v, F0 / sc.F), force_scale)
     if 0.0 < amplitude < MIN_AMPLITUDE:
         raise ValueError(
@@ -253,7 +274,10 @@ def _check_amplitude(v0: float, F0: float, force_scale: float, sc: Scales) -> No
 
 def _dense_times(dense: Any, t_end: float) -> np.ndarray:
     """The requested sample times [s] as an array; ``ValueError`` unless increasing within [0, t_end]."""
-    times = np.asarray(dense, dtype=float)
+    try:
+        times = np.asarray(dense, dtype=float)
+    except (TypeError, ValueError):
+        raise TypeError(f"dense must be True, False or a 1-D array of sample times [s], got {dense!r}") from None
     if times.ndim != 1 or times.size < 1 or not np.all(np.isfinite(times)):
         raise ValueError("dense must be True, False or a 1-D array of finite sample times [s]")
     if np.any(np.diff(times) <= 0) or times[0] < 0 or times[-1] > t_end:
