@@ -177,3 +177,19 @@ def test_saturating_first_excursion_at_full_order() -> None:
             res = pf.simulate(system, 0.02, reversals=30, rtol=rtol)
             assert error(normalised(res), ref) <= 3 * rtol, (gamma, rtol)
             assert res.stats.events == res.events[0] == 1
+
+
+def test_forced_saturation_at_full_order() -> None:
+    """0 < gamma < 1 driven through saturation in every half-cycle (``u = 2 sin(0.7 w0 t)`` N from
+    rest): reversals within 3 rtol of the reference at rtol 1e-6 ... 1e-10 (measured <= 1.2 rtol).
+    The speed at each saturation comes from the branch's energy balance; taken from the dense
+    output of the step across the singular point it put 27-236 rtol into the positions."""
+    for gamma in (0.3, 0.25):
+        system = pf.Oscillator(pf.Dahl(SIGMA, 1.0, gamma), MASS, u=Sine(2.0, 70.0 / (2.0 * math.pi)))
+        sats: list = []
+        ref = dahl_reference(gamma, 0.0, amp=2.0, w=0.7, t_end=50.0, s0=1.0, saturations=sats)
+        assert len(ref) == 10 and sum(sats) >= 10
+        for rtol in (1e-6, 1e-8, 1e-10):
+            res = pf.simulate(system, 0.0, t_end=0.5, rtol=rtol)
+            assert error(normalised(res), ref) <= 3 * rtol, (gamma, rtol)
+            assert res.stats.events == sum(sats)

@@ -208,6 +208,18 @@ class FrictionModel(ABC):
         """
         return None
 
+    def branch_potential(self, z: Sequence[Any], m: Sequence[Any], s: Any, q: Any) -> Any:
+        """Potential of the friction force along the current branch up to its next model event
+        (floats and CasADi symbols alike), for models whose branch is elastic until then.
+
+        On such a stretch the force depends on the position along the branch alone, so
+        ``v~^2 / 2 + branch_potential - W~`` (``W~`` the input's work) is conserved, and the
+        simulator sets the speed at each model event from it: the event is located on the
+        integrator's dense output, which is of low order next to a singular point such as
+        Dahl's saturation for gamma < 1. ``None`` (the default): no such correction.
+        """
+        return None
+
     def travel(self, z0: Sequence[float], z1: Sequence[float], s: float, q: Any) -> float:
         """Normalised displacement between states ``z0`` and ``z1`` of one branch (if
         :attr:`tracks_position`)."""

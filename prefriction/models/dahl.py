@@ -189,46 +189,20 @@ class Dahl(FrictionModel):
 
     def free_branch(self, z: Sequence[float], m: Sequence[float], v: float, s: float, q: Any,
                     horizon: float) -> Optional[tuple[float, float, list[float], list[float], float, int]]:
-        """Closed forms of the unforced branch for gamma < 1 (see :meth:`FrictionModel.free_branch`).
+        """gamma = 0 below saturation: the linear oscillator, in closed form (see
+        :meth:`FrictionModel.free_branch`).
 
-        - gamma = 0 below saturation, the linear oscillator: ``f = s F~ = p``,
-          ``(s v~)' = -f``, ``f' = s v~``, so the point ``(s v~, f)`` turns on the circle of radius
-          ``a = hypot(s v~, f)`` (``docs/mathematics.md#prandtl-stop``): ``f = a sin(t~ + theta)``,
-          ``theta = atan2(f, s v~)``, and the reversal comes at ``t~ = pi/2 - theta`` with
-          ``f = a``, below saturation if ``a <= 1`` (at ``a = 1`` saturation coincides with the
-          reversal). Integrated, the error of every step drifted the energy (300x rtol over
-          1e4 reversals).
-        - 0 < gamma < 1 on a branch that saturates (kinetic energy above the branch energy left
-          to saturation, ``r / e - r^(1/e + 1) / (1 + e)`` with ``r = 1 - e p``, ``e = 1 - gamma``):
-          the half-cycle to its reversal at ``|F| = Fc`` (one saturation event), by the quadrature
-          of ``docs/mathematics.md#saturation`` (``exact_reversals``). The force has the singular
-          term ``(1 - e p)^(1/e)`` at saturation; a Runge-Kutta step across it loses its order,
-          and the located event carried errors of 3-19 rtol into the positions. A saturated
-          state slides at unit deceleration to its reversal.
-
-        ``None`` (integrate) for gamma >= 1, a branch that does not saturate (0 < gamma < 1),
-        ``a > 1`` or a mass at rest (gamma = 0), or a reversal beyond ``horizon``.
+        There ``f = s F~ = p``, ``(s v~)' = -f`` and ``f' = s v~``, so the point ``(s v~, f)`` turns
+        on the circle of radius ``a = hypot(s v~, f)`` (``docs/mathematics.md#prandtl-stop``):
+        ``f = a sin(t~ + theta)``, ``theta = atan2(f, s v~)``; the reversal comes at
+        ``t~ = pi/2 - theta`` with ``f = a``, below saturation if ``a <= 1`` (at ``a = 1``
+        saturation coincides with the reversal). Integrated, the error of every step drifted
+        the energy (300x rtol over 1e4 reversals). ``None`` (integrate) for gamma > 0, a
+        saturated state, a mass at rest or ``a > 1``.
         """
-        gamma = q[0]
-        if gamma >= 1.0:
+        if q[0] != 0.0 or m[0] > 0.5:
             return None
-        w = s * v
-        e = 1.0 - gamma
-        if m[0] > 0.5:  # saturated: Coulomb slide at unit deceleration
-            return (w, 0.0, [1.0 / e], [1.0], s * 0.5 * w * w, 0) if w < horizon else None
-        if gamma == 0.0:
-            return self._linear_branch(z[0], w, s, horizon)
-        r = 1.0 - e * z[0]
-        if 0.5 * w * w <= r / e - r ** (1.0 / e + 1.0) / (1.0 + e):  # reverses before saturation
-            return None
-        from prefriction.analysis.exact import _first_segment  # (imports the models)
-
-        dt, dist, _ = _first_segment(float(force_of_p(z[0], gamma)), 0.5 * w * w, gamma)
-        return (dt, 0.0, [1.0 / e], [1.0], s * dist, 1) if dt < horizon else None
-
-    @staticmethod
-    def _linear_branch(f: float, w: float, s: float, horizon: float) -> Optional[tuple]:
-        """gamma = 0 below saturation (:meth:`free_branch`) from ``f = p`` and ``w = s v~``."""
+        w, f = s * v, z[0]  # force_of_p(p, 0) = p
         a = math.hypot(w, f)
         if not 0.0 < a <= 1.0 + 4e-16:
             return None
@@ -240,6 +214,16 @@ class Dahl(FrictionModel):
         phase = horizon + theta
         f1 = a * math.sin(phase)
         return horizon, s * a * math.cos(phase), [f1], [0.0], s * (f1 - f), 0
+
+    def branch_potential(self, z: Sequence[Any], m: Sequence[Any], s: Any, q: Any) -> Any:
+        """gamma < 1 before saturation: ``H(p) = int_0^p f dp = p + ((1 - e p)^(1/e + 1) - 1) / (1 + e)``,
+        ``e = 1 - gamma`` (``docs/mathematics.md#saturation``); ``None`` for gamma >= 1 (no events)."""
+        if not self.saturates:
+            return None
+        p, e = z[0], 1.0 - q[0]
+        if _sym(p, e):
+            return p + (ca.fmax(1.0 - e * p, 0.0) ** (1.0 / e + 1.0) - 1.0) / (1.0 + e)
+        return p + (max(1.0 - e * p, 0.0) ** (1.0 / e + 1.0) - 1.0) / (1.0 + e)
 
     def travel(self, z0: Sequence[float], z1: Sequence[float], s: float, q: Any) -> float:
         """``s (p1 - p0)`` with the branch distances of the log-gaps ``z0``, ``z1`` (gamma >= 1)."""

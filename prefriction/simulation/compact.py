@@ -38,6 +38,8 @@ def advance_compact(self: "Run", t_target: float, n_target: float) -> bool:
     im = [ix[f"m{i}"] for i in range(L.nm)]
     tracks = ixh is None
     ine = ix.get("ne")  # the model's event count (models with events)
+    iEb = L.param.get("Eb")  # the branch's energy: the speed at model events (branch_potential)
+    potential = model.branch_potential
     force, travel, reverse, snap = model.force, model.travel, model.reverse, self.snap
     P[:] = self.P0  # eps and the model's numbers q
     st, rev = self.st, self.rev
@@ -79,6 +81,8 @@ def advance_compact(self: "Run", t_target: float, n_target: float) -> bool:
         AF = min(A, 1.0) * eps
         Av = A * eps
         P[0], P[1], P[2], P[3] = Ax, Av, AF, s
+        if iEb is not None:
+            P[iEb] = 0.5 * v * v + float(potential(z, m, s, q))
         X0[iv] = v / Av
         for i, k in enumerate(iz):
             X0[k] = z[i] / AF

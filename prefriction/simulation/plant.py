@@ -33,6 +33,10 @@ State vector (indices in :class:`Layout`), kept short because the cost of a step
     (models with events only) the model events since the last reversal, each counted as the
     number of flags it changes (:func:`event_count`), and the counts of the newest ``K``
     half-cycles, shifted in by each reversal as the register is;
+``Ebh``
+    (models with events and a branch potential) the branch's mechanical energy
+    ``v~^2 / 2 + potential - W~``, ``AE`` times it; the model events set the speed from it
+    when the parameter ``ecorr`` is 1 (the compact model has it as the parameter ``Eb``);
 ``xch``
     continuous controller states, ``xc = S * xch``;
 register
@@ -171,6 +175,9 @@ class Layout:
             names.append("Eh")
         if model.n_events:  # model events since the last reversal, and in the newest K half-cycles
             names += ["ne"] + [f"nr{j}" for j in range(spec.K)]
+        self.potential = has_potential(model)
+        if self.potential:  # the branch's mechanical energy (speed at events, FrictionModel.branch_potential)
+            names.append("Ebh")
         self.state = {k: i for i, k in enumerate(names)}
         self.xc = slice(len(names), len(names) + spec.n_c)
         self.reg = len(names) + spec.n_c
@@ -178,6 +185,8 @@ class Layout:
         self.nx = self.reg + spec.K * self.reg_width
         self.n_active = 2 + self.nz + int(spec.forced) + int(spec.energy) + spec.n_c
         pnames = ["Ax", "Av", "AF", "AE", "xref", "Efref", "nstop", "snap", "tunit", "xunit", "Fc", "eps"]
+        if self.potential:
+            pnames.append("ecorr")  # 1: the speed at model events from the energy (0: as integrated)
         self.param = {k: i for i, k in enumerate(pnames)}
         self.q = self._block(len(pnames), spec.n_q)
         (nu_p, nu_c), (nr_p, nr_c) = _sizes(spec.u_sig), _sizes(spec.r_sig)
@@ -203,8 +212,9 @@ class Layout:
         return slice(start, start + size)
 
     def _compact(self, spec: PlantSpec) -> None:
-        """Layout of the compact unforced model: ``[xh,] vh, z..., m...`` (no ``xh`` if the model
-        tracks the position), parameters ``Ax, Av, AF, s, eps, q...``, controls ``dur, t0``."""
+        """Layout of the compact unforced model: ``[xh,] vh, z..., m...[, ne]`` (no ``xh`` if the model
+        tracks the position), parameters ``Ax, Av, AF, s, eps[, Eb], q...``, controls ``dur, t0``."""
+        self.potential = has_potential(spec.model)
         names = [] if spec.model.tracks_position else ["xh"]
         names += ["vh"] + [f"z{i}" for i in range(self.nz)] + [f"m{i}" for i in range(self.nm)]
         if spec.model.n_events:
@@ -214,7 +224,8 @@ class Layout:
         self.reg = self.nx = len(names)
         self.reg_width = 0
         self.n_active = len(names) - self.nm - (1 if spec.model.n_events else 0)
-        self.param = {k: i for i, k in enumerate(["Ax", "Av", "AF", "s", "eps"])}
+        # Eb: the branch's mechanical energy v^2 / 2 + potential (speed at model events)
+        self.param = {k: i for i, k in enumerate(["Ax", "Av", "AF", "s", "eps"] + (["Eb"] if self.potential else []))}
         self.q = self._block(len(self.param), spec.n_q)
         self.up = self.rp = self._block(self.q.stop, 0)
         self.p_A = self.p_B = self.p_C = self.p_D = self.p_S = self.np = self.q.stop
@@ -242,6 +253,11 @@ def _symbols(spec: PlantSpec) -> tuple:
     p = {k: P[i] for k, i in L.param.items()}
     c = {k: U[i] for k, i in L.control.items()}
     return L, X, P, U, tau, st, p, c
+
+
+def has_potential(model: FrictionModel) -> bool:
+    """True if the model has events and a branch potential (:meth:`FrictionModel.branch_potential`)."""
+    return bool(model.n_events) and type(model).branch_potential is not FrictionModel.branch_potential
 
 
 def event_count(m: list, mn: list) -> Any:
@@ -347,6 +363,10 @@ def build_integrator(spec: PlantSpec) -> ca.Function:
         zn, mn = model.on_event(k, z, m, s, q)
         ch = model_changes(zn, mn)
         ch["ne"] = st["ne"] + event_count(m, mn)
+        if L.potential:  # v^2 / 2 + potential - W conserved up to the event
+            kinetic = p["AE"] * st["Ebh"] + (W if spec.forced else 0.0) - model.branch_potential(zn, m, s, q)
+            vh = s * ca.sqrt(ca.fmax(2.0 * kinetic, 0.0)) / p["Av"]
+            ch["vh"] = ca.if_else(p["ecorr"] > 0.5, vh, st["vh"])
         return ch
 
     def reversal(new_s: Any, extra: dict) -> ca.SX:
@@ -359,6 +379,8 @@ def build_integrator(spec: PlantSpec) -> ca.Function:
         if spec.forced:
             ch["Wh"] = 0.0
             ch["armed"] = 1.0
+        if L.potential:  # at rest on the new branch, no work yet
+            ch["Ebh"] = model.branch_potential(zn, mn, new_s, q) / p["AE"]
         if model.n_events:  # the half-cycle's event count enters the count register
             ch["ne"] = 0.0
             for j in range(spec.K - 1, 0, -1):
@@ -438,6 +460,9 @@ def _build_compact(spec: PlantSpec) -> ca.Function:
         for i in range(L.nm):
             after[L.state[f"m{i}"]] = mn[i]
         after[L.state["ne"]] = st["ne"] + event_count(m, mn)
+        if L.potential:  # v^2 / 2 + potential conserved up to the event
+            kinetic = p["Eb"] - model.branch_potential(zn, m, s, q)
+            after[L.state["vh"]] = s * ca.sqrt(ca.fmax(2.0 * kinetic, 0.0)) / p["Av"]
         post = ca.if_else(idx == k + 1, after, post)
     trans = ca.Function(
         "transition", [idx, tau, X, ca.SX(0, 1), P, U], [post, ca.SX(0, 1)],

@@ -95,6 +95,8 @@ class Run:
         np.copyto(P, self.P0)
         P[ix["Ax"]], P[ix["Av"]], P[ix["AF"]], P[ix["AE"]] = a["Ax"], a["Av"], a["AF"], a["AE"]
         P[ix["xref"]], P[ix["Efref"]], P[ix["nstop"]] = self.st["x"], self.st["Ef"], nstop
+        if "ecorr" in ix:  # the speed at model events from the branch's energy, when it is known
+            P[ix["ecorr"]] = 1.0 if "Eb" in self.st else 0.0
 
     def _pack(self, call: BufferedIntegrator, L: Layout, a: dict) -> None:
         """Write the scaled state into ``call.X0`` (the register is output only)."""
@@ -115,6 +117,8 @@ class Run:
             X[ix["Eh"]] = 0.0
         if "ne" in ix:
             X[ix["ne"]] = st.get("ne", 0)  # (a state set without it: none so far)
+        if "Ebh" in ix:
+            X[ix["Ebh"]] = st.get("Eb", 0.0) / a["AE"]
         if self.spec.fb == "continuous":
             X[L.xc] = st["xc"] / self.S
 
@@ -151,6 +155,8 @@ class Run:
             counts.append(int(c[ix[f"nr{j}"]] + 0.5) if counted else 0)
         out["new"], out["new_events"] = regs, counts
         out["ne"] = int(c[ix["ne"]] + 0.5) if counted else 0
+        if "Ebh" in ix and "Eb" in self.st:
+            out["Eb"] = a["AE"] * c[ix["Ebh"]]
         # a skipped reversal pair stopped the call at the least speed after it (1 + t~ there)
         out["tmiss"] = c[ix["tmiss"]] - 1.0 if "tmiss" in ix and c[ix["tmiss"]] > 0.5 else None
         out["overflow"] = new > self.spec.K
@@ -200,6 +206,8 @@ class Run:
             st["W"], st["ne"] = 0.0, 0
             st["z"], st["m"] = self.model.reverse(st["z"], st["m"], new_s, self.q, self.snap)
             st["s"] = new_s
+            if "Eb" in st:  # at rest on the new branch
+                st["Eb"] = float(self.model.branch_potential(st["z"], st["m"], new_s, self.q))
         st["rest"] = 0.0
 
     def _call(self, call: BufferedIntegrator, L: Layout, times: list[float], nstop: float) -> tuple[np.ndarray, dict]:
@@ -273,6 +281,8 @@ class Run:
         self._record(out)
         for k in ("x", "v", "F", "z", "m", "s", "rest", "W", "Ef", "xc", "ne"):
             self.st[k] = out[k]
+        if "Eb" in out:
+            self.st["Eb"] = out["Eb"]
         self.st["t"] = t if out["t"] is None else out["t"]
 
     # --- loops --------------------------------------------------------------------------

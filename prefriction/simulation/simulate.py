@@ -314,6 +314,8 @@ def _initial_state(run: Run, x0: float, v0: float, F0: float, xc0: np.ndarray, *
     F = float(model.force(list(z), list(m), v0 / sc.v, s0, run.q))
     st = {"x": x0 / sc.x, "v": v0 / sc.v, "F": F, "z": list(z), "m": list(m),
           "t": 0.0, "s": s0, "rest": rest, "W": 0.0, "Ef": 0.0, "xc": xc0, "uhold": 0.0, "ne": 0}
+    if run.L.potential:  # the branch's mechanical energy v^2 / 2 + potential - W (speed at events)
+        st["Eb"] = 0.5 * st["v"] ** 2 + float(model.branch_potential(st["z"], st["m"], s0, run.q))
     return st, s0
 
 
