@@ -37,7 +37,6 @@ def advance_compact(self: "Run", t_target: float, n_target: float) -> bool:
     iz = [ix[f"z{i}"] for i in range(L.nz)]
     im = [ix[f"m{i}"] for i in range(L.nm)]
     tracks = ixh is None
-    ine = ix.get("ne")  # the model's event count (models with events)
     iEb = L.param.get("Eb")  # the branch's energy: the speed at model events (branch_potential)
     potential = model.branch_potential
     force, travel, reverse, snap = model.force, model.travel, model.reverse, self.snap
@@ -88,8 +87,6 @@ def advance_compact(self: "Run", t_target: float, n_target: float) -> bool:
             X0[k] = z[i] / AF
         for i, k in enumerate(im):
             X0[k] = m[i]
-        if ine is not None:
-            X0[ine] = ne
         if not tracks:
             X0[ixh] = 0.0
         U[0], U[1] = t1 - t, t
@@ -112,9 +109,13 @@ def advance_compact(self: "Run", t_target: float, n_target: float) -> bool:
             self._count_steps(call)
         z1 = [AF * c[k] for k in iz]
         x = x + travel(z, z1, s, q) if tracks else x + Ax * c[ixh]
-        z, m = z1, [c[k] for k in im]
-        if ine is not None:
-            ne = int(c[ine] + 0.5)
+        m1 = [c[k] for k in im]
+        # the events of the call: the flags it set (the model's events only set flags; the
+        # register model counts them in a state, plant.event_count)
+        for a, b in zip(m, m1):
+            if b > a + 0.5:
+                ne += 1
+        z, m = z1, m1
         sv = s * c[iv] * eps
         if sv > -0.5:  # no reversal: vh is the velocity
             v = Av * c[iv]
