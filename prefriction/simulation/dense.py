@@ -308,7 +308,7 @@ def samples_si(run: "Run", samples: "SampleBuffer | Sequence[tuple]", u_hist: Se
             u = np.asarray(system.u(t), dtype=float) if system.forced else np.zeros(n)
             if feedback is not None:
                 e = np.asarray(feedback.reference(t), dtype=float) - x
-                u = u + (xc @ feedback.C[0] if run.spec.n_c else 0.0) + feedback.D[0, 0] * e
+                u = u + feedback.force(xc, e)
             extra["u"] = u
     if feedback is not None:
         extra["xc"] = xc[:, :n_user]

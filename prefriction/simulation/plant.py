@@ -34,7 +34,9 @@ State vector (indices in :class:`Layout`), kept short because the cost of a step
     number of flags it changes (:func:`event_count`), and the counts of the newest ``K``
     half-cycles, shifted in by each reversal as the register is;
 ``xch``
-    continuous controller states, ``xc = S * xch``;
+    continuous controller states, ``xc = S * xch``; the controller's force is
+    ``clip(C xc + D e, -umax, umax)`` with back-calculation ``k_aw (u - w)`` on ``xc'``
+    (run-time ``umax``, ``k_aw``; ``umax = 1e300`` and ``k_aw = 0`` give the linear law);
 register
     the newest ``K`` reversals, newest first: ``(t~, x~, F~[, W~])`` each.
 
@@ -188,8 +190,11 @@ class Layout:
         self.p_B = self.p_A + n * n
         self.p_C = self.p_B + n
         self.p_D = self.p_C + n
-        self.p_S = self.p_D + (1 if spec.fb == "continuous" else 0)
-        self.np = self.p_S + n
+        cont = 1 if spec.fb == "continuous" else 0
+        self.p_S = self.p_D + cont
+        self.p_umax = self.p_S + n  # force limit / Fc (1e300: none), then the anti-windup gains
+        self.p_kaw = self.p_umax + cont
+        self.np = self.p_kaw + cont * n
         cnames = ["dur", "t0"]
         if spec.fb == "sampled":
             cnames.append("uhold")
@@ -217,7 +222,7 @@ class Layout:
         self.param = {k: i for i, k in enumerate(["Ax", "Av", "AF", "s", "eps"])}
         self.q = self._block(len(self.param), spec.n_q)
         self.up = self.rp = self._block(self.q.stop, 0)
-        self.p_A = self.p_B = self.p_C = self.p_D = self.p_S = self.np = self.q.stop
+        self.p_A = self.p_B = self.p_C = self.p_D = self.p_S = self.p_umax = self.p_kaw = self.np = self.q.stop
         self.control = {"dur": 0, "t0": 1}
         self.uc = self.rc = self._block(2, 0)
         self.nu = 2
@@ -288,9 +293,11 @@ def build_integrator(spec: PlantSpec) -> ca.Function:
             A = ca.reshape(P[L.p_A:L.p_B], n, n)
             B = P[L.p_B:L.p_C]
             C = ca.reshape(P[L.p_C:L.p_D], 1, n)
-            S = P[L.p_S:L.np]
+            S = P[L.p_S:L.p_umax]
             xc = S * X[L.xc]
-            u = u + (ca.mtimes(C, xc) if n else 0.0) + P[L.p_D] * e
+            w = (ca.mtimes(C, xc) if n else 0.0) + P[L.p_D] * e  # unclipped controller output
+            u_fb = ca.fmin(ca.fmax(w, -P[L.p_umax]), P[L.p_umax])  # force limit
+            u = u + u_fb
         else:
             u = u + c["uhold"] / p["Fc"]
     acc = u - F
@@ -310,7 +317,8 @@ def build_integrator(spec: PlantSpec) -> ca.Function:
     for k, val in dot.items():
         ode[L.state[k]] = val
     if spec.fb == "continuous" and n:
-        ode[L.xc] = run * (ca.mtimes(A, xc) + B * e) / S
+        # back-calculation anti-windup: k_aw (u - w) (zero while the limit does not bind)
+        ode[L.xc] = run * (ca.mtimes(A, xc) + B * e + P[L.p_kaw:L.np] * (u_fb - w)) / S
     ode = c["dur"] * ode
     # indicators in units of the amplitude (vh is scaled by 1/eps); forced: offset so that a
     # branch starting at v = 0 has a positive indicator (EPS_START)

@@ -86,7 +86,9 @@ class Run:
             P[L.p_B:L.p_C] = fb.B[:, 0] * sc.t * sc.x
             P[L.p_C:L.p_D] = Ct
             P[L.p_D] = fb.D[0, 0] * sc.x / sc.F
-            P[L.p_S:L.np] = self.S
+            P[L.p_S:L.p_umax] = self.S
+            P[L.p_umax] = 1e300 if fb.u_max is None else fb.u_max / sc.F  # no limit: the linear law
+            P[L.p_kaw:L.np] = fb.k_aw * sc.t * sc.F
         return P
 
     def _params(self, call: BufferedIntegrator, L: Layout, a: dict, nstop: float) -> None:
@@ -181,7 +183,7 @@ class Run:
         u = float(self.system.u(t_si)) if self.system.forced else 0.0
         if self.spec.fb == "continuous":
             e = float(self.fb.reference(t_si)) - st["x"] * sc.x
-            u += float(self.fb.C[0] @ st["xc"] + self.fb.D[0, 0] * e)
+            u += float(self.fb.force(st["xc"], e))
         elif fb is not None and fb.sampled:
             u += st["uhold"]
         return u / sc.F - st["F"]
