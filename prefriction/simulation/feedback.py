@@ -183,8 +183,8 @@ class LinearFeedback:
         """Number of controller states ``n``."""
         return self.A.shape[0]
 
-    def force(self, xc: Any, e: Any) -> Any:
-        """Controller force [N] ``clip(C xc + D e, -u_max, u_max)`` (no clip without ``u_max``).
+    def output(self, xc: Any, e: Any) -> Any:
+        """Unclipped controller output ``w = C xc + D e`` [N].
 
         Parameters
         ----------
@@ -194,7 +194,12 @@ class LinearFeedback:
             Error ``r - x`` [m], scalar or shape ``(k,)``.
         """
         xc = np.asarray(xc, dtype=float)
-        w = (xc @ self.C[0] if self.n_states else 0.0) + self.D[0, 0] * np.asarray(e, dtype=float)
+        return (xc @ self.C[0] if self.n_states else 0.0) + self.D[0, 0] * np.asarray(e, dtype=float)
+
+    def force(self, xc: Any, e: Any) -> Any:
+        """Controller force [N] ``clip(C xc + D e, -u_max, u_max)`` (no clip without ``u_max``);
+        arguments as for :meth:`output`."""
+        w = self.output(xc, e)
         return w if self.u_max is None else np.clip(w, -self.u_max, self.u_max)
 
     @property

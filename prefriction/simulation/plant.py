@@ -173,6 +173,8 @@ class Layout:
             names.append("Eh")
         if model.n_events:  # model events since the last reversal, and in the newest K half-cycles
             names += ["ne"] + [f"nr{j}" for j in range(spec.K)]
+        if spec.fb == "continuous":
+            names.append("sat")  # clip of the controller force: 0 inside, +-1 at +-umax
         self.state = {k: i for i, k in enumerate(names)}
         self.xc = slice(len(names), len(names) + spec.n_c)
         self.reg = len(names) + spec.n_c
@@ -296,7 +298,8 @@ def build_integrator(spec: PlantSpec) -> ca.Function:
             S = P[L.p_S:L.p_umax]
             xc = S * X[L.xc]
             w = (ca.mtimes(C, xc) if n else 0.0) + P[L.p_D] * e  # unclipped controller output
-            u_fb = ca.fmin(ca.fmax(w, -P[L.p_umax]), P[L.p_umax])  # force limit
+            umax, sat = P[L.p_umax], st["sat"]
+            u_fb = ca.if_else(ca.fabs(sat) < 0.5, w, sat * umax)  # force limit: the clip's mode is a state
             u = u + u_fb
         else:
             u = u + c["uhold"] / p["Fc"]
@@ -330,6 +333,10 @@ def build_integrator(spec: PlantSpec) -> ca.Function:
         sa_n = s * acc / p["Av"] * p["eps"]  # s a~ relative to the amplitude
         zero.append(ca.if_else(ca.logic_and(run_m > 0.5, armed), -sa_n, 1.0))  # least speed
         zero.append(ca.if_else(ca.logic_and(run_m > 0.5, ca.logic_not(armed)), sa_n, 1.0))  # greatest
+    if spec.fb == "continuous":  # the clip's switches (w = +-umax), relative to umax
+        inside = ca.fabs(sat) < 0.5
+        zero.append(ca.if_else(run > 0.5, ca.if_else(inside, 1.0 - w / umax, ca.if_else(sat > 0.5, w / umax - 1.0, 1.0)), 1.0))
+        zero.append(ca.if_else(run > 0.5, ca.if_else(inside, 1.0 + w / umax, ca.if_else(sat < -0.5, -1.0 - w / umax, 1.0)), 1.0))
     dae = {"x": X, "p": P, "u": U, "t": tau, "ode": ode, "zero": ca.vertcat(*zero)}
 
     # transition: the state just after an event
@@ -389,6 +396,9 @@ def build_integrator(spec: PlantSpec) -> ca.Function:
         posts.append(ca.if_else(new_dir != s, reversal(new_dir, {"rest": 0.0}), with_({"rest": 0.0})))
         posts.append(ca.if_else(s * st["vh"] < 0.0, with_({"tmiss": 1.0 + t_n, "armed": 0.0}), with_({"armed": 0.0})))
         posts.append(with_({"armed": 1.0}))
+    if spec.fb == "continuous":  # enter or leave the upper, then the lower limit
+        posts.append(with_({"sat": ca.if_else(ca.fabs(st["sat"]) < 0.5, 1.0, 0.0)}))
+        posts.append(with_({"sat": ca.if_else(ca.fabs(st["sat"]) < 0.5, -1.0, 0.0)}))
     post = posts[-1]
     for k in range(len(posts) - 2, -1, -1):
         post = ca.if_else(idx == k, posts[k], post)

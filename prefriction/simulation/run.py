@@ -119,6 +119,7 @@ class Run:
             X[ix["ne"]] = st.get("ne", 0)  # (a state set without it: none so far)
         if self.spec.fb == "continuous":
             X[L.xc] = st["xc"] / self.S
+            X[ix["sat"]] = self._clip_mode()
 
     def _unpack(self, L: Layout, col: np.ndarray, a: dict, n_before: int, nstop: float) -> dict:
         """State of one output column; ``t`` is the stop time if the call stopped at ``nstop``."""
@@ -175,6 +176,14 @@ class Run:
         if "uhold" in L.control:
             U[L.control["uhold"]] = self.st["uhold"]
         return U
+
+    def _clip_mode(self) -> float:
+        """Mode of the continuous controller's force limit now: 0 inside, +-1 clipped at +-u_max."""
+        fb, st = self.fb, self.st
+        if fb.u_max is None:
+            return 0.0
+        w = float(fb.output(st["xc"], float(fb.reference(st["t"] * self.sc.t)) - st["x"] * self.sc.x))
+        return 0.0 if abs(w) <= fb.u_max else math.copysign(1.0, w)
 
     def _net_force(self) -> float:
         """Normalised net force ``u~ - F~`` on the mass in the current state."""
