@@ -177,10 +177,12 @@ def test_bad_force_limits_are_refused():
             LinearFeedback(**mats, u_max=bad)
     with pytest.raises(TypeError, match="u_max must be a real number, got '2'"):
         LinearFeedback(**mats, u_max="2")
-    with pytest.raises(ValueError, match=r"k_aw must be a finite vector of length 2 \[1/\(N s\)\], got \[1.0\]"):
+    with pytest.raises(ValueError, match=r"k_aw must be a vector of length n = 2 \(the controller states of A\), got \[1.0\]"):
         LinearFeedback(**mats, u_max=2.0, k_aw=[1.0])
-    with pytest.raises(ValueError, match=r"k_aw must be a finite vector of length 2"):
+    with pytest.raises(ValueError, match=r"k_aw\[1\] must be finite .* \[1/\(N s\)\], got nan"):
         LinearFeedback(**mats, u_max=2.0, k_aw=[1.0, math.nan])
+    with pytest.raises(TypeError, match=r"k_aw must be a real number or an array of finite real numbers"):
+        LinearFeedback(**mats, u_max=2.0, k_aw="fast")
     with pytest.raises(ValueError, match=r"k_aw=\[1.0, 0.0\] needs a force limit u_max"):
         LinearFeedback(**mats, k_aw=[1.0, 0.0])
     Cd = _design().c2d(1e-4)
