@@ -117,9 +117,10 @@ def simulate_loop(
         Continuous (its states are integrated with the plant) or discrete with ``dt > 0``
         (sampled-data loop: ``u[k] = C xc[k] + D e[k]`` held constant over each sample
         interval, zero-order hold), e.g. from ``control.c2d``. A :class:`PID` with a force
-        limit ``u_max`` (sampled loops only) applies ``clip(u, -u_max, u_max)`` and corrects
-        its integrator by back-calculation, ``xc[k+1] = A xc[k] + B e[k] + Ts k_aw (u[k] - v[k])``
-        with the unclipped output ``v[k]`` and ``k_aw`` of :meth:`PID.back_calculation_gain`.
+        limit ``u_max`` applies ``clip(v, -u_max, u_max)`` to its output ``v`` and corrects
+        its integrator by back-calculation with ``k_aw`` of :meth:`PID.back_calculation_gain`:
+        ``xc[k+1] = A xc[k] + B e[k] + Ts k_aw (u[k] - v[k])`` in a sampled loop,
+        ``xc' = A xc + B e + k_aw (u - v)`` in a continuous one (Astrom and Hagglund).
     reference : float, callable or (t, r)
         Position reference [m]: a number (a step at ``t = 0``), a callable ``r(t)`` of time
         [s], or samples ``(t, r)`` of equal length (linear between samples, held constant
@@ -165,9 +166,6 @@ def simulate_loop(
     TypeError
         Wrong argument types, unknown keyword arguments, a reference callable that cannot be
         traced in a continuous loop.
-    NotImplementedError
-        A :class:`PID` with a force limit ``u_max`` in a continuous loop (the simulator's
-        continuous feedback is linear; the force limit is simulated for sampled loops).
     prefriction.SolverError
         If the integration fails (the message names the time, the state and what to try).
 
@@ -196,11 +194,6 @@ def simulate_loop(
     if Ts is not None:
         sample_count(t_end, Ts, t_end / Ts)  # refuse runs that would exhaust the memory
     closed_loop(system, C, regime="presliding", warn=True)
-    if saturated and Ts is None:
-        raise NotImplementedError(
-            f"u_max={controller.u_max!r}: force saturation with anti-windup is simulated for sampled "
-            "controllers only (prefriction.simulate's continuous feedback is linear); give Ts"
-        )
     fb_reference = reference
     stats = None
     if Ts is not None:
@@ -225,7 +218,8 @@ def simulate_loop(
             )
     else:
         dense = np.linspace(0.0, t_end, 2001) if t_out is None else _check_t_out(t_out, t_end)
-        fb = LinearFeedback(A=C.A, B=C.B, C=C.C, D=C.D, Ts=Ts, reference=fb_reference, xc0=xc0)
+        limit = {"u_max": controller.u_max, "k_aw": controller.back_calculation_gain()} if saturated else {}
+        fb = LinearFeedback(A=C.A, B=C.B, C=C.C, D=C.D, Ts=Ts, reference=fb_reference, xc0=xc0, **limit)
         sim = prefriction.simulate(system, v0, x0=x0, F0=F0, t_end=t_end, rtol=rtol, dense=dense, feedback=fb, jit=jit)
     t = sim.t
     r = _evaluate(reference, t)

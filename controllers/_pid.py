@@ -7,9 +7,9 @@ limit for anti-windup) that produces its linear form as a python-control ``State
     C(s) = kp + ki / s + kd s / (tau s + 1)
 
 The anti-windup (back-calculation) acts only when a force limit ``u_max`` is given, and only in
-:func:`controllers.simulate_loop` with a sampled loop (``Ts``): a saturation is not linear, so
-the LTI object itself cannot carry it, and the simulator's continuous feedback is linear. Exported as a plain LTI object (``pid.ss()``, ``pid.c2d(Ts)``) the controller is the
-unsaturated linear law.
+:func:`controllers.simulate_loop` (sampled or continuous loops): a saturation is not linear, so
+the LTI object itself cannot carry it. Exported as a plain LTI object (``pid.ss()``,
+``pid.c2d(Ts)``) the controller is the unsaturated linear law.
 """
 
 from __future__ import annotations
@@ -46,8 +46,8 @@ class PID:
         Derivative filter ratio used when ``tau`` is not given, ``0 < N < inf``.
     u_max : float, optional
         Force limit [N], ``0 < u_max < inf``. Only :func:`controllers.simulate_loop` uses it,
-        for sampled loops: the plant receives ``clip(u, -u_max, u_max)`` and the integrator is
-        corrected by back-calculation. ``None``: no limit, the loop is the linear law.
+        for sampled and continuous loops: the plant receives ``clip(u, -u_max, u_max)`` and the
+        integrator is corrected by back-calculation. ``None``: no limit, the loop is the linear law.
     t_track : float, optional
         Tracking time constant of the back-calculation anti-windup [s], ``0 < t_track < inf``:
         ``d/dt (ki * integral) = ki e + (sat(u) - u) / t_track``. Default
@@ -217,7 +217,7 @@ def pid(
     N : float, default 10
         Derivative filter ratio used when ``tau`` is not given, > 0.
     u_max : float, optional
-        Force limit [N], > 0, with back-calculation anti-windup (sampled loops).
+        Force limit [N], > 0, with back-calculation anti-windup (sampled and continuous loops).
     t_track : float, optional
         Tracking time constant [s] of the anti-windup (see :class:`PID`).
 

@@ -131,7 +131,7 @@ def dense(run: "Run", times: np.ndarray, t_end: float, n_target: float, buf: Sam
     if grid.size and grid[0] <= run.st["t"]:
         buf.append(run.sample())
         i = 1
-    n_key = run.L.state["n"]
+    n_key, tm = run.L.state["n"], run.L.state.get("tmiss")
     nstop = min(n_target, 1e18)
     while i < grid.size:
         if len(run.rev) >= n_target:
@@ -144,7 +144,8 @@ def dense(run: "Run", times: np.ndarray, t_end: float, n_target: float, buf: Sam
         n_col = np.floor(cols[n_key] + 0.5)
         total = n_col[-1] - n0
         new = np.diff(n_col, prepend=n0) if total > 0 else None  # reversals per column
-        if n_col[-1] >= nstop or (total > run.spec.K and new.max() > run.spec.K):  # stop or register
+        missed = tm is not None and cols[tm, -1] > 0.5  # a reversal pair skipped inside one step
+        if n_col[-1] >= nstop or missed or (total > run.spec.K and new.max() > run.spec.K):  # stop or register
             # overflow: column by column
             used, stopped = _columns_one_by_one(run, cols, pts, is_sample[i:i + m], a, n_target, nstop, buf)
             if stopped:
@@ -193,13 +194,14 @@ def _columns_together(run: "Run", cols: np.ndarray, pts: np.ndarray, is_sample: 
 def _columns_one_by_one(run: "Run", cols: np.ndarray, pts: np.ndarray, is_sample: np.ndarray, a: dict,
                         n_target: float, nstop: float, buf: SampleBuffer) -> tuple[int, bool]:
     """Take the outputs of one call column by column (the run stops in it, or more than ``K``
-    reversals fell between two outputs: that piece is integrated again by ``advance``).
-    Returns the number of outputs used and whether the run stopped."""
+    reversals fell between two outputs, or a reversal pair inside one step stopped the call:
+    that piece is integrated again by ``advance``). Returns the number of outputs used and
+    whether the run stopped."""
     L = run.L
     for j in range(cols.shape[1]):
         out = run._unpack(L, cols[:, j], a, len(run.rev), nstop)
         t = float(pts[j])
-        if out["overflow"]:
+        if out["overflow"] or out["tmiss"] is not None:
             if run.advance(t, n_target):
                 return j + 1, True
             if is_sample[j]:
@@ -308,7 +310,7 @@ def samples_si(run: "Run", samples: "SampleBuffer | Sequence[tuple]", u_hist: Se
             u = np.asarray(system.u(t), dtype=float) if system.forced else np.zeros(n)
             if feedback is not None:
                 e = np.asarray(feedback.reference(t), dtype=float) - x
-                u = u + (xc @ feedback.C[0] if run.spec.n_c else 0.0) + feedback.D[0, 0] * e
+                u = u + feedback.force(xc, e)
             extra["u"] = u
     if feedback is not None:
         extra["xc"] = xc[:, :n_user]

@@ -7,6 +7,9 @@ state-space form, all in SI units:
 - force ``u = C xc + D e`` [N] (plus ``system.u(t)`` if the oscillator has an input force too);
 - continuous controller (``Ts is None``): ``xc' = A xc + B e``, integrated together with the
   plant in the same CasADi right-hand side;
+- optional force limit ``u_max`` with back-calculation anti-windup (continuous controllers):
+  the output ``w = C xc + D e`` is clipped, ``u = clip(w, -u_max, u_max)``, and
+  ``xc' = A xc + B e + k_aw (u - w)`` (Astrom and Hagglund);
 - sampled-data controller (``Ts > 0``): ``xc[k+1] = A xc[k] + B e[k]`` with ``e[k] = e(k Ts)``,
   the force ``u[k] = C xc[k] + D e[k]`` held constant (zero-order hold) over
   ``[k Ts, (k+1) Ts)``; reversals inside a sample interval are located as in the open loop.
@@ -108,15 +111,26 @@ class LinearFeedback:
         linearly and held constant outside the sample range.
     xc0 : array_like or None, default None
         Initial controller state, shape ``(n,)``; zeros if ``None``.
+    u_max : float or None, default None
+        Force limit [N], ``0 < u_max < inf``, of a continuous controller: the plant receives
+        ``clip(C xc + D e, -u_max, u_max)``. ``None``: no limit (the linear law).
+    k_aw : array_like or None, default None
+        Back-calculation gains [1/(N s)] per controller state, shape ``(n,)``, finite: ``xc' = A xc
+        + B e + k_aw (u - w)`` with the clipped force ``u`` and the unclipped output ``w``. Zeros
+        if ``None``; only with ``u_max``.
 
     Raises
     ------
     TypeError
-        If a matrix or ``xc0`` is not real numbers (``None``, strings, booleans, complex,
-        ragged nesting), ``Ts`` is not a real number, or ``reference`` is of no accepted kind.
+        If a matrix, ``xc0`` or ``k_aw`` is not real numbers (``None``, strings, booleans,
+        complex, ragged nesting), ``Ts`` or ``u_max`` is not a real number, or ``reference`` is
+        of no accepted kind.
     ValueError
         If a matrix or ``xc0`` has the wrong shape or a non-finite entry, ``Ts`` is not
-        positive, or the reference samples are malformed.
+        positive, the reference samples are malformed, ``u_max`` is not finite and positive,
+        ``k_aw`` has the wrong length or a non-finite entry, ``u_max`` or ``k_aw`` is given with
+        a sampled controller (``Ts``; :func:`controllers.simulate_loop` limits sampled loops),
+        or ``k_aw`` without ``u_max``.
     """
 
     A: Any = field(default_factory=lambda: np.zeros((0, 0)))
@@ -126,6 +140,8 @@ class LinearFeedback:
     Ts: Optional[float] = None
     reference: Reference = 0.0
     xc0: Any = None
+    u_max: Optional[float] = None
+    k_aw: Any = None
 
     def __post_init__(self) -> None:
         n = _state_count(self.A)
@@ -145,11 +161,46 @@ class LinearFeedback:
             raise ValueError(f"xc0 must be a vector of length n = {n} (the controller states of A), got {got}")
         xc0.setflags(write=False)
         object.__setattr__(self, "xc0", xc0)
+        self._check_limit(n)
+
+    def _check_limit(self, n: int) -> None:
+        """Validate ``u_max`` and ``k_aw`` (continuous controllers only) and store them."""
+        if self.Ts is not None and (self.u_max is not None or self.k_aw is not None):
+            raise ValueError(f"u_max and k_aw are for continuous controllers (Ts=None), got Ts={self.Ts!r}: "
+                            "run a force-limited sampled loop with controllers.simulate_loop")
+        if self.u_max is not None:
+            object.__setattr__(self, "u_max", check_positive("u_max", self.u_max))
+        elif self.k_aw is not None:
+            raise ValueError(f"k_aw={self.k_aw!r} needs a force limit u_max (back-calculation acts on the clipped force)")
+        k = np.zeros(n) if self.k_aw is None else check_real_array("k_aw", self.k_aw, "1/(N s)").reshape(-1)
+        if k.shape != (n,):
+            raise ValueError(f"k_aw must be a vector of length n = {n} (the controller states of A), got {self.k_aw!r}")
+        k.setflags(write=False)
+        object.__setattr__(self, "k_aw", k)
 
     @property
     def n_states(self) -> int:
         """Number of controller states ``n``."""
         return self.A.shape[0]
+
+    def output(self, xc: Any, e: Any) -> Any:
+        """Unclipped controller output ``w = C xc + D e`` [N].
+
+        Parameters
+        ----------
+        xc : array_like
+            Controller state, shape ``(n,)``, or states ``(k, n)`` at ``k`` times.
+        e : float or array_like
+            Error ``r - x`` [m], scalar or shape ``(k,)``.
+        """
+        xc = np.asarray(xc, dtype=float)
+        return (xc @ self.C[0] if self.n_states else 0.0) + self.D[0, 0] * np.asarray(e, dtype=float)
+
+    def force(self, xc: Any, e: Any) -> Any:
+        """Controller force [N] ``clip(C xc + D e, -u_max, u_max)`` (no clip without ``u_max``);
+        arguments as for :meth:`output`."""
+        w = self.output(xc, e)
+        return w if self.u_max is None else np.clip(w, -self.u_max, self.u_max)
 
     @property
     def sampled(self) -> bool:

@@ -16,14 +16,15 @@ from prefriction.units import Scales
 def applied_force_scale(system: Oscillator, fb: Optional[LinearFeedback], x0: float, t_end: float) -> float:
     """Size [N] of the applied force over ``[0, t_end]`` as the motion sees it: the input's
     :func:`motion_bound` plus the feedback force ``|D| max |r - x0| + |C xc0|`` (reference
-    evaluated at 257 times)."""
+    evaluated at 257 times), at most its limit ``fb.u_max``."""
     scale = motion_bound(system.u, t_end, Scales.of(system).t) if system.forced else 0.0
     if fb is not None:
         t = np.linspace(0.0, t_end, 257)
         with np.errstate(invalid="ignore"):
             r = np.asarray(fb.reference(t), dtype=float)
-            scale += abs(fb.D[0, 0]) * float(np.nanmax(np.abs(r - x0), initial=0.0))
-        scale += float(np.abs(fb.C[0] @ fb.xc0))
+            f = abs(fb.D[0, 0]) * float(np.nanmax(np.abs(r - x0), initial=0.0))
+        f += float(np.abs(fb.C[0] @ fb.xc0))
+        scale += f if fb.u_max is None else min(f, fb.u_max)
     return scale
 
 

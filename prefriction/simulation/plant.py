@@ -38,7 +38,9 @@ State vector (indices in :class:`Layout`), kept short because the cost of a step
     ``v~^2 / 2 + potential - W~``, ``AE`` times it; the model events set the speed from it
     when the parameter ``ecorr`` is 1 (the compact model has it as the parameter ``Eb``);
 ``xch``
-    continuous controller states, ``xc = S * xch``;
+    continuous controller states, ``xc = S * xch``; the controller's force is
+    ``clip(C xc + D e, -umax, umax)`` with back-calculation ``k_aw (u - w)`` on ``xc'``
+    (run-time ``umax``, ``k_aw``; ``umax = 1e300`` and ``k_aw = 0`` give the linear law);
 register
     the newest ``K`` reversals, newest first: ``(t~, x~, F~[, W~])`` each.
 
@@ -178,6 +180,8 @@ class Layout:
         self.potential = has_potential(model)
         if self.potential:  # the branch's mechanical energy (speed at events, FrictionModel.branch_potential)
             names.append("Ebh")
+        if spec.fb == "continuous":
+            names.append("sat")  # clip of the controller force: 0 inside, +-1 at +-umax
         self.state = {k: i for i, k in enumerate(names)}
         self.xc = slice(len(names), len(names) + spec.n_c)
         self.reg = len(names) + spec.n_c
@@ -197,8 +201,11 @@ class Layout:
         self.p_B = self.p_A + n * n
         self.p_C = self.p_B + n
         self.p_D = self.p_C + n
-        self.p_S = self.p_D + (1 if spec.fb == "continuous" else 0)
-        self.np = self.p_S + n
+        cont = 1 if spec.fb == "continuous" else 0
+        self.p_S = self.p_D + cont
+        self.p_umax = self.p_S + n  # force limit / Fc (1e300: none), then the anti-windup gains
+        self.p_kaw = self.p_umax + cont
+        self.np = self.p_kaw + cont * n
         cnames = ["dur", "t0"]
         if spec.fb == "sampled":
             cnames.append("uhold")
@@ -226,7 +233,7 @@ class Layout:
         self.param = {k: i for i, k in enumerate(["Ax", "Av", "AF", "s", "eps"] + (["Eb"] if self.potential else []))}
         self.q = self._block(len(self.param), spec.n_q)
         self.up = self.rp = self._block(self.q.stop, 0)
-        self.p_A = self.p_B = self.p_C = self.p_D = self.p_S = self.np = self.q.stop
+        self.p_A = self.p_B = self.p_C = self.p_D = self.p_S = self.p_umax = self.p_kaw = self.np = self.q.stop
         self.control = {"dur": 0, "t0": 1}
         self.uc = self.rc = self._block(2, 0)
         self.nu = 2
@@ -302,9 +309,12 @@ def build_integrator(spec: PlantSpec) -> ca.Function:
             A = ca.reshape(P[L.p_A:L.p_B], n, n)
             B = P[L.p_B:L.p_C]
             C = ca.reshape(P[L.p_C:L.p_D], 1, n)
-            S = P[L.p_S:L.np]
+            S = P[L.p_S:L.p_umax]
             xc = S * X[L.xc]
-            u = u + (ca.mtimes(C, xc) if n else 0.0) + P[L.p_D] * e
+            w = (ca.mtimes(C, xc) if n else 0.0) + P[L.p_D] * e  # unclipped controller output
+            umax, sat = P[L.p_umax], st["sat"]
+            u_fb = ca.if_else(ca.fabs(sat) < 0.5, w, sat * umax)  # force limit: the clip's mode is a state
+            u = u + u_fb
         else:
             u = u + c["uhold"] / p["Fc"]
     acc = u - F
@@ -324,7 +334,8 @@ def build_integrator(spec: PlantSpec) -> ca.Function:
     for k, val in dot.items():
         ode[L.state[k]] = val
     if spec.fb == "continuous" and n:
-        ode[L.xc] = run * (ca.mtimes(A, xc) + B * e) / S
+        # back-calculation anti-windup: k_aw (u - w) (zero while the limit does not bind)
+        ode[L.xc] = run * (ca.mtimes(A, xc) + B * e + P[L.p_kaw:L.np] * (u_fb - w)) / S
     ode = c["dur"] * ode
     # indicators in units of the amplitude (vh is scaled by 1/eps); forced: offset so that a
     # branch starting at v = 0 has a positive indicator (EPS_START)
@@ -336,6 +347,10 @@ def build_integrator(spec: PlantSpec) -> ca.Function:
         sa_n = s * acc / p["Av"] * p["eps"]  # s a~ relative to the amplitude
         zero.append(ca.if_else(ca.logic_and(run_m > 0.5, armed), -sa_n, 1.0))  # least speed
         zero.append(ca.if_else(ca.logic_and(run_m > 0.5, ca.logic_not(armed)), sa_n, 1.0))  # greatest
+    if spec.fb == "continuous":  # the clip's switches (w = +-umax), relative to umax
+        inside = ca.fabs(sat) < 0.5
+        zero.append(ca.if_else(run > 0.5, ca.if_else(inside, 1.0 - w / umax, ca.if_else(sat > 0.5, w / umax - 1.0, 1.0)), 1.0))
+        zero.append(ca.if_else(run > 0.5, ca.if_else(inside, 1.0 + w / umax, ca.if_else(sat < -0.5, -1.0 - w / umax, 1.0)), 1.0))
     dae = {"x": X, "p": P, "u": U, "t": tau, "ode": ode, "zero": ca.vertcat(*zero)}
 
     # transition: the state just after an event
@@ -401,6 +416,9 @@ def build_integrator(spec: PlantSpec) -> ca.Function:
         posts.append(ca.if_else(new_dir != s, reversal(new_dir, {"rest": 0.0}), with_({"rest": 0.0})))
         posts.append(ca.if_else(s * st["vh"] < 0.0, with_({"tmiss": 1.0 + t_n, "armed": 0.0}), with_({"armed": 0.0})))
         posts.append(with_({"armed": 1.0}))
+    if spec.fb == "continuous":  # enter or leave the upper, then the lower limit
+        posts.append(with_({"sat": ca.if_else(ca.fabs(st["sat"]) < 0.5, 1.0, 0.0)}))
+        posts.append(with_({"sat": ca.if_else(ca.fabs(st["sat"]) < 0.5, -1.0, 0.0)}))
     post = posts[-1]
     for k in range(len(posts) - 2, -1, -1):
         post = ca.if_else(idx == k, posts[k], post)

@@ -297,7 +297,7 @@ def _initial_state(run: Run, x0: float, v0: float, F0: float, xc0: np.ndarray, *
     u0 = float(system.u(0.0)) if system.forced else 0.0
     if feedback is not None:
         e0 = float(feedback.reference(0.0)) - x0
-        u0 += float(feedback.C[0] @ xc0 + feedback.D[0, 0] * e0)
+        u0 += float(feedback.force(xc0, e0))
     acc0 = (u0 - F0) / Fc
     rest = 0.0
     if v0 != 0.0:
@@ -380,4 +380,6 @@ def _padded(fb: LinearFeedback, order: int) -> LinearFeedback:
     C = np.zeros((1, order))
     C[:, :n] = fb.C
     xc0 = np.concatenate([fb.xc0, np.zeros(order - n)])
-    return LinearFeedback(A=A, B=B, C=C, D=fb.D, Ts=fb.Ts, reference=fb.reference, xc0=xc0)
+    k_aw = None if fb.u_max is None else np.concatenate([fb.k_aw, np.zeros(order - n)])
+    return LinearFeedback(A=A, B=B, C=C, D=fb.D, Ts=fb.Ts, reference=fb.reference, xc0=xc0, u_max=fb.u_max,
+                          k_aw=k_aw)
