@@ -57,26 +57,10 @@ def rel_err(res, ref):
 
 
 def slips_seen(model, sys_, v0, n, rtol, **kw):
-    """Simulate and return the result and the number of elements that slipped in each half-cycle.
-
-    The simulator exposes no event count. The unforced loop passes the model's flags to
-    ``reverse`` (floats) at every reversal before clearing them: an element slips at most once
-    per half-cycle, so the flags set there are that half-cycle's slips. We wrap ``reverse`` of
-    this instance to read them (the plant is shared with every MaxwellSlip of the same N).
-    """
-    seen = []
-    inner = type(model).reverse
-
-    def recording(z, m, s_new, q, snap):
-        seen.append(int(round(sum(m))))
-        return inner(model, z, m, s_new, q, snap)
-
-    object.__setattr__(model, "reverse", recording)
-    try:
-        res = pf.simulate(sys_, v0, reversals=n, rtol=rtol, **kw)
-    finally:
-        object.__delattr__(model, "reverse")
-    return res, np.array(seen)
+    """Simulate and return the result and the element slips the simulator counted in each
+    half-cycle (``result.events``, one count per reversal; ``model`` is the system's friction)."""
+    res = pf.simulate(sys_, v0, reversals=n, rtol=rtol, **kw)
+    return res, np.asarray(res.events)
 
 
 # ------------------------------------------------------------------------------ the model
