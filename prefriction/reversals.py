@@ -119,7 +119,11 @@ def _column(name: str, values: Any, *, finite: bool) -> np.ndarray:
     """``values`` as a 1-D float array; ``TypeError`` unless real numbers, ``ValueError`` for a
     non-finite entry (``finite``) or an infinite one (NaN allowed: the quantity is not defined)."""
     allowed = "a 1-D array of real numbers"
-    text = repr(values) if len(repr(values)) <= 80 else repr(values)[:77] + "..."
+    if isinstance(values, np.ndarray) and values.dtype.kind == "f" and values.ndim == 1:
+        bad = ~np.isfinite(values) if finite else np.isinf(values)
+        if not bad.any():  # the simulator's and the exact reference's columns: no copy, no message
+            return values.astype(float)
+    text = _short(values)
     if values is None or isinstance(values, (str, bytes, dict, set)):
         raise TypeError(f"table.{name} must be {allowed}, got {text} of type {type(values).__name__}")
     try:
@@ -138,3 +142,9 @@ def _column(name: str, values: Any, *, finite: bool) -> np.ndarray:
         raise ValueError(f"table.{name} must be {kind}, got a non-finite entry at index {i} (reversal {i + 1}): "
                          f"{float(arr[i])!r}")
     return arr
+
+
+def _short(values: Any) -> str:
+    """``repr(values)`` cut to 80 characters (formatted only when a message needs it)."""
+    text = repr(values)
+    return text if len(text) <= 80 else text[:77] + "..."
