@@ -34,7 +34,8 @@ with friction", IEEE Trans. Automatic Control 40(3), 419-425, 1995. Parameters o
 
 Experiments 1, 3, 4 and 5 run through :func:`prefriction.simulate`, which locates every
 velocity reversal (the kink of ``|v|``) and switches the LuGre branch there. All five are
-checked against an independent scipy Radau reference in ``tests/test_lugre.py``.
+checked against an independent scipy Radau reference in ``tests/test_lugre.py``. The numbers
+of each figure, and how they compare with the paper's figures, are in ``docs/lugre.md``.
 """
 
 from __future__ import annotations
