@@ -127,7 +127,9 @@ def analyze_samples(
     if len(rev) == 0:
         raise ValueError(
             f"v changes sign nowhere in the {t.size} samples (t from {float(t[0])!r} to {float(t[-1])!r} s): "
-            "no reversal to analyse; simulate longer"
+            "the motion never reverses in them, and the bookkeeping (2.3)-(2.12) is made at reversals: give "
+            "samples that contain at least one velocity reversal (a longer run if the motion still oscillates; "
+            "an overdamped or monotone motion has none)"
         )
     cont, held = _input_forces(system, t, u, zoh)
     W = input_work(t, x, v, rev, method, u=cont, held=held)
