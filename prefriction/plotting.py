@@ -7,8 +7,9 @@ global state behind.
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
-from typing import Union
+from typing import Optional, Sequence, Union
 
 import numpy as np
 from matplotlib.axes import Axes
@@ -94,3 +95,59 @@ def save(fig: Figure, outdir: PathLike, name: str, *, dpi: int = 130) -> Path:
     path = out / name
     fig.savefig(path, dpi=dpi)
     return path
+
+
+def script_args(
+    argv: Sequence[str], default_out: PathLike = ".", *, allow_quick: bool = True, prog: Optional[str] = None
+) -> tuple[str, bool]:
+    """Parse an example script's command line ``[outdir] [--quick]``.
+
+    Parameters
+    ----------
+    argv : sequence of str
+        The arguments after the script name, e.g. ``sys.argv[1:]``.
+    default_out : str or Path
+        Output directory when none is given.
+    allow_quick : bool
+        Whether the script accepts ``--quick`` (a faster, coarser run); when False, ``--quick``
+        is refused like any other option.
+    prog : str, optional
+        Script name shown in the usage line (default ``sys.argv[0]``).
+
+    Returns
+    -------
+    outdir : str
+        The output directory (``default_out`` if none given).
+    quick : bool
+        True if ``--quick`` was given.
+
+    Notes
+    -----
+    ``-h``/``--help`` prints the usage and exits with status 0. Any other argument starting
+    with ``-``, or more than one output directory, prints the usage and a message naming the
+    argument to stderr and exits with status 2 (the argparse convention).
+    """
+    prog = prog if prog is not None else Path(sys.argv[0]).name
+    usage = f"usage: {prog} [outdir]" + (" [--quick]" if allow_quick else "")
+    outdirs: list[str] = []
+    quick = False
+    for arg in argv:
+        if arg in ("-h", "--help"):
+            print(usage)
+            raise SystemExit(0)
+        if arg == "--quick" and allow_quick:
+            quick = True
+        elif arg.startswith("-"):
+            allowed = "--quick, -h/--help" if allow_quick else "-h/--help"
+            _refuse(usage, f"unknown option {arg!r} (allowed: {allowed})")
+        else:
+            outdirs.append(arg)
+    if len(outdirs) > 1:
+        _refuse(usage, f"one output directory expected, got {len(outdirs)}: {outdirs!r}")
+    return (outdirs[0] if outdirs else str(default_out)), quick
+
+
+def _refuse(usage: str, message: str) -> None:
+    """Print ``usage`` and ``message`` to stderr and exit with status 2."""
+    print(f"{usage}\nerror: {message}", file=sys.stderr)
+    raise SystemExit(2)
