@@ -78,4 +78,7 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
 
 
 if __name__ == "__main__":
-    print(main(sys.argv[1] if len(sys.argv) > 1 else ".")["png"])
+    from prefriction.plotting import script_args
+
+    outdir, quick = script_args(sys.argv[1:])
+    print(main(outdir, quick=quick)["png"])

@@ -82,5 +82,7 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
 
 
 if __name__ == "__main__":
-    args = [a for a in sys.argv[1:] if a != "--quick"]
-    main(args[0] if args else ".", quick="--quick" in sys.argv[1:])
+    from prefriction.plotting import script_args
+
+    outdir, quick = script_args(sys.argv[1:])
+    main(outdir, quick=quick)

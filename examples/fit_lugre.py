@@ -123,5 +123,7 @@ def _figure(res: identify.FitResult, t: np.ndarray, coverage: dict, seeds: int, 
 
 
 if __name__ == "__main__":
-    args = [a for a in sys.argv[1:] if a != "--quick"]
-    main(args[0] if args else ".", quick="--quick" in sys.argv[1:])
+    from prefriction.plotting import script_args
+
+    outdir, quick = script_args(sys.argv[1:])
+    main(outdir, quick=quick)

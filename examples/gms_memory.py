@@ -211,6 +211,9 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
 
 
 if __name__ == "__main__":
-    out = main(sys.argv[1] if len(sys.argv) > 1 else ".")
+    from prefriction.plotting import script_args
+
+    outdir, quick = script_args(sys.argv[1:])
+    out = main(outdir, quick=quick)
     print(out["png"], "closure [N]:", out["closure"], "inertia [N]:", out["inertia"], "outer gap:", out["outer_gap"],
           "loop widths [N]:", out["loop_width"])

@@ -150,7 +150,10 @@ def main(outdir: str | Path = ".", *, t_end: float = 24.0, steps: int = 30) -> d
 
 
 if __name__ == "__main__":
-    out = main(sys.argv[1] if len(sys.argv) > 1 else ".")
+    from prefriction.plotting import script_args
+
+    outdir, _ = script_args(sys.argv[1:], allow_quick=False)
+    out = main(outdir)
     print(out["hunting"].summary())
     print(f"hunting cycle's F1/V1 = {out['N_eff']:.4g} N s/m (damping {out['N_eff'].real:.4g} N s/m, "
           f"stiffness {-2 * math.pi / out['hunting'].period * out['N_eff'].imag:.4g} N/m)")

@@ -579,4 +579,7 @@ def main(outdir: str | Path = ".", *, quick: bool = False, bench: Optional[bool]
 
 
 if __name__ == "__main__":
-    print([str(p) for p in main(sys.argv[1] if len(sys.argv) > 1 else ".")["pngs"]])
+    from prefriction.plotting import script_args
+
+    outdir, quick = script_args(sys.argv[1:])
+    print([str(p) for p in main(outdir, quick=quick)["pngs"]])

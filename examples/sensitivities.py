@@ -54,6 +54,9 @@ def main(outdir: str | Path = ".") -> dict:
 
 
 if __name__ == "__main__":
-    out = main(sys.argv[1] if len(sys.argv) > 1 else ".")
+    from prefriction.plotting import script_args
+
+    outdir, _ = script_args(sys.argv[1:], allow_quick=False)
+    out = main(outdir)
     print(out["result"].summary())
     print(f"largest relative difference against the exact map: {out['max_relative_difference']:.3g}")

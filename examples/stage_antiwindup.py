@@ -53,7 +53,10 @@ def main(outdir: "str | Path" = ".") -> dict:
 
 
 if __name__ == "__main__":
-    out = main(sys.argv[1] if len(sys.argv) > 1 else ".")
+    from prefriction.plotting import script_args
+
+    outdir, _ = script_args(sys.argv[1:], allow_quick=False)
+    out = main(outdir)
     print(f"wrote {out['path']}")
     for label, c in out["cases"].items():
         print(f"  {label:<14} overshoot {c['overshoot'] * 1e9:8.1f} nm, peak |u| {c['peak_force']:.3g} N, "

@@ -33,4 +33,7 @@ def main(outdir: "str | Path" = ".") -> dict:
 
 
 if __name__ == "__main__":
-    print(report(main(sys.argv[1] if len(sys.argv) > 1 else ".")))
+    from prefriction.plotting import script_args
+
+    outdir, _ = script_args(sys.argv[1:], allow_quick=False)
+    print(report(main(outdir)))
