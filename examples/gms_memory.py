@@ -215,5 +215,10 @@ if __name__ == "__main__":
 
     outdir, quick = script_args(sys.argv[1:])
     out = main(outdir, quick=quick)
-    print(out["png"], "closure [N]:", out["closure"], "inertia [N]:", out["inertia"], "outer gap:", out["outer_gap"],
-          "loop widths [N]:", out["loop_width"])
+    join = ", ".join
+    print(f"wrote {out['png']}")
+    print(f"inner loops: closure {join(f'{c * 1e3:+.3g}' for c in out['closure'])} mN "
+          f"(loop widths {join(f'{w * 1e3:.3g}' for w in out['loop_width'])} mN)")
+    print(f"damping force tau|u'| {out['damping_force'] * 1e3:.3g} mN, largest inertial force "
+          f"{out['inertia'] * 1e3:.3g} mN; nested vs outer run: {out['outer_gap']['F'] * 1e3:.3g} mN, "
+          f"{out['outer_gap']['x'] * 1e9:.3g} nm")
