@@ -54,8 +54,9 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
         r = identify.fit(START, maxwell_slip_loops(TRUE, t, x, NOISE, np.random.default_rng(100 + seed)))
         inside += (r.low <= truth) & (truth <= r.high)
         print(f"seed {seed + 1}/{seeds}", file=sys.stderr, end="\r")
+    print(file=sys.stderr)
     coverage = dict(zip(res.names, (inside / seeds).tolist()))
-    print(f"\ncoverage of the 95 % intervals over {seeds} seeds: "
+    print(f"coverage of the 95 % intervals over {seeds} seeds: "
           + ", ".join(f"{n} {100 * c:.0f} %" for n, c in coverage.items())
           + f"; all {100 * inside.sum() / (seeds * truth.size):.0f} %")
 
