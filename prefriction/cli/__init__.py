@@ -17,13 +17,17 @@ COMMANDS = {
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Dispatch ``argv`` (default ``sys.argv[1:]``) to a subcommand; return its exit code."""
+    """Dispatch ``argv`` (default ``sys.argv[1:]``) to a subcommand; return its exit code.
+
+    ``-h``/``--help`` prints the usage and returns 0; no command or an unknown one prints an
+    error to stderr and returns 2 (the argparse convention).
+    """
     args = list(sys.argv[1:] if argv is None else argv)
-    if not args or args[0] in ("-h", "--help"):
-        print("usage: prefriction COMMAND [options]\n\ncommands:")
-        for name, (_, text) in COMMANDS.items():
-            print(f"  {name:<8} {text}")
-        print("\n'prefriction COMMAND --help' shows the options of a command.")
+    if not args:  # argparse convention: a missing command is a usage error
+        print(_usage() + "\nprefriction: error: a command is required", file=sys.stderr)
+        return 2
+    if args[0] in ("-h", "--help"):
+        print(_usage())
         return 0
     name, rest = args[0], args[1:]
     if name not in COMMANDS:
@@ -31,6 +35,14 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     module = importlib.import_module(COMMANDS[name][0])
     return int(module.main(rest) or 0)
+
+
+def _usage() -> str:
+    """The usage text: every command with its one-line description."""
+    lines = ["usage: prefriction COMMAND [options]", "", "commands:"]
+    lines += [f"  {name:<8} {text}" for name, (_, text) in COMMANDS.items()]
+    lines += ["", "'prefriction COMMAND --help' shows the options of a command."]
+    return "\n".join(lines)
 
 
 if __name__ == "__main__":
