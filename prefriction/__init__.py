@@ -59,6 +59,7 @@ __all__ = [
     "sweep",
 ]
 __version__ = "0.2.0"
+del annotations  # bound by the __future__ import; not part of the API
 
 
 _LAZY = ("describing", "identify")  # python-control (1.6 s) and scipy.stats (0.6 s) on first use
