@@ -25,13 +25,21 @@ import control
 import numpy as np
 from scipy.special import ive
 
-from prefriction._validation import check_array_interval, check_finite, check_positive
+from prefriction._validation import check_finite, check_positive, check_real_array
 
 __all__ = ["DahlDescribingFunction", "dahl_cycle", "dahl_describing_function"]
 
 
-def _k(A: Any, sigma: float, Fc: float) -> np.ndarray:
-    A = check_array_interval("A", A, 0.0, math.inf)
+def _k(A: Any, sigma: float, Fc: float) -> tuple[np.ndarray, np.ndarray]:
+    """``A`` [m] as a float array and ``k = sigma A / Fc``; the arguments validated."""
+    try:
+        A = check_real_array("A", A, "m", lo=0.0)
+    except ValueError as exc:
+        if "entries (memory)" in str(exc):
+            raise
+        arr = np.asarray(A, dtype=float)
+        bad = float(arr[~(np.isfinite(arr) & (arr >= 0.0))].flat[0])
+        raise ValueError(f"A must lie in [0, inf) [m] (every entry finite), got {bad!r}") from None
     return A, check_positive("sigma", sigma) * A / check_positive("Fc", Fc)
 
 
