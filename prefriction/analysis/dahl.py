@@ -108,7 +108,8 @@ def _direction(direction: Any) -> float:
 def _normalised_position(name: str, x: Any, sigma: float, Fc: float) -> np.ndarray:
     """``sigma x / Fc`` of the positions ``x`` [m]: finite entries whose normalised value is finite."""
     x = check_real_array(name, x, "m")
-    y = sigma * x / Fc
+    with np.errstate(over="ignore"):  # an overflow is refused below, naming the entry
+        y = sigma * x / Fc
     bad = ~np.isfinite(y)
     if np.any(bad):
         raise ValueError(
