@@ -139,8 +139,8 @@ def check_array_interval(name: str, values: Any, lo: float, hi: float) -> np.nda
         if "entries (memory)" in str(exc):
             raise
         arr = np.asarray(values, dtype=float)
-        first = arr[~((arr >= lo) & (arr <= hi))].flat[0]
-        raise ValueError(f"{name} must lie in [{lo!r}, {hi!r}] (every entry), got {first!r}") from None
+        first = float(arr[~(np.isfinite(arr) & (arr >= lo) & (arr <= hi))].flat[0])
+        raise ValueError(f"{name} must lie in [{lo!r}, {hi!r}] (every entry finite), got {first!r}") from None
 
 
 def check_signal(name: str, value: Any, unit: str, letter: str) -> Any:
