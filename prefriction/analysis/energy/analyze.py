@@ -162,6 +162,11 @@ def analyze_result(
 ) -> Report:
     """:func:`analyze_samples` of a simulation's samples, with the applied force ``result.u``.
 
+    The reversals are found in the samples (:func:`find_reversals`). A reversal on the last
+    sample, where a run stopped by ``reversals=n`` ends, is not among them: the samples do not
+    show the velocity's sign after it. Simulate one reversal more (or to a ``t_end`` past it) to
+    have all ``n`` half-cycles analysed.
+
     Parameters
     ----------
     result : SimulationResult or controllers.LoopResult
