@@ -1,4 +1,9 @@
-"""The integration loop of one :func:`prefriction.simulate` call (normalised units inside)."""
+"""The integration loop of one :func:`prefriction.simulate` call (normalised units inside).
+
+:class:`Run` holds the run's state and drives the integrator calls; the conversion of the
+state to and from a call's buffers is in :mod:`prefriction.simulation.state_io`, the rests
+decided between calls in :mod:`prefriction.simulation.rest`.
+"""
 
 from __future__ import annotations
 
@@ -10,7 +15,9 @@ import numpy as np
 from prefriction.simulation.compact import advance_compact
 from prefriction.simulation.integrator import INTEGRATOR_FAILED, BufferedIntegrator, integrator
 from prefriction.simulation.feedback import LinearFeedback
-from prefriction.simulation.plant import EPS_REST, EPS_TOUCH, Layout, PlantSpec
+from prefriction.simulation.plant import Layout, PlantSpec
+from prefriction.simulation.rest import Rest
+from prefriction.simulation.state_io import StateIO
 from prefriction.errors import SolverError
 from prefriction.models import Oscillator
 from prefriction.units import Scales
@@ -18,12 +25,14 @@ from prefriction.units import Scales
 N_DENSE = 16  # output times per call of the dense-output integrator
 
 
-class Run:
+class Run(StateIO, Rest):
     """The integration loop of one :func:`prefriction.simulate` call (normalised units inside).
 
     ``simulate`` sets the initial state ``st``, the run constants (``snap``, ``force_scale``,
-    ``breaks``, signal kinds, ``P0``) and then drives :meth:`advance`, :meth:`dense` and
-    :meth:`sample`; the reversals found are in ``rev``.
+    ``breaks``, signal kinds, ``P0``) and then drives :meth:`advance` (or
+    :func:`prefriction.simulation.dense.dense`) and :meth:`sample`; the reversals found are in
+    ``rev``. Packing of the call buffers: :class:`~prefriction.simulation.state_io.StateIO`;
+    rests between calls: :class:`~prefriction.simulation.rest.Rest`.
     """
 
     def __init__(self, system: Oscillator, spec: PlantSpec, fb: Optional[LinearFeedback],
@@ -50,177 +59,7 @@ class Run:
         self.S = np.ones(spec.n_c)  # controller state scales (times eps)
         self.P0 = np.zeros(self.L.np)  # parameters fixed during the run
 
-    # --- state conversion -------------------------------------------------------------
-    def _scales(self) -> dict:
-        """Amplitude scales of the next call (normalised units): the state and, if forced, the
-        force scale of the input and the largest amplitude so far (a motion can grow)."""
-        v, F = self.st["v"], self.st["F"]
-        A = math.hypot(v, F)
-        if self.spec.forced:
-            self.A_max = max(self.A_max, A)
-            A = max(A, self.force_scale, 0.1 * self.A_max)
-        A = max(A, 1e-150)  # AE = A^2 stays a normal double
-        Ax = max(A, 0.5 * A * A, min(abs(self.st["x"]), 1.0))  # positions: relative to |x| (<= 1)
-        return {"Ax": Ax, "Av": A, "AF": min(A, 1.0), "AE": A * A}
-
-    def _constant_params(self, L: Layout) -> np.ndarray:
-        """Parameter vector with the entries that stay fixed during the run."""
-        sc, fb, spec = self.sc, self.fb, self.spec
-        P = np.zeros(L.np)
-        P[L.param["eps"]] = self.eps
-        P[L.q] = self.q
-        if spec.stops_at_reversal:  # the amplitudes and the direction change per call
-            return P
-        P[L.param["snap"]] = self.snap
-        P[L.param["tunit"]] = sc.t
-        P[L.param["xunit"]] = sc.x
-        P[L.param["Fc"]] = sc.F
-        if spec.u_sig is not None:
-            P[L.up] = spec.u_sig.params()
-        if spec.r_sig is not None:
-            P[L.rp] = spec.r_sig.params()
-        if spec.fb == "continuous":
-            Ct = fb.C[0] / sc.F
-            self.S = self.eps * np.where(Ct != 0, 1.0 / np.where(Ct == 0, 1.0, np.abs(Ct)), 1.0)
-            P[L.p_A:L.p_B] = (fb.A * sc.t).T.ravel()  # column-major, as ca.reshape reads it
-            P[L.p_B:L.p_C] = fb.B[:, 0] * sc.t * sc.x
-            P[L.p_C:L.p_D] = Ct
-            P[L.p_D] = fb.D[0, 0] * sc.x / sc.F
-            P[L.p_S:L.p_umax] = self.S
-            P[L.p_umax] = 1e300 if fb.u_max is None else fb.u_max / sc.F  # no limit: the linear law
-            P[L.p_kaw:L.np] = fb.k_aw * sc.t * sc.F
-        return P
-
-    def _params(self, call: BufferedIntegrator, L: Layout, a: dict, nstop: float) -> None:
-        """Write the parameters of the next call into ``call.P``."""
-        P, ix = call.P, L.param
-        np.copyto(P, self.P0)
-        P[ix["Ax"]], P[ix["Av"]], P[ix["AF"]], P[ix["AE"]] = a["Ax"], a["Av"], a["AF"], a["AE"]
-        P[ix["xref"]], P[ix["Efref"]], P[ix["nstop"]] = self.st["x"], self.st["Ef"], nstop
-        if "ecorr" in ix:  # the speed at model events from the branch's energy, when it is known
-            P[ix["ecorr"]] = 1.0 if "Eb" in self.st else 0.0
-
-    def _pack(self, call: BufferedIntegrator, L: Layout, a: dict) -> None:
-        """Write the scaled state into ``call.X0`` (the register is output only)."""
-        st, ix, X = self.st, L.state, call.X0
-        X[0] = 0.0  # xh: positions relative to xref
-        X[1] = st["v"] / a["Av"]
-        for i, zi in enumerate(st["z"]):
-            X[2 + i] = zi / a["AF"]
-        X[ix["s"]] = st["s"]
-        X[ix["n"]] = len(self.rev)
-        for i, mi in enumerate(st["m"]):
-            X[ix[f"m{i}"]] = mi
-        if "rest" in ix:
-            X[ix["rest"]] = st["rest"]
-            X[ix["Wh"]] = st["W"] / a["AE"]
-            X[ix["armed"]], X[ix["tmiss"]] = 1.0, 0.0
-        if "Eh" in ix:
-            X[ix["Eh"]] = 0.0
-        if "ne" in ix:
-            X[ix["ne"]] = st.get("ne", 0)  # (a state set without it: none so far)
-        if "Ebh" in ix:
-            X[ix["Ebh"]] = st.get("Eb", 0.0) / a["AE"]
-        if self.spec.fb == "continuous":
-            X[L.xc] = st["xc"] / self.S
-            X[ix["sat"]] = self._clip_mode()
-
-    def _unpack(self, L: Layout, col: np.ndarray, a: dict, n_before: int, nstop: float) -> dict:
-        """State of one output column; ``t`` is the stop time if the call stopped at ``nstop``."""
-        ix = L.state
-        c = col.tolist()  # Python floats: cheaper to index than numpy scalars
-        n = int(c[ix["n"]] + 0.5)
-        s = c[ix["s"]]
-        z = [a["AF"] * c[2 + i] for i in range(L.nz)]
-        m = [c[ix[f"m{i}"]] for i in range(L.nm)]
-        v = a["Av"] * c[1]
-        out = {
-            "x": a["xref"] + a["Ax"] * c[0],
-            "v": v,
-            "z": z,
-            "m": m,
-            "F": float(self.model.force(z, m, v, s, self.q)),
-            "s": s,
-            "n": n,
-            "frozen": n >= nstop,
-            "rest": c[ix["rest"]] if "rest" in ix else 0.0,
-            "W": a["AE"] * c[ix["Wh"]] if "Wh" in ix else 0.0,
-            "Ef": a["Efref"] + a["AE"] * c[ix["Eh"]] if "Eh" in ix else 0.0,
-            "xc": col[L.xc] * self.S if self.spec.fb == "continuous" else self.st["xc"],
-        }
-        new = n - n_before
-        w, r0 = L.reg_width, L.reg
-        regs, counts = [], []
-        counted = "ne" in ix
-        for j in range(min(new, self.spec.K) - 1, -1, -1):
-            k = r0 + j * w
-            regs.append((c[k], c[k + 1], c[k + 2], c[k + 3] if w == 4 else 0.0))
-            counts.append(int(c[ix[f"nr{j}"]] + 0.5) if counted else 0)
-        out["new"], out["new_events"] = regs, counts
-        out["ne"] = int(c[ix["ne"]] + 0.5) if counted else 0
-        if "Ebh" in ix and "Eb" in self.st:
-            out["Eb"] = a["AE"] * c[ix["Ebh"]]
-        # a skipped reversal pair stopped the call at the least speed after it (1 + t~ there)
-        out["tmiss"] = c[ix["tmiss"]] - 1.0 if "tmiss" in ix and c[ix["tmiss"]] > 0.5 else None
-        out["overflow"] = new > self.spec.K
-        out["t"] = regs[-1][0] if out["frozen"] and regs else None
-        return out
-
     # --- one call -----------------------------------------------------------------------
-    def _controls(self, t0: float, t1: float, j: int) -> list[float]:
-        """Controls of the output interval [t0, t1] (normalised times)."""
-        L, sc = self.L, self.sc
-        U = [0.0] * L.nu
-        U[L.control["dur"]] = t1 - t0
-        U[L.control["t0"]] = t0 - (t1 - t0) * j  # t~ = t0 + dur * tau, tau in [j, j + 1]
-        if L.uc.stop > L.uc.start:
-            U[L.uc] = self.spec.u_sig.piece(t0 * sc.t, t1 * sc.t).tolist()
-            if self.hold_in_piece:  # a sampled controller's held force joins the input's piece
-                U[L.uc.start + 1] += self.st["uhold"]
-        if L.rc.stop > L.rc.start:
-            U[L.rc] = self.spec.r_sig.piece(t0 * sc.t, t1 * sc.t).tolist()
-        if "uhold" in L.control:
-            U[L.control["uhold"]] = self.st["uhold"]
-        return U
-
-    def _clip_mode(self) -> float:
-        """Mode of the continuous controller's force limit now: 0 inside, +-1 clipped at +-u_max."""
-        fb, st = self.fb, self.st
-        if fb.u_max is None:
-            return 0.0
-        w = float(fb.output(st["xc"], float(fb.reference(st["t"] * self.sc.t)) - st["x"] * self.sc.x))
-        return 0.0 if abs(w) <= fb.u_max else math.copysign(1.0, w)
-
-    def _net_force(self) -> float:
-        """Normalised net force ``u~ - F~`` on the mass in the current state."""
-        st, sc, fb = self.st, self.sc, self.fb
-        t_si = st["t"] * sc.t
-        u = float(self.system.u(t_si)) if self.system.forced else 0.0
-        if self.spec.fb == "continuous":
-            e = float(self.fb.reference(t_si)) - st["x"] * sc.x
-            u += float(self.fb.force(st["xc"], e))
-        elif fb is not None and fb.sampled:
-            u += st["uhold"]
-        return u / sc.F - st["F"]
-
-    def _leave_rest(self) -> None:
-        """End a rest at the start of a call if the net force no longer vanishes (the input or the
-        held force jumped at a sample time; inside a call the rest-exit event does this)."""
-        acc = self._net_force()
-        if abs(acc) <= EPS_REST * self.eps * self._scales()["Av"]:
-            return
-        st = self.st
-        new_s = 1.0 if acc > 0 else -1.0
-        if new_s != st["s"]:  # leaves backwards: a reversal at this instant
-            self.rev.append((st["t"], st["x"], st["F"], st["W"]))
-            self.rev_events.append(st.get("ne", 0))
-            st["W"], st["ne"] = 0.0, 0
-            st["z"], st["m"] = self.model.reverse(st["z"], st["m"], new_s, self.q, self.snap)
-            st["s"] = new_s
-            if "Eb" in st:  # at rest on the new branch
-                st["Eb"] = float(self.model.branch_potential(st["z"], st["m"], new_s, self.q))
-        st["rest"] = 0.0
-
     def _call(self, call: BufferedIntegrator, L: Layout, times: list[float], nstop: float) -> tuple[np.ndarray, dict]:
         """One integrator call over the output ``times`` (normalised), stopping at ``nstop`` reversals."""
         if self.spec.forced and self.st["rest"] > 0.5:
@@ -268,6 +107,13 @@ class Run:
         if self.steps is not None:
             self._count_steps(call)
 
+    def _count_steps(self, call: BufferedIntegrator) -> None:
+        """Add the steps of the last call (interpreted integrator only; else ``steps`` = None)."""
+        try:  # statistics exist for the interpreted integrator only (memory 1: the buffer's)
+            self.steps += int(call.fun.stats(1)["n_steps"])
+        except (RuntimeError, KeyError):
+            self.steps = None
+
     def _failure(self, why: str) -> SolverError:
         """The SolverError of a failed call: time, state, reversals so far and what to try."""
         sc, st = self.sc, self.st
@@ -293,13 +139,6 @@ class Run:
         self.st["t"] = t if out["t"] is None else out["t"]
 
     # --- loops --------------------------------------------------------------------------
-    def _count_steps(self, call: BufferedIntegrator) -> None:
-        """Add the steps of the last call (interpreted integrator only; else ``steps`` = None)."""
-        try:  # statistics exist for the interpreted integrator only (memory 1: the buffer's)
-            self.steps += int(call.fun.stats(1)["n_steps"])
-        except (RuntimeError, KeyError):
-            self.steps = None
-
     def advance(self, t_target: float, n_target: float) -> bool:
         """Integrate to normalised time ``t_target`` or ``n_target`` reversals; True if the latter."""
         if self.spec.stops_at_reversal:
@@ -340,22 +179,6 @@ class Run:
                                         f"was not resolved by a second pass")
             self._accept(out, t1)
             grow = 1.0 if out["frozen"] or len(self.rev) > n0 else 2.0 * grow
-
-    def _rest_at_noise_level(self) -> bool:
-        """Put the mass at rest (``v = 0``) if its speed and net force are at the error level of
-        the run (:data:`EPS_TOUCH` and :data:`EPS_REST` times ``Av = eps A``); True if it did.
-
-        A loop that settles at equilibrium without a clean zero of the velocity (its speed
-        decays into the integration error) shows "reversal pairs" that are noise; such a mass
-        rests, as at a zero velocity with a vanishing net force (``docs/simulator.md#events``).
-        """
-        st = self.st
-        Av = self.eps * self._scales()["Av"]
-        if abs(st["v"]) > EPS_TOUCH * Av or abs(self._net_force()) > EPS_REST * Av:
-            return False
-        st["v"], st["rest"] = 0.0, 1.0
-        st["F"] = float(self.model.force(st["z"], st["m"], 0.0, st["s"], self.q))  # rate-dependent models
-        return True
 
     def _retry_to(self, t_miss: float) -> float:
         """End of the second pass over a call that skipped a reversal pair: ``t_miss`` (the least

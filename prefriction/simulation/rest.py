@@ -1,0 +1,87 @@
+"""Rests of the mass between integrator calls: leaving one, and settling into one.
+
+:class:`Rest` is the part of :class:`prefriction.simulation.run.Run` that decides, in Python,
+whether the mass at ``v = 0`` stays at rest (a vanishing net force, ``docs/simulator.md#events``);
+inside a call the plant's rest events do this.
+"""
+
+from __future__ import annotations
+
+from typing import Callable, Optional
+
+import numpy as np
+
+from prefriction.models import Oscillator
+from prefriction.models.base import FrictionModel
+from prefriction.simulation.feedback import LinearFeedback
+from prefriction.simulation.plant import EPS_REST, EPS_TOUCH, PlantSpec
+from prefriction.units import Scales
+
+__all__ = ["Rest"]
+
+
+class Rest:
+    """Net force on the mass and the rest transitions made between calls.
+
+    A mixin of :class:`~prefriction.simulation.run.Run`, which sets the attributes below and
+    provides the amplitude scales ``_scales`` (:class:`~prefriction.simulation.state_io.StateIO`).
+    """
+
+    system: Oscillator
+    spec: PlantSpec
+    fb: Optional[LinearFeedback]
+    sc: Scales
+    model: FrictionModel
+    q: np.ndarray
+    eps: float
+    snap: float
+    st: dict
+    rev: list
+    rev_events: list
+    _scales: Callable[[], dict]
+
+    def _net_force(self) -> float:
+        """Normalised net force ``u~ - F~`` on the mass in the current state."""
+        st, sc, fb = self.st, self.sc, self.fb
+        t_si = st["t"] * sc.t
+        u = float(self.system.u(t_si)) if self.system.forced else 0.0
+        if self.spec.fb == "continuous":
+            e = float(self.fb.reference(t_si)) - st["x"] * sc.x
+            u += float(self.fb.force(st["xc"], e))
+        elif fb is not None and fb.sampled:
+            u += st["uhold"]
+        return u / sc.F - st["F"]
+
+    def _leave_rest(self) -> None:
+        """End a rest at the start of a call if the net force no longer vanishes (the input or the
+        held force jumped at a sample time; inside a call the rest-exit event does this)."""
+        acc = self._net_force()
+        if abs(acc) <= EPS_REST * self.eps * self._scales()["Av"]:
+            return
+        st = self.st
+        new_s = 1.0 if acc > 0 else -1.0
+        if new_s != st["s"]:  # leaves backwards: a reversal at this instant
+            self.rev.append((st["t"], st["x"], st["F"], st["W"]))
+            self.rev_events.append(st.get("ne", 0))
+            st["W"], st["ne"] = 0.0, 0
+            st["z"], st["m"] = self.model.reverse(st["z"], st["m"], new_s, self.q, self.snap)
+            st["s"] = new_s
+            if "Eb" in st:  # at rest on the new branch
+                st["Eb"] = float(self.model.branch_potential(st["z"], st["m"], new_s, self.q))
+        st["rest"] = 0.0
+
+    def _rest_at_noise_level(self) -> bool:
+        """Put the mass at rest (``v = 0``) if its speed and net force are at the error level of
+        the run (:data:`EPS_TOUCH` and :data:`EPS_REST` times ``Av = eps A``); True if it did.
+
+        A loop that settles at equilibrium without a clean zero of the velocity (its speed
+        decays into the integration error) shows "reversal pairs" that are noise; such a mass
+        rests, as at a zero velocity with a vanishing net force (``docs/simulator.md#events``).
+        """
+        st = self.st
+        Av = self.eps * self._scales()["Av"]
+        if abs(st["v"]) > EPS_TOUCH * Av or abs(self._net_force()) > EPS_REST * Av:
+            return False
+        st["v"], st["rest"] = 0.0, 1.0
+        st["F"] = float(self.model.force(st["z"], st["m"], 0.0, st["s"], self.q))  # rate-dependent models
+        return True
