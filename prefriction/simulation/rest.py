@@ -17,7 +17,32 @@ from prefriction.simulation.feedback import LinearFeedback
 from prefriction.simulation.plant import EPS_REST, EPS_TOUCH, PlantSpec
 from prefriction.units import Scales
 
-__all__ = ["Rest"]
+__all__ = ["Rest", "initial_direction"]
+
+
+def initial_direction(v0: float, acc0: float, F0: float) -> tuple[float, float]:
+    """Direction of the first branch and whether the mass starts at rest.
+
+    Parameters
+    ----------
+    v0 : float
+        Initial velocity (any unit; only its sign is used).
+    acc0 : float
+        Initial net force over ``Fc``, ``(u(0) - F0) / Fc`` [-].
+    F0 : float
+        Initial friction force (only its sign is used).
+
+    Returns
+    -------
+    (float, float)
+        ``s0`` (+1 or -1: the sign of ``v0``, else of the net force) and ``rest`` (1.0 when both
+        vanish: the mass rests and the next branch opposes ``F0``, else 0.0).
+    """
+    if v0 != 0.0:
+        return (1.0 if v0 > 0 else -1.0), 0.0
+    if abs(acc0) > 1e-14:
+        return (1.0 if acc0 > 0 else -1.0), 0.0
+    return (-1.0 if F0 > 0 else 1.0), 1.0
 
 
 class Rest:

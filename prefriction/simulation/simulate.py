@@ -40,6 +40,7 @@ import numpy as np
 from prefriction.signals import Constant, compiled_form
 from prefriction.simulation.feedback import LinearFeedback
 from prefriction.simulation.dense import SampleBuffer, dense_loop, samples_si
+from prefriction.simulation.rest import initial_direction
 from prefriction.simulation.run import N_DENSE, Run
 from prefriction.simulation.plant import Layout, PlantSpec
 from prefriction.simulation.force_scale import applied_force_scale
@@ -299,15 +300,9 @@ def _initial_state(run: Run, x0: float, v0: float, F0: float, xc0: np.ndarray, *
         e0 = float(feedback.reference(0.0)) - x0
         u0 += float(feedback.force(xc0, e0))
     acc0 = (u0 - F0) / Fc
-    rest = 0.0
-    if v0 != 0.0:
-        s0 = 1.0 if v0 > 0 else -1.0
-    elif abs(acc0) > 1e-14:
-        s0 = 1.0 if acc0 > 0 else -1.0
-    else:
-        s0, rest = (-1.0 if F0 > 0 else 1.0), 1.0
-        if not stops:
-            raise ValueError("v0 = 0 and F0 = 0 without input: the mass rests, no reversal will come; give t_end")
+    s0, rest = initial_direction(v0, acc0, F0)
+    if rest and not stops:
+        raise ValueError("v0 = 0 and F0 = 0 without input: the mass rests, no reversal will come; give t_end")
     z, m = model.initial_state(F0 / Fc, s0)
     # the friction force at t = 0: for a rate-dependent model (LuGre: sigma1 z' + sigma2 v) it
     # differs from the state's force F0 when v0 != 0

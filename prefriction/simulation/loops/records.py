@@ -12,6 +12,7 @@ from prefriction.errors import SolverError
 from prefriction.models import Oscillator
 from prefriction.simulation.feedback import LinearFeedback
 from prefriction.simulation.plant import PlantSpec
+from prefriction.simulation.rest import initial_direction
 from prefriction.simulation.run import Run
 from prefriction.units import Scales
 
@@ -28,13 +29,7 @@ def initial_state(system: Oscillator, fb: LinearFeedback, LL: LoopLayout, x0: fl
     if u_max is not None:
         u0 = min(max(u0, -u_max), u_max)
     acc0 = (u0 - F0) / Fc
-    rest = 0.0
-    if v0 != 0.0:
-        s0 = 1.0 if v0 > 0 else -1.0
-    elif abs(acc0) > 1e-14:
-        s0 = 1.0 if acc0 > 0 else -1.0
-    else:
-        s0, rest = (-1.0 if F0 > 0 else 1.0), 1.0
+    s0, rest = initial_direction(v0, acc0, F0)
     z, m = model.initial_state(F0 / Fc, s0)
     S = np.zeros(LL.nS)
     ix = LL.state
