@@ -51,6 +51,18 @@ def advance_compact(self: "Run", t_target: float, n_target: float) -> bool:
     n = len(rev)
     # a model with closed-form branches (free_branch: e.g. Dahl gamma = 0 below saturation)
     free = model.free_branch if type(model).free_branch is not FrictionModel.free_branch else None
+
+    def reversal(t: float, x: float, z: list, m: list, s: float, ne: int) -> tuple:
+        """Record the reversal at ``(t, x)`` with its events; the new direction and reset state.
+
+        The force is the one after the model's reset: an event within ``snap`` of the reversal
+        is taken as coinciding with it (the reset puts its state on the switching surface)."""
+        s = -s
+        z, m = reverse(z, m, s, q, snap)
+        rev.append((t, x, float(force(z, m, 0.0, s, q)), 0.0))
+        rev_events.append(ne)
+        return s, z, m
+
     while n < n_target and t < t_stop:
         exact = free(z, m, v, s, q, t_target - t) if free is not None else None
         if exact is not None:  # no integration: the branch in closed form
@@ -60,10 +72,7 @@ def advance_compact(self: "Run", t_target: float, n_target: float) -> bool:
             if dt < t_target - t:  # a reversal
                 t += dt
                 n += 1
-                s = -s
-                z, m = reverse(z, m, s, q, snap)
-                rev.append((t, x, float(force(z, m, 0.0, s, q)), 0.0))
-                rev_events.append(ne)
+                s, z, m = reversal(t, x, z, m, s, ne)
                 ne = 0
             else:
                 t = t_target
@@ -125,12 +134,7 @@ def advance_compact(self: "Run", t_target: float, n_target: float) -> bool:
             t = t + (t1 - t) * (-sv - 1.0)  # t0 + dur tau, as the integrator's time
             v = 0.0
             n += 1
-            s = -s
-            z, m = reverse(z, m, s, q, snap)
-            # the force after the model's reset: an event within snap of the reversal is taken
-            # as coinciding with it (the reset puts its state on the switching surface)
-            rev.append((t, x, float(force(z, m, 0.0, s, q)), 0.0))
-            rev_events.append(ne)
+            s, z, m = reversal(t, x, z, m, s, ne)
             ne = 0
             grow = 1.0
     self.calls += calls
