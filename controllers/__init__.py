@@ -12,7 +12,7 @@
   ``u_max`` adds back-calculation anti-windup (sampled loops). Returns a :class:`LoopResult`.
 - :func:`plant_iosys` is the same stage as a ``control.NonlinearIOSystem`` for
   ``control.interconnect``; it does not locate reversals (see its notes and
-  ``python -m controllers.benchmark`` for the measured shortfall and run times).
+  ``python -m prefriction.controllers.benchmark`` for the measured shortfall and run times).
 - :mod:`controllers.plotting` draws step responses; :mod:`controllers.example_stage` holds the
   stage of ``examples/stage_*.py`` and of the benchmark and runs their step responses.
 """

@@ -10,7 +10,7 @@ every ``v`` at once. Its right-hand side is not smooth at ``v = 0``, and python-
 integrator (scipy ``solve_ivp``) neither locates the velocity reversals nor restarts there: it
 steps across each kink, so its accuracy is limited there whatever the tolerance.
 :func:`controllers.simulate_loop` lands on every reversal instead. The shortfall measured on
-the stage example is printed by ``python -m controllers.benchmark``.
+the stage example is printed by ``python -m prefriction.controllers.benchmark``.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Benchmark of the compiled sampled-data loop against python-control, same loop, same run.
 
-``python -m controllers.benchmark`` (``prefriction bench --loops``) prints, for the PID loop of
+``python -m prefriction.controllers.benchmark`` (``prefriction bench --loops``) prints, for the PID loop of
 ``examples/stage_pid.py`` (stage m = 1 kg, sigma = 1e6 N/m, Fc = 1 N; PID placed at 150 Hz,
 zeta = 0.7; 10 kHz ZOH; 1 um step; 1 s):
 
@@ -196,11 +196,11 @@ def run(*, t_end: float = 1.0, repeats: int = 3, sweep: int = 100, lengths: tupl
 
 
 def main(argv: Optional[list[str]] = None) -> int:
-    """Command line: ``python -m controllers.benchmark [--t-end 1] [--repeats 3] [--sweep 100] [--lengths 0.1 1 10]``.
+    """Command line: ``python -m prefriction.controllers.benchmark [--t-end 1] [--repeats 3] [--sweep 100] [--lengths 0.1 1 10]``.
 
     Returns 0 when every target passes, 1 when one fails.
     """
-    ap = argparse.ArgumentParser(prog="python -m controllers.benchmark", description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(prog="python -m prefriction.controllers.benchmark", description=__doc__.splitlines()[0])
     ap.add_argument("--t-end", type=float, default=1.0, help="simulated time of the timed loop [s]")
     ap.add_argument("--repeats", type=int, default=3, help="repeats of the warm timing (the minimum is reported)")
     ap.add_argument("--sweep", type=int, default=100, help="gains in the tuning sweep (0: skip)")

@@ -32,7 +32,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-import controllers  # noqa: E402
+from prefriction import controllers  # noqa: E402
 import prefriction as pf  # noqa: E402
 from prefriction.describing import (  # noqa: E402
     VelocityDescribingFunction,

@@ -18,9 +18,9 @@ from pathlib import Path
 
 import numpy as np
 
-import controllers
-from controllers.example_stage import FC, TS, stage, title
-from controllers.plotting import plot_steps
+from prefriction import controllers
+from prefriction.controllers.example_stage import FC, TS, stage, title
+from prefriction.controllers.plotting import plot_steps
 
 T_END = 0.03  # s
 STEP = 5e-6  # m

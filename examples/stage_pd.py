@@ -21,8 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
-import controllers
-from controllers.example_stage import report, stage, step_responses
+from prefriction import controllers
+from prefriction.controllers.example_stage import report, stage, step_responses
 
 T_END = 0.02  # s
 

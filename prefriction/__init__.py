@@ -47,6 +47,7 @@ __all__ = [
     "SimulationResult",
     "SolverError",
     "SweepResult",
+    "controllers",
     "dahl",
     "energy",
     "exact_reversals",
@@ -62,7 +63,7 @@ __version__ = "0.2.0"
 del annotations  # bound by the __future__ import; not part of the API
 
 
-_LAZY = ("describing", "identify")  # python-control (1.6 s) and scipy.stats (0.6 s) on first use
+_LAZY = ("controllers", "describing", "identify")  # python-control (1.6 s) and scipy.stats (0.6 s) on first use
 
 
 def __getattr__(name: str):

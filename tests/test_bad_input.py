@@ -381,7 +381,7 @@ ROWS += rows_for("energy.total_energy", en.total_energy, dict(t=T, v=V, F=FS, sy
 ROWS += rows_for("energy.work_integral", en.work_integral, dict(x=XS, F=FS), dict(x=bad_samples, F=bad_samples))
 
 # controllers --------------------------------------------------------------------------------
-import controllers as ctl  # noqa: E402
+from prefriction import controllers as ctl  # noqa: E402
 
 PIDC = ctl.pd(1e5, 300.0, tau=1e-4)
 STAGE = pf.Oscillator(pf.Dahl(sigma=1e4, Fc=1.0), mass=1.0)

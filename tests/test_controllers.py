@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-import controllers
+from prefriction import controllers
 import prefriction
 
 M, SIGMA, FC = 1.0, 1e6, 1.0

@@ -15,10 +15,10 @@ import matplotlib
 import numpy as np
 import pytest
 
-import controllers
+from prefriction import controllers
 import prefriction
-from controllers import benchmark
-from controllers.example_stage import report
+from prefriction.controllers import benchmark
+from prefriction.controllers.example_stage import report
 
 matplotlib.use("Agg")
 

@@ -19,7 +19,7 @@ import warnings
 import numpy as np
 import pytest
 
-import controllers
+from prefriction import controllers
 import prefriction as pf
 
 M, R0, T_END = 1.0, 2e-5, 0.05

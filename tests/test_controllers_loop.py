@@ -18,7 +18,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
 
-import controllers
+from prefriction import controllers
 import prefriction
 
 M, SIGMA = 1.0, 1e6

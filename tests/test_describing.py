@@ -12,7 +12,7 @@ import mpmath
 import numpy as np
 import pytest
 
-import controllers
+from prefriction import controllers
 import prefriction as pf
 from prefriction.describing import (
     DahlDescribingFunction,

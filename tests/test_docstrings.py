@@ -6,7 +6,7 @@ import inspect
 
 import pytest
 
-import controllers
+from prefriction import controllers
 import prefriction
 from prefriction import dahl, energy
 

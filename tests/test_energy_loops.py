@@ -25,7 +25,7 @@ import pytest
 from scipy.integrate import quad, solve_ivp
 from scipy.optimize import brentq
 
-import controllers
+from prefriction import controllers
 import prefriction as pf
 from prefriction import energy
 

@@ -375,7 +375,7 @@ def test_simulate_loop_in_the_linear_regime_is_the_linear_loop():
     ``sigma x + (sigma2 + sum sigma_i) x'``, and the PD loop is python-control's linear closed loop."""
     import control
 
-    import controllers
+    from prefriction import controllers
 
     k, m, kp, kd, tau, r0 = np.array([2e5, 3e5, 5e5]), 1.0, 2e6, 2000.0, 5e-5, 1e-6
     sigma2, damping = 30.0, np.array([10.0, 20.0, 40.0])

@@ -11,9 +11,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import controllers
+from prefriction import controllers
 import prefriction
-from controllers.zoh_reference import zoh_reference
+from prefriction.controllers.zoh_reference import zoh_reference
 from prefriction.simulation.feedback import MAX_SAMPLES, LinearFeedback
 from prefriction.simulation.loops import BLOCK
 

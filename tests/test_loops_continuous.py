@@ -20,9 +20,9 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-import controllers
+from prefriction import controllers
 import prefriction
-from controllers.example_stage import stage
+from prefriction.controllers.example_stage import stage
 from prefriction.simulation.feedback import LinearFeedback
 
 REST = 1e-12  # net force [N] below which a mass at zero velocity rests (far below the loop's forces)

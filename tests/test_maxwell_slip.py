@@ -377,7 +377,7 @@ def test_simulate_loop_in_the_linear_regime_is_the_linear_loop():
     python-control's linear closed loop."""
     import control
 
-    import controllers
+    from prefriction import controllers
 
     k, m, kp, kd, tau, r0 = np.array([2e5, 3e5, 5e5]), 1.0, 2e6, 2000.0, 5e-5, 1e-6
     stage = pf.Oscillator(pf.MaxwellSlip(k, [1e8, 1e8, 1e8]), mass=m)

@@ -121,7 +121,7 @@ def test_loops_and_sweeps_run_any_protocol_model():
     range it is a spring k, so the PD loop is python-control's linear closed loop."""
     import control
 
-    import controllers
+    from prefriction import controllers
 
     k, m, kp, kd, tau, r0 = 1e6, 1.0, 2e6, 2000.0, 5e-5, 1e-6
     stage = pf.Oscillator(ElasticPlastic(k, 1e8), mass=m)  # never slips: F = k x

@@ -9,7 +9,7 @@ import mpmath
 import numpy as np
 import pytest
 
-import controllers
+from prefriction import controllers
 import prefriction as pf
 from prefriction.sensitivity import exact_sensitivities, map_derivative, sensitivities
 

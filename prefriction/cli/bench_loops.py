@@ -13,13 +13,13 @@ from typing import Optional
 
 def run(*, t_end: float = 1.0, repeats: int = 3, sweep: int = 100, lengths: tuple = (0.1, 1.0, 10.0)) -> str:
     """The benchmark's table (see :func:`controllers.benchmark.run`)."""
-    from controllers.benchmark import run as run_loops
+    from prefriction.controllers.benchmark import run as run_loops
 
     return run_loops(t_end=t_end, repeats=repeats, sweep=sweep, lengths=lengths)
 
 
 def main(argv: Optional[list[str]] = None) -> int:
-    """Command line of ``prefriction bench --loops`` (arguments of ``python -m controllers.benchmark``)."""
-    from controllers.benchmark import main as main_loops
+    """Command line of ``prefriction bench --loops`` (arguments of ``python -m prefriction.controllers.benchmark``)."""
+    from prefriction.controllers.benchmark import main as main_loops
 
     return main_loops(argv)

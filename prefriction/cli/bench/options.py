@@ -127,7 +127,7 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
                       help="instead: parameter sweeps, compiles and end-to-end time of cold and warm "
                            "processes against scipy DOP853")
     what.add_argument("--loops", action="store_true",
-                      help="instead: the positioning-loop benchmark (python -m controllers.benchmark): "
+                      help="instead: the positioning-loop benchmark (python -m prefriction.controllers.benchmark): "
                            "compiled PID loop against python-control, tuning sweep, loop lengths; "
                            "--repeats sets its warm repeats (default 3)")
     args = ap.parse_args(argv)
@@ -135,7 +135,7 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
         ap.error("--repeats applies to the headline and stability sections, not to --sweep or --models")
     if args.loops and args.quick:
         ap.error("--quick does not apply to --loops (the loop benchmark has no quick mode; "
-                 "python -m controllers.benchmark --help lists its sizes)")
+                 "python -m prefriction.controllers.benchmark --help lists its sizes)")
     if args.loops and args.out is not None:
         ap.error("--out does not apply to --loops (it writes no files; its table goes to stdout)")
     if not args.loops:
