@@ -11,7 +11,8 @@ A signal (an input force [N], a reference position [m], ...) is split in two par
   with different amplitudes share one compiled function.
 
 Kinds: :class:`Constant`, :class:`Step`, :class:`Ramp`, :class:`Sine`, :class:`Chirp`,
-:class:`Samples` (piecewise linear data), :class:`Traced` (an arbitrary traceable Python
+:class:`Samples` (piecewise linear data), :class:`ZeroOrderHold`
+(piecewise constant with jumps), :class:`Traced` (an arbitrary traceable Python
 function; compiled once *per function object*) and :class:`Sum` (made with ``+``).
 :func:`as_signal` converts the user-facing forms (number, ``(t, values)``, callable) to signals.
 
@@ -38,6 +39,7 @@ from prefriction.signals.conversion import as_signal
 from prefriction.signals.periodic import Chirp, Sine
 from prefriction.signals.piecewise import Constant, Ramp, Step
 from prefriction.signals.samples import MAX_SAMPLES, Samples
+from prefriction.signals.hold import ZeroOrderHold
 from prefriction.signals.traced import Traced
 
 __all__ = [
@@ -51,6 +53,7 @@ __all__ = [
     "Step",
     "Sum",
     "Traced",
+    "ZeroOrderHold",
     "as_signal",
     "MAX_SAMPLES",
 ]

@@ -1,0 +1,108 @@
+"""The solve-and-check loop shared by the point-to-point problems: IPOPT, then a replay through
+:func:`prefriction.simulate`, with finer integration until the replay lands within ``tol``."""
+
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass
+from typing import Callable, Optional
+
+import numpy as np
+
+from prefriction.errors import SolverError
+from prefriction.models import Oscillator
+from prefriction.optimal.replay import replay
+from prefriction.optimal.result import PointToPointResult
+from prefriction.optimal.transcription import Transcription
+from prefriction.signals import ZeroOrderHold
+from prefriction.units import Scales
+
+__all__ = ["Setup", "optimise", "MAX_SUBSTEPS"]
+
+MAX_SUBSTEPS = 64
+"""Finest integration: RK4 substeps per control interval."""
+
+
+@dataclass(frozen=True)
+class Setup:
+    """What :func:`optimise` needs besides the transcription: names, units, the friction force of
+    a node (normalised state and phase index -> normalised force) and the first guess."""
+
+    method: str
+    objective: str
+    system: Oscillator
+    distance: float
+    modes: tuple
+    force: Callable[[np.ndarray, int], float]
+    T0: np.ndarray
+    U0: list
+
+
+def optimise(setup: Setup, build: Callable[[int], Transcription], *, substeps: int, tol: Optional[float],
+             max_iter: int) -> PointToPointResult:
+    """Solve the transcription ``build(substeps)`` and replay the force; while the replay misses the
+    target by more than ``tol`` [m] (``None``: no check), double the substeps and solve again from
+    the solution."""
+    sc = Scales.of(setup.system)
+    tr = build(substeps)
+    w = tr.forward(setup.T0, setup.U0)
+    wall = 0.0
+    while True:
+        w, stats, t_ipopt = tr.solve(w, max_iter=max_iter, tol=1e-10)
+        wall += t_ipopt
+        if not stats["success"]:
+            raise SolverError(
+                f"IPOPT found no {setup.objective}-optimal {setup.method} move of {setup.distance!r} m "
+                f"(phases {setup.modes}, {tr.N} intervals of {substeps} RK4 steps): {stats['return_status']} after "
+                f"{stats['iter_count']} iterations. Try other modes, more intervals, a larger u_max or, "
+                f"for objective='effort', a longer t_final"
+            )
+        result = _with_replay(_result(setup, tr, w, sc, int(stats["iter_count"]), wall), setup.system)
+        if tol is None:
+            return result
+        if abs(result.replay.x_error) <= tol or 2 * substeps > MAX_SUBSTEPS:
+            break
+        print(f"prefriction.optimal: replay misses by {result.replay.x_error:.3g} m > tol = {tol!r} m; "
+              f"solving again with {2 * substeps} RK4 steps per interval", file=sys.stderr)
+        substeps *= 2
+        T, Y, U = tr.unpack(w)
+        tr = build(substeps)
+        w = tr.pack(T, Y, U)
+    if abs(result.replay.x_error) > tol:
+        raise SolverError(
+            f"the optimal force replayed through simulate misses the target by {result.replay.x_error!r} m "
+            f"> tol = {tol!r} m even with {substeps} RK4 steps per interval: try more intervals or a larger tol"
+        )
+    return result
+
+
+def _with_replay(result: PointToPointResult, system: Oscillator) -> PointToPointResult:
+    from dataclasses import replace
+
+    return replace(result, replay=replay(system, result.u, result.t_final, result.distance))
+
+
+def _result(setup: Setup, tr: Transcription, w: np.ndarray, sc: Scales, iterations: int,
+            wall: float) -> PointToPointResult:
+    """The result in SI units from the decision vector ``w``."""
+    T, Y, U = tr.unpack(w)
+    N = tr.N
+    t, x, v, F, starts, forces = [], [], [], [], [], []
+    offset = 0.0
+    for k in range(tr.n_ph):
+        nodes = offset + T[k] * np.arange(N + 1) / N
+        first = 0 if k == 0 else 1  # a join's node is the previous phase's last
+        t.extend(nodes[first:])
+        x.extend(Y[k][0, first:])
+        v.extend(Y[k][1, first:])
+        F.extend(setup.force(Y[k][:, j], k) for j in range(first, N + 1))
+        starts.extend(nodes[:-1])
+        forces.extend(U[k])
+        offset += T[k]
+    u = ZeroOrderHold(np.array(starts + [offset]) * sc.t, np.array(forces + [0.0]) * sc.F, name="u", unit="N")
+    effort = float(sum(T[k] / N * np.sum(U[k] ** 2) for k in range(tr.n_ph))) * sc.F ** 2 * sc.t
+    return PointToPointResult(
+        method=setup.method, objective=setup.objective, distance=setup.distance, u=u, t_final=offset * sc.t,
+        t=np.array(t) * sc.t, x=np.array(x) * sc.x, v=np.array(v) * sc.v, F=np.array(F) * sc.F,
+        modes=setup.modes, durations=np.asarray(T) * sc.t, effort=effort, iterations=iterations, solve_time=wall,
+    )
