@@ -16,6 +16,8 @@ Public API, re-exported from private modules:
 - derivatives through the simulator and the exact map: :func:`sensitivities`
   (:mod:`prefriction.sensitivity`)
 - describing functions and limit cycles (hunting): :mod:`prefriction.describing`
+- the models and the simulator's plant as CasADi Functions: :mod:`prefriction.symbolic`
+- optimal point-to-point motion through pre-sliding friction (IPOPT): :mod:`prefriction.optimal`
 """
 
 from __future__ import annotations
@@ -28,7 +30,7 @@ from prefriction.simulation.simulate import SimulationResult, simulate
 from prefriction.simulation.sweep import SweepResult, sweep
 from prefriction.simulation.feedback import LinearFeedback
 from prefriction.analysis import dahl, energy
-from prefriction import sensitivity, signals
+from prefriction import optimal, sensitivity, signals, symbolic
 from prefriction.sensitivity import sensitivities
 from prefriction.analysis.exact import exact_reversals
 
@@ -53,11 +55,13 @@ __all__ = [
     "exact_reversals",
     "describing",
     "identify",
+    "optimal",
     "sensitivities",
     "sensitivity",
     "signals",
     "simulate",
     "sweep",
+    "symbolic",
 ]
 __version__ = "0.2.0"
 del annotations  # bound by the __future__ import; not part of the API

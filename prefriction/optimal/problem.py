@@ -84,7 +84,8 @@ def point_to_point(system: Oscillator, distance: float, *, u_max: float, objecti
     each, in the normalised units of :class:`prefriction.Scales`.
 
     The force is then replayed through :func:`prefriction.simulate` (``result.replay``); while it
-    misses the target by more than ``tol``, the problem is solved again with twice the substeps.
+    misses the target by more than ``tol`` or ends with a speed above ``1e-8`` of the peak speed
+    (simulate's default ``rtol``), the problem is solved again with twice the substeps.
 
     Parameters
     ----------
@@ -108,7 +109,7 @@ def point_to_point(system: Oscillator, distance: float, *, u_max: float, objecti
     substeps : int, default 8
         RK4 steps per interval at the first solve (1 to 64).
     tol : float or None, default 1e-9
-        Largest accepted miss of the replayed force [m]; None: accept the first solution.
+        Largest accepted miss of the replayed force [m] (1 nm); None: accept the first solution.
     max_iter : int, default 500
         IPOPT iteration limit.
 
@@ -154,11 +155,11 @@ def point_to_point(system: Oscillator, distance: float, *, u_max: float, objecti
 
     phases = [Phase(rhs=rhs(s), path=lambda y, s=s: s * y[1]) for s in modes]
 
-    def jump(y: ca.SX, k: int) -> ca.SX:
+    def jump(y: ca.MX, k: int) -> ca.MX:
         zr, _ = model.reverse([y[2 + i] for i in range(nz)], [], modes[k], q, 1e-12)
         return ca.vertcat(y[0], y[1], *zr)
 
-    def final(y: ca.SX) -> ca.SX:
+    def final(y: ca.MX) -> ca.MX:
         return ca.vertcat(y[0] - d, y[1], model.force([y[2 + i] for i in range(nz)], [], 0.0, modes[-1], q))
 
     z0, _ = model.initial_state(0.0, modes[0])

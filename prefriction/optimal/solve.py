@@ -21,6 +21,8 @@ __all__ = ["Setup", "optimise", "MAX_SUBSTEPS"]
 
 MAX_SUBSTEPS = 64
 """Finest integration: RK4 substeps per control interval."""
+V_RTOL = 1e-8
+"""Largest accepted final velocity of the replay, relative to the peak velocity (simulate's default rtol)."""
 
 
 @dataclass(frozen=True)
@@ -41,8 +43,8 @@ class Setup:
 def optimise(setup: Setup, build: Callable[[int], Transcription], *, substeps: int, tol: Optional[float],
              max_iter: int) -> PointToPointResult:
     """Solve the transcription ``build(substeps)`` and replay the force; while the replay misses the
-    target by more than ``tol`` [m] (``None``: no check), double the substeps and solve again from
-    the solution."""
+    target by more than ``tol`` [m] or ends faster than :data:`V_RTOL` of the peak speed
+    (``tol = None``: no check), double the substeps and solve again from the solution."""
     sc = Scales.of(setup.system)
     tr = build(substeps)
     w = tr.forward(setup.T0, setup.U0)
@@ -60,20 +62,28 @@ def optimise(setup: Setup, build: Callable[[int], Transcription], *, substeps: i
         result = _with_replay(_result(setup, tr, w, sc, int(stats["iter_count"]), wall), setup.system)
         if tol is None:
             return result
-        if abs(result.replay.x_error) <= tol or 2 * substeps > MAX_SUBSTEPS:
+        if _lands(result, tol) or 2 * substeps > MAX_SUBSTEPS:
             break
-        print(f"prefriction.optimal: replay misses by {result.replay.x_error:.3g} m > tol = {tol!r} m; "
-              f"solving again with {2 * substeps} RK4 steps per interval", file=sys.stderr)
+        print(f"prefriction.optimal: replay ends {result.replay.x_error:.3g} m from the target at "
+              f"{result.replay.v_final:.3g} m/s; solving again with {2 * substeps} RK4 steps per interval", file=sys.stderr)
         substeps *= 2
         T, Y, U = tr.unpack(w)
         tr = build(substeps)
         w = tr.pack(T, Y, U)
-    if abs(result.replay.x_error) > tol:
+    if not _lands(result, tol):
         raise SolverError(
-            f"the optimal force replayed through simulate misses the target by {result.replay.x_error!r} m "
-            f"> tol = {tol!r} m even with {substeps} RK4 steps per interval: try more intervals or a larger tol"
+            f"the optimal force replayed through simulate ends {result.replay.x_error!r} m from the target "
+            f"(tol = {tol!r} m) at {result.replay.v_final!r} m/s (allowed {V_RTOL} of the peak velocity) even with "
+            f"{substeps} RK4 steps per interval: try more intervals or a larger tol"
         )
     return result
+
+
+def _lands(result: PointToPointResult, tol: float) -> bool:
+    """True if the replay ends within ``tol`` [m] of the target and at a speed below
+    :data:`V_RTOL` of the peak speed."""
+    return (abs(result.replay.x_error) <= tol
+            and abs(result.replay.v_final) <= V_RTOL * float(np.max(np.abs(result.v))))
 
 
 def _with_replay(result: PointToPointResult, system: Oscillator) -> PointToPointResult:

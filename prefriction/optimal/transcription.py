@@ -20,10 +20,11 @@ __all__ = ["Phase", "Transcription"]
 
 @dataclass(frozen=True)
 class Phase:
-    """One phase: dynamics ``rhs(y, u) -> y'`` (SX), and a path function ``path(y) >= 0`` at the nodes."""
+    """One phase: dynamics ``rhs(y, u) -> y'`` (on SX), and a path function ``path(y) >= 0`` at the
+    nodes (on MX)."""
 
     rhs: Callable[[ca.SX, ca.SX], ca.SX]
-    path: Optional[Callable[[ca.SX], ca.SX]] = None
+    path: Optional[Callable[[ca.MX], ca.MX]] = None
 
 
 def _interval(phase: Phase, ny: int, substeps: int) -> ca.Function:
@@ -47,17 +48,18 @@ class Transcription:
     """
 
     def __init__(self, phases: Sequence[Phase], ny: int, *, intervals: int, substeps: int,
-                 y0: Sequence[float], jump: Callable[[ca.SX, int], ca.SX],
-                 final: Callable[[ca.SX], ca.SX], u_max: float, objective: str,
+                 y0: Sequence[float], jump: Callable[[ca.MX, int], ca.MX],
+                 final: Callable[[ca.MX], ca.MX], u_max: float, objective: str,
                  t_total: Optional[float], t_min: float) -> None:
         self.n_ph, self.ny, self.N = len(phases), ny, intervals
         n_ph, N = self.n_ph, intervals
-        T = ca.SX.sym("T", n_ph)
-        Y = [ca.SX.sym(f"Y{k}", ny, N + 1) for k in range(n_ph)]
-        U = [ca.SX.sym(f"U{k}", 1, N) for k in range(n_ph)]
+        # MX: the mapped interval Function stays one node, so building the Hessian is cheap
+        T = ca.MX.sym("T", n_ph)
+        Y = [ca.MX.sym(f"Y{k}", ny, N + 1) for k in range(n_ph)]
+        U = [ca.MX.sym(f"U{k}", 1, N) for k in range(n_ph)]
         g, lbg, ubg = [], [], []
 
-        def eq(expr: ca.SX) -> None:
+        def eq(expr: ca.MX) -> None:
             g.append(ca.vec(expr)), lbg.extend([0.0] * expr.numel()), ubg.extend([0.0] * expr.numel())
 
         eq(Y[0][:, 0] - ca.DM(list(y0)))
@@ -79,7 +81,7 @@ class Transcription:
             eq(ca.sum1(T) - t_total)
         self.y0 = np.asarray(y0, dtype=float)
         self._steps = [_interval(phase, ny, substeps) for phase in phases]
-        yj = ca.SX.sym("y", ny)
+        yj = ca.MX.sym("y", ny)
         self._jumps = [None] + [ca.Function("jump", [yj], [jump(yj, k)]) for k in range(1, n_ph)]
         self.x = ca.vertcat(T, *[ca.vec(y) for y in Y], *[ca.vec(u) for u in U])
         f = ca.sum1(T) if objective == "time" else effort
@@ -121,7 +123,8 @@ class Transcription:
 
     def solve(self, w0: np.ndarray, *, max_iter: int, tol: float) -> tuple[np.ndarray, dict, float]:
         """IPOPT from ``w0``: the solution, CasADi's stats and IPOPT's wall time [s]."""
-        opts = {"print_time": False, "ipopt": {"print_level": 0, "sb": "yes", "max_iter": max_iter, "tol": tol}}
+        opts = {"print_time": False, "ipopt": {"print_level": 0, "sb": "yes", "max_iter": max_iter, "tol": tol,
+                                               "bound_relax_factor": 0.0}}  # |u| <= u_max exactly
         solver = ca.nlpsol("point_to_point", "ipopt", self.nlp, opts)
         start = time.perf_counter()
         sol = solver(x0=w0, lbx=self.lbx, ubx=self.ubx, lbg=self.lbg, ubg=self.ubg)
