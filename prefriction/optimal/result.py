@@ -41,7 +41,7 @@ class PointToPointResult:
     effort : float
         ``int u^2 dt`` over the move [N^2 s].
     iterations : int
-        IPOPT iterations (of the last solve; 0 for the closed form).
+        IPOPT iterations (all solves; 0 for the closed form).
     solve_time : float
         IPOPT wall time [s] (all solves).
     replay : Replay or None

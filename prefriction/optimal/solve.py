@@ -48,10 +48,10 @@ def optimise(setup: Setup, build: Callable[[int], Transcription], *, substeps: i
     sc = Scales.of(setup.system)
     tr = build(substeps)
     w = tr.forward(setup.T0, setup.U0)
-    wall = 0.0
+    wall, iterations = 0.0, 0
     while True:
         w, stats, t_ipopt = tr.solve(w, max_iter=max_iter, tol=1e-10)
-        wall += t_ipopt
+        wall, iterations = wall + t_ipopt, iterations + int(stats["iter_count"])
         if not stats["success"]:
             raise SolverError(
                 f"IPOPT found no {setup.objective}-optimal {setup.method} move of {setup.distance!r} m "
@@ -59,7 +59,7 @@ def optimise(setup: Setup, build: Callable[[int], Transcription], *, substeps: i
                 f"{stats['iter_count']} iterations. Try other modes, more intervals, a larger u_max or, "
                 f"for objective='effort', a longer t_final"
             )
-        result = _with_replay(_result(setup, tr, w, sc, int(stats["iter_count"]), wall), setup.system)
+        result = _with_replay(_result(setup, tr, w, sc, iterations, wall), setup.system)
         if tol is None:
             return result
         if _lands(result, tol) or 2 * substeps > MAX_SUBSTEPS:
