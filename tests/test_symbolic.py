@@ -161,3 +161,20 @@ def test_bad_input_names_the_argument():
         branch_functions(pf.Dahl(1e4, 1.0), 0.0)
     with pytest.raises(TypeError, match="model must be"):
         plant_step("Dahl")
+
+
+def test_plant_step_derivative_from_rest_is_finite_and_right(dahl_step):
+    """From rest the amplitude scale has a kink; the derivative must not see it."""
+    u = ca.MX.sym("u")
+    y1 = dahl_step([0.0, 0.0, 0.0, 1.0], [1.0], u, 2.0, 1e-11)[0]
+    J = float(ca.Function("J", [u], [ca.jacobian(y1[0], u)])(0.5))
+    du = 1e-5
+    hi, lo = _scipy_step([0.0, 0.0, 0.0], 0.5 + du, 2.0, 1.0, 1.0)[0], _scipy_step([0.0, 0.0, 0.0], 0.5 - du, 2.0, 1.0, 1.0)[0]
+    assert J == pytest.approx((hi[0] - lo[0]) / (2 * du), rel=1e-6)
+
+
+def test_compiled_plant_step_gives_the_same_numbers(dahl_step):
+    fast = plant_step(pf.Dahl(sigma=1e4, Fc=1.0), jit=True)
+    args = ([0.1, 0.7, 0.2, 1.0], [1.0], -0.4, 3.5, 1e-10)
+    for a, b in zip(fast(*args), dahl_step(*args)):
+        np.testing.assert_allclose(np.array(a), np.array(b), rtol=1e-13, atol=1e-15)

@@ -7,8 +7,10 @@ from typing import Any
 
 import casadi as ca
 
+from prefriction._validation import check_bool
 from prefriction.models import FrictionModel, Oscillator
 from prefriction.signals import Constant
+from prefriction.simulation.compiled import compiled
 from prefriction.simulation.plant import EPS_TOUCH, Layout, PlantSpec, build_integrator, has_potential
 
 __all__ = ["plant_step"]
@@ -17,7 +19,7 @@ _CAL = 0.1  # as prefriction.simulation.simulate: eps = rtol * 0.1 * sqrt(active
 _NSTOP = 1e9  # no reversal limit within a step
 
 
-def plant_step(model: Any) -> ca.Function:
+def plant_step(model: Any, *, jit: bool = False) -> ca.Function:
     """The compiled plant of :func:`prefriction.simulate` over one step of constant force, as a
     CasADi Function: every reversal and model event inside the step is located and handled.
 
@@ -48,6 +50,10 @@ def plant_step(model: Any) -> ca.Function:
     ----------
     model : FrictionModel or Oscillator
         The friction model (of a system: its friction model).
+    jit : bool, default False
+        Compile the Function with gcc (cached on disk like the simulator's plants) for fast
+        numeric calls, e.g. a hardware-in-the-loop or Monte Carlo loop. A compiled Function has
+        no derivatives: keep ``jit=False`` inside an NLP.
 
     Returns
     -------
@@ -77,10 +83,12 @@ def plant_step(model: Any) -> ca.Function:
     z = [y0[2 + i] for i in range(nz)]
     m = [y0[3 + nz + i] for i in range(nm)]
     F = model.force(z, m, v, s, q)
-    A = ca.fmax(ca.fmax(ca.sqrt(v * v + F * F), ca.fabs(u)), 1e-150)  # amplitude of the motion
-    eps = rtol * _CAL * math.sqrt(L.n_active / L.nx)
-    # states scaled by the amplitude times the tolerance (absolute error control, docs/simulator.md)
-    scale = {"Ax": eps * ca.fmax(ca.fmax(A, 0.5 * A * A), ca.fmin(ca.fabs(x), 1.0)), "Av": eps * A,
+    # states scaled by the amplitude of the motion times the tolerance (absolute error control,
+    # docs/simulator.md); the scales are constants for differentiation (the result does not depend
+    # on them, and the amplitude's kink at rest would give NaN derivatives)
+    A = ca.stop_diff(ca.fmax(ca.fmax(ca.sqrt(v * v + F * F), ca.fabs(u)), 1e-150), 1)
+    eps = ca.stop_diff(rtol, 1) * _CAL * math.sqrt(L.n_active / L.nx)
+    scale = {"Ax": eps * ca.fmax(ca.fmax(A, 0.5 * A * A), ca.stop_diff(ca.fmin(ca.fabs(x), 1.0), 1)), "Av": eps * A,
              "AF": eps * ca.fmin(A, 1.0), "AE": eps * A * A}
     st = {"xh": 0.0, "vh": v / scale["Av"], "s": s, "n": 0.0, "armed": 1.0, "Wh": 0.0, "tmiss": 0.0,
           "rest": ca.if_else(ca.logic_and(v == 0.0, ca.fabs(u - F) <= EPS_TOUCH * scale["Av"]), 1.0, 0.0)}
@@ -99,5 +107,8 @@ def plant_step(model: Any) -> ca.Function:
     y1 = ca.vertcat(x + scale["Ax"] * out["xh"], scale["Av"] * out["vh"], *[scale["AF"] * out[f"z{i}"] for i in range(nz)],
                     out["s"], *[out[f"m{i}"] for i in range(nm)])
     ok = ca.if_else(out["tmiss"] > 0.5, 0.0, 1.0)
-    return ca.Function("plant_step", [y0, q, u, h, rtol], [y1, out["n"], ok],
-                       ["y0", "q", "u", "h", "rtol"], ["y1", "reversals", "ok"])
+    fun = ca.Function("plant_step", [y0, q, u, h, rtol], [y1, out["n"], ok],
+                      ["y0", "q", "u", "h", "rtol"], ["y1", "reversals", "ok"])
+    if not check_bool("jit", jit):
+        return fun
+    return compiled(fun, f"{type(model).__name__} plant over a step")[0]
