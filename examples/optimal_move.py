@@ -28,14 +28,14 @@ LUGRE = pf.Oscillator(pf.LuGre(sigma0=1e5, sigma1=300.0, sigma2=0.4, Fc=1.0, Fs=
 V_SMOOTH = (1e-3, 1e-4)  # [m/s] tanh smoothing velocities
 
 
-def moves(stage: pf.Oscillator, *, effort: bool) -> dict:
+def moves(stage: pf.Oscillator, *, effort: bool, smoothing: tuple = V_SMOOTH) -> dict:
     """The optimal, smoothed and bang-bang moves of ``stage`` (name -> PointToPointResult)."""
     out = {"pre-sliding, min time": optimal.point_to_point(stage, DISTANCE, u_max=U_MAX)}
     if effort:
         T = 1.3 * out["pre-sliding, min time"].t_final
         out["pre-sliding, min effort (1.3 T)"] = optimal.point_to_point(
             stage, DISTANCE, u_max=U_MAX, objective="effort", t_final=T)
-    for vs in V_SMOOTH:
+    for vs in smoothing:
         out[f"tanh, v_s = {vs * 1e3:g} mm/s"] = optimal.smoothed_point_to_point(stage, DISTANCE, u_max=U_MAX, v_smooth=vs)
     out["Coulomb bang-bang"] = optimal.bang_bang(stage, DISTANCE, u_max=U_MAX)
     return out
@@ -52,10 +52,10 @@ def table(rows: dict) -> str:
     return "\n".join(lines)
 
 
-def after(stage: pf.Oscillator, r: optimal.PointToPointResult, t_end: float) -> pf.SimulationResult:
+def after(stage: pf.Oscillator, r: optimal.PointToPointResult, t_end: float, samples: int) -> pf.SimulationResult:
     """The stage driven by ``r.u`` (no force after ``r.t_final``) up to ``t_end`` [s], dense."""
     return pf.simulate(pf.Oscillator(stage.friction, mass=stage.mass, u=r.u), 0.0, t_end=t_end,
-                       rtol=1e-10, dense=np.linspace(0.0, t_end, 1500))
+                       rtol=1e-10, dense=np.linspace(0.0, t_end, samples))
 
 
 def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
@@ -64,10 +64,10 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
     Returns
     -------
     dict
-        ``dahl`` and ``lugre`` (name -> :class:`prefriction.optimal.PointToPointResult`),
-        ``table`` (markdown), ``png``.
+        ``dahl`` and ``lugre`` (name -> :class:`prefriction.optimal.PointToPointResult`; quick:
+        no LuGre, no minimum-effort move, one smoothing), ``table`` (markdown), ``png``.
     """
-    dahl = moves(DAHL, effort=True)
+    dahl = moves(DAHL, effort=not quick, smoothing=V_SMOOTH[:1] if quick else V_SMOOTH)
     lugre = {} if quick else moves(LUGRE, effort=False)
     rows = {("Dahl", k): r for k, r in dahl.items()}
     rows.update({("LuGre", k): r for k, r in lugre.items()})
@@ -79,8 +79,10 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
     shown = ["pre-sliding, min time", "pre-sliding, min effort (1.3 T)", f"tanh, v_s = {V_SMOOTH[0] * 1e3:g} mm/s",
              "Coulomb bang-bang"]
     for c, name in zip(COLORS, shown):
+        if name not in dahl:  # quick: no minimum-effort move
+            continue
         r = dahl[name]
-        run = after(DAHL, r, t_end)
+        run = after(DAHL, r, t_end, 300 if quick else 1500)
         t_ms = run.t * 1e3
         axes[0, 0].step(np.r_[r.u.t, t_end] * 1e3, np.r_[r.u.u, 0.0], where="post", color=c, lw=1.4, label=name)
         axes[0, 1].plot(t_ms, (run.x - DISTANCE) * 1e6, color=c, lw=1.4, label=name)
