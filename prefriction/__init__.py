@@ -5,7 +5,7 @@ Public API, re-exported from private modules:
 - models (:mod:`prefriction.models`): :class:`FrictionModel` (the protocol), :class:`Dahl`,
   :class:`MaxwellSlip`, :class:`GMS`, :class:`LuGre`, :class:`Oscillator`, :class:`Parameter`
 - input signals: :mod:`prefriction.signals` (``Constant``, ``Step``, ``Ramp``, ``Sine``,
-  ``Chirp``, ``Samples`` and sums; compiled once per kind)
+  ``Chirp``, ``Samples``, ``ZeroOrderHold`` and sums; compiled once per kind)
 - analytics: :mod:`prefriction.dahl` (exact and approximate reversal maps, energies; Dahl only)
 - exact reference: :func:`exact_reversals` (Dahl only)
 - simulation: :func:`simulate` (closed linear loops: :class:`LinearFeedback`), :func:`sweep`
