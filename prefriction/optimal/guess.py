@@ -14,6 +14,10 @@ __all__ = ["coulomb_times", "bang_bang_signal", "modes_from_simulation", "guess_
 
 MAX_PHASES = 8
 """Most phases (velocity-sign changes + 1) a move may have."""
+EXTRA_PHASE = 0.3
+"""First guess of the duration of a phase other than the main one, in time units sqrt(m / sigma):
+short enough that the unforced stage does not reverse on it (a wrong-way branch would drive the
+force past Fc and the next reset to NaN)."""
 
 
 def coulomb_times(distance: float, u_max: float, Fc: float, mass: float) -> tuple[float, float]:
@@ -58,24 +62,24 @@ def guess_forces(modes: tuple, distance: float, u_max: float, Fc: float, mass: f
                  t_total: float | None, t_unit: float) -> tuple[np.ndarray, list]:
     """Normalised phase durations and forces of the first guess.
 
-    The first phase towards the target carries the bang-bang profile (``t_total`` given: a
-    symmetric profile of that duration); the other phases last one time unit ``sqrt(m / sigma)``
-    with no force.
+    The first phase towards the target carries the bang-bang profile (``t_total`` given: the
+    least-effort force of the frictionless stage plus the Coulomb force); the other phases last :data:`EXTRA_PHASE` time units
+    ``sqrt(m / sigma)`` with no force.
     """
     s = math.copysign(1.0, distance)
     main = modes.index(s) if s in modes else 0
-    if t_total is None:
-        t1, t2 = coulomb_times(distance, u_max, Fc, mass)
-    else:
-        T = max(t_total - (len(modes) - 1) * t_unit, 0.5 * t_total)
-        a = 4.0 * abs(distance) / (mass * T * T)
-        t1 = t2 = 0.5 * T
-        u_max = min(u_max, mass * a + Fc)
-    T = np.ones(len(modes))
-    T[main] = (t1 + t2) / t_unit
+    T = np.full(len(modes), EXTRA_PHASE)
     U = [np.zeros(intervals) for _ in modes]
-    mid = (np.arange(intervals) + 0.5) / intervals * (t1 + t2)
-    U[main] = np.where(mid < t1, s * u_max, -s * u_max) / Fc
+    if t_total is None:  # the Coulomb bang-bang profile
+        t1, t2 = coulomb_times(distance, u_max, Fc, mass)
+        T[main] = (t1 + t2) / t_unit
+        mid = (np.arange(intervals) + 0.5) / intervals * (t1 + t2)
+        U[main] = np.where(mid < t1, s * u_max, -s * u_max) / Fc
+    else:  # least effort without friction, a = 6 d (1 - 2 t/T) / T^2, plus the Coulomb force
+        Tm = max(t_total - (len(modes) - 1) * EXTRA_PHASE * t_unit, 0.5 * t_total)
+        T[main] = Tm / t_unit
+        mid = (np.arange(intervals) + 0.5) / intervals
+        U[main] = np.clip(mass * 6.0 * distance * (1.0 - 2.0 * mid) / Tm ** 2 + s * Fc, -u_max, u_max) / Fc
     if t_total is not None:
         T *= t_total / t_unit / T.sum()
     return T, U

@@ -15,6 +15,7 @@ from prefriction.optimal.guess import MAX_PHASES, guess_forces, modes_from_simul
 from prefriction.optimal.result import PointToPointResult
 from prefriction.optimal.solve import MAX_SUBSTEPS, Setup, optimise
 from prefriction.optimal.transcription import Phase, Transcription
+from prefriction.symbolic import branch_functions
 from prefriction.units import Scales
 
 __all__ = ["point_to_point", "check_move", "MAX_INTERVALS"]
@@ -78,7 +79,7 @@ def point_to_point(system: Oscillator, distance: float, *, u_max: float, objecti
     end at rest at ``x = distance`` with no friction force (so that ``u = 0`` holds it there),
     under ``|u| <= u_max``. The friction model keeps its branch structure: the move is split into
     phases of one velocity sign each (``modes``), joined at reversals where the velocity is zero
-    and the model resets its state (:meth:`prefriction.FrictionModel.reverse`); the phase
+    and the model resets its state (the ``reset`` of :func:`prefriction.symbolic.branch_functions`); the phase
     durations (the switching times) are decision variables. Each phase is transcribed by multiple
     shooting with ``intervals`` control intervals of constant force and ``substeps`` RK4 steps
     each, in the normalised units of :class:`prefriction.Scales`.
@@ -144,23 +145,25 @@ def point_to_point(system: Oscillator, distance: float, *, u_max: float, objecti
         )
     modes = modes_from_simulation(system, distance, u_max) if modes is None else check_modes(modes, distance)
     sc = Scales.of(system)
-    q = model.runtime_params_for(sc)
-    nz, d = model.n_states, distance / sc.x
+    branches = {s: branch_functions(system, s) for s in (1.0, -1.0)}  # the model's CasADi Functions
+    q, nz, d = branches[1.0].q, model.n_states, distance / sc.x
+    no_flags = ca.DM(0, 1)
 
     def rhs(s: float):
+        b = branches[s]
+
         def f(y: ca.SX, u: ca.SX) -> ca.SX:
-            z = [y[2 + i] for i in range(nz)]
-            return ca.vertcat(y[1], u - model.force(z, [], y[1], s, q), *model.rate(z, [], y[1], s, q))
+            z = y[2:]
+            return ca.vertcat(y[1], u - b.force(z, no_flags, y[1], q), b.rate(z, no_flags, y[1], q))
         return f
 
     phases = [Phase(rhs=rhs(s), path=lambda y, s=s: s * y[1]) for s in modes]
 
-    def jump(y: ca.MX, k: int) -> ca.MX:
-        zr, _ = model.reverse([y[2 + i] for i in range(nz)], [], modes[k], q, 1e-12)
-        return ca.vertcat(y[0], y[1], *zr)
+    def jump(y: ca.MX, k: int) -> ca.MX:  # the reversal that ends phase k - 1
+        return ca.vertcat(y[0], y[1], branches[modes[k - 1]].reset(y[2:], no_flags, q, 1e-12)[0])
 
     def final(y: ca.MX) -> ca.MX:
-        return ca.vertcat(y[0] - d, y[1], model.force([y[2 + i] for i in range(nz)], [], 0.0, modes[-1], q))
+        return ca.vertcat(y[0] - d, y[1], branches[modes[-1]].force(y[2:], no_flags, 0.0, q))
 
     z0, _ = model.initial_state(0.0, modes[0])
     t_total = None if t_final is None else t_final / sc.t
@@ -171,7 +174,7 @@ def point_to_point(system: Oscillator, distance: float, *, u_max: float, objecti
                              final=final, u_max=u_max / sc.F, objective=objective, t_total=t_total, t_min=1e-6)
 
     def force(y: np.ndarray, k: int) -> float:
-        return float(model.force([float(zi) for zi in y[2:]], [], float(y[1]), modes[k], q))
+        return float(branches[modes[k]].force(y[2:], no_flags, y[1], q))
 
     setup = Setup("pre-sliding", objective, system, distance, modes, force, T0, U0)
     return optimise(setup, build, substeps=substeps, tol=tol, max_iter=max_iter)

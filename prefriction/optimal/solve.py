@@ -48,9 +48,9 @@ def optimise(setup: Setup, build: Callable[[int], Transcription], *, substeps: i
     sc = Scales.of(setup.system)
     tr = build(substeps)
     w = tr.forward(setup.T0, setup.U0)
-    wall, iterations = 0.0, 0
+    wall, iterations, lam = 0.0, 0, None
     while True:
-        w, stats, t_ipopt = tr.solve(w, max_iter=max_iter, tol=1e-10)
+        w, lam, stats, t_ipopt = tr.solve(w, max_iter=max_iter, tol=1e-10, lam=lam)
         wall, iterations = wall + t_ipopt, iterations + int(stats["iter_count"])
         if not stats["success"]:
             raise SolverError(

@@ -121,12 +121,22 @@ class Transcription:
         U = [w[i + k * N:i + (k + 1) * N] for k in range(n_ph)]
         return T, Y, U
 
-    def solve(self, w0: np.ndarray, *, max_iter: int, tol: float) -> tuple[np.ndarray, dict, float]:
-        """IPOPT from ``w0``: the solution, CasADi's stats and IPOPT's wall time [s]."""
-        opts = {"print_time": False, "ipopt": {"print_level": 0, "sb": "yes", "max_iter": max_iter, "tol": tol,
-                                               "bound_relax_factor": 0.0}}  # |u| <= u_max exactly
-        solver = ca.nlpsol("point_to_point", "ipopt", self.nlp, opts)
+    def solve(self, w0: np.ndarray, *, max_iter: int, tol: float,
+              lam: Optional[tuple] = None) -> tuple[np.ndarray, tuple, dict, float]:
+        """IPOPT from ``w0`` (and the multipliers ``lam = (lam_x, lam_g)`` of a solution of the
+        same problem at another integration, for a warm start): the solution, its multipliers,
+        CasADi's stats and IPOPT's wall time [s]."""
+        ipopt = {"print_level": 0, "sb": "yes", "max_iter": max_iter, "tol": tol,
+                 "bound_relax_factor": 0.0}  # |u| <= u_max exactly
+        args = {"x0": w0, "lbx": self.lbx, "ubx": self.ubx, "lbg": self.lbg, "ubg": self.ubg}
+        if lam is not None:  # near the solution: start there, with a small barrier parameter
+            ipopt.update({"warm_start_init_point": "yes", "mu_init": 1e-9, "warm_start_bound_push": 1e-12,
+                          "warm_start_mult_bound_push": 1e-12, "warm_start_slack_bound_push": 1e-12})
+            args.update(lam_x0=lam[0], lam_g0=lam[1])
+        solver = ca.nlpsol("point_to_point", "ipopt", self.nlp,
+                           {"print_time": False, "show_eval_warnings": False, "ipopt": ipopt})
         start = time.perf_counter()
-        sol = solver(x0=w0, lbx=self.lbx, ubx=self.ubx, lbg=self.lbg, ubg=self.ubg)
+        sol = solver(**args)
         wall = time.perf_counter() - start
-        return np.array(sol["x"]).ravel(), solver.stats(), wall
+        lam_out = (np.array(sol["lam_x"]).ravel(), np.array(sol["lam_g"]).ravel())
+        return np.array(sol["x"]).ravel(), lam_out, solver.stats(), wall
