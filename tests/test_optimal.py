@@ -91,11 +91,43 @@ def test_effort_optimal_move_lands_and_costs_less(effort_move, dahl_move):
     assert e.effort == pytest.approx(float(np.sum(e.u.u[:-1] ** 2 * np.diff(e.u.t))), rel=1e-12)
 
 
-def test_lugre_move_lands_through_simulate():
+def _scipy_lugre(u, t_final, sigma0=1e5, sigma1=300.0, sigma2=0.4, Fc=1.0, Fs=1.5, vs=1e-3, m=1.0):
+    """x, v at t_final of m x'' = u - F with LuGre (1)-(3) of Canudas de Wit et al. 1995 in SI units,
+    from rest; Radau restarted at each jump of the held force and at each zero of v (the kink of |v|)."""
+    y = np.zeros(3)  # x [m], v [m/s], z [m]
+    edges = list(u.t) + [t_final]
+    for k in range(len(u.t)):
+        t0, t1, uk = edges[k], min(edges[k + 1], t_final), u.u[k]
+        while t0 < t1:
+            a0 = uk - sigma0 * y[2] - sigma2 * y[1]
+            s = math.copysign(1.0, y[1] if y[1] != 0.0 else a0)
+
+            def rhs(_, w, s=s, uk=uk):
+                g = Fc + (Fs - Fc) * math.exp(-((w[1] / vs) ** 2))
+                dz = w[1] - sigma0 * s * w[1] * w[2] / g  # |v| = s v on this branch
+                return [w[1], (uk - sigma0 * w[2] - sigma1 * dz - sigma2 * w[1]) / m, dz]
+
+            def rev(_, w):
+                return w[1]
+
+            rev.terminal, rev.direction = True, -s
+            sol = solve_ivp(rhs, (t0, t1), y, method="Radau", rtol=1e-12, atol=[1e-16, 1e-13, 1e-18], events=rev)
+            if sol.status == 1 and sol.t_events[0][0] < t1 and sol.t_events[0][0] > t0:
+                t0, y = float(sol.t_events[0][0]), sol.y_events[0][0].copy()
+                y[1] = 0.0
+            else:
+                t0, y = t1, sol.y[:, -1]
+    return y
+
+
+def test_lugre_move_lands_through_simulate_and_scipy():
     r = optimal.point_to_point(LUGRE, -5e-4, u_max=4.0, intervals=16)
     assert r.modes == (-1.0, 1.0)
     assert abs(r.replay.x_error) <= 1e-9
     assert abs(r.replay.v_final) <= 1e-8 * np.max(np.abs(r.v))
+    y = _scipy_lugre(r.u, r.t_final)
+    assert abs(y[0] + 5e-4) <= 1e-9
+    assert abs(y[1]) <= 1e-8 * np.max(np.abs(r.v))
 
 
 def test_smoothed_and_bang_bang_forces_miss_the_target():
