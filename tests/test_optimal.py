@@ -159,6 +159,9 @@ def test_zero_order_hold_signal():
     ({"u_max": 5.0, "modes": (1.0, 1.0)}, ValueError, "alternate"),
     ({"u_max": 5.0, "modes": (-1.0, 1.0)}, ValueError, "away from the target"),
     ({"u_max": 5.0, "intervals": 10_000}, ValueError, "intervals"),
+    ({"u_max": 5.0, "tol": -1.0}, ValueError, "tol"),
+    ({"u_max": 5.0, "max_iter": 0}, ValueError, "max_iter"),
+    ({"u_max": "5"}, TypeError, "u_max"),
 ])
 def test_bad_input_names_the_argument(kwargs, error, match):
     with pytest.raises(error, match=match):
@@ -171,6 +174,12 @@ def test_models_with_events_are_refused():
         optimal.point_to_point(stage, D, u_max=5.0, modes=(1.0, -1.0))
     with pytest.raises(ValueError, match="distance"):
         optimal.point_to_point(DAHL, 0.0, u_max=5.0)
+    with pytest.raises(ValueError, match="system.u must be None"):
+        optimal.point_to_point(pf.Oscillator(DAHL.friction, u=1.0), D, u_max=5.0)
+    with pytest.raises(TypeError, match="system must be"):
+        optimal.bang_bang(DAHL.friction, D, u_max=5.0)
+    with pytest.raises(ValueError, match="v_smooth"):
+        optimal.smoothed_point_to_point(DAHL, D, u_max=5.0, v_smooth=0.0)
 
 
 def test_unloading_phase_ends_at_the_branch_zero_crossing_3_6(dahl_move):

@@ -18,10 +18,12 @@ from prefriction.optimal.transcription import Phase, Transcription
 from prefriction.symbolic import branch_functions
 from prefriction.units import Scales
 
-__all__ = ["point_to_point", "check_move", "MAX_INTERVALS"]
+__all__ = ["point_to_point", "check_move", "MAX_INTERVALS", "MAX_ITER"]
 
 MAX_INTERVALS = 200
 """Most control intervals per phase."""
+MAX_ITER = 10_000
+"""Largest IPOPT iteration limit."""
 
 
 def check_move(system: Any, distance: Any, u_max: Any, objective: Any, t_final: Any, intervals: Any,
@@ -112,7 +114,7 @@ def point_to_point(system: Oscillator, distance: float, *, u_max: float, objecti
     tol : float or None, default 1e-9
         Largest accepted miss of the replayed force [m] (1 nm); None: accept the first solution.
     max_iter : int, default 500
-        IPOPT iteration limit.
+        IPOPT iteration limit (1 to :data:`MAX_ITER`).
 
     Returns
     -------
@@ -137,6 +139,8 @@ def point_to_point(system: Oscillator, distance: float, *, u_max: float, objecti
     """
     distance, u_max, objective, t_final, intervals, substeps = check_move(
         system, distance, u_max, objective, t_final, intervals, substeps)
+    tol = None if tol is None else check_positive("tol", tol)
+    max_iter = check_count("max_iter", max_iter, 1, MAX_ITER)
     model = system.friction
     if model.n_flags or model.n_events:
         raise ValueError(

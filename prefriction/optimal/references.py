@@ -4,15 +4,16 @@ optimiser (:func:`smoothed_point_to_point`) and the Coulomb bang-bang profile (:
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from typing import Optional
 
 import casadi as ca
 import numpy as np
 
-from prefriction._validation import check_positive
+from prefriction._validation import check_count, check_positive
 from prefriction.models import Oscillator
 from prefriction.optimal.guess import bang_bang_signal, coulomb_times, guess_forces
-from prefriction.optimal.problem import check_move
+from prefriction.optimal.problem import MAX_ITER, check_move
 from prefriction.optimal.replay import replay
 from prefriction.optimal.result import PointToPointResult
 from prefriction.optimal.solve import Setup, optimise
@@ -61,6 +62,7 @@ def smoothed_point_to_point(system: Oscillator, distance: float, *, u_max: float
     distance, u_max, objective, t_final, intervals, substeps = check_move(
         system, distance, u_max, objective, t_final, intervals, substeps)
     v_smooth = check_positive("v_smooth", v_smooth)
+    max_iter = check_count("max_iter", max_iter, 1, MAX_ITER)
     sc = Scales.of(system)
     vs, d = v_smooth / sc.v, distance / sc.x
 
@@ -123,6 +125,4 @@ def bang_bang(system: Oscillator, distance: float, *, u_max: float) -> PointToPo
         F=np.full(3, s * Fc), modes=(s,), durations=np.array([t_final]),
         effort=u_max * u_max * t_final, iterations=0, solve_time=0.0,
     )
-    from dataclasses import replace
-
     return replace(result, replay=replay(system, u, t_final, distance))

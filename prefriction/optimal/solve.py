@@ -4,7 +4,7 @@
 from __future__ import annotations
 
 import sys
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Callable, Optional
 
 import numpy as np
@@ -67,9 +67,7 @@ def optimise(setup: Setup, build: Callable[[int], Transcription], *, substeps: i
         print(f"prefriction.optimal: replay ends {result.replay.x_error:.3g} m from the target at "
               f"{result.replay.v_final:.3g} m/s; solving again with {2 * substeps} RK4 steps per interval", file=sys.stderr)
         substeps *= 2
-        T, Y, U = tr.unpack(w)
-        tr = build(substeps)
-        w = tr.pack(T, Y, U)
+        tr = build(substeps)  # same variables: w and lam carry over
     if not _lands(result, tol):
         raise SolverError(
             f"the optimal force replayed through simulate ends {result.replay.x_error!r} m from the target "
@@ -87,8 +85,6 @@ def _lands(result: PointToPointResult, tol: float) -> bool:
 
 
 def _with_replay(result: PointToPointResult, system: Oscillator) -> PointToPointResult:
-    from dataclasses import replace
-
     return replace(result, replay=replay(system, result.u, result.t_final, result.distance))
 
 
