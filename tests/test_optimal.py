@@ -6,6 +6,7 @@ and force jump); the smoothed and bang-bang references miss; bad input is refuse
 from __future__ import annotations
 
 import math
+import pickle
 
 import numpy as np
 import pytest
@@ -145,6 +146,8 @@ def test_zero_order_hold_signal():
     np.testing.assert_array_equal(u(np.array([-1.0, 0.0, 0.999, 1.0, 1.5, 2.0, 9.0])), [3, 3, 3, -1, -1, 0.5, 0.5])
     assert u.bound(1.5) == 3.0 and u.bound(0.5) == 3.0 and list(u.breaks()) == [0.0, 1.0, 2.0]
     assert list(u.piece(1.0, 2.0)) == [1.0, -1.0, 0.0]
+    back = pickle.loads(pickle.dumps(u))  # process pools and dask ship signals
+    assert list(back.t) == list(u.t) and list(back.u) == list(u.u)
     with pytest.raises(ValueError, match="strictly increasing"):
         pf.signals.ZeroOrderHold([0.0, 0.0], [1.0, 2.0])
     with pytest.raises(ValueError, match="same length"):
