@@ -81,6 +81,14 @@ def test_time_optimal_move_is_near_the_coulomb_bound_and_bang_bang(dahl_move):
     assert 0.9 < r.t_final / bb.t_final < 1.2
 
 
+def test_finer_control_grid_is_not_slower(dahl_move):
+    """Halving the control intervals nests the piecewise-constant forces: the optimum cannot get worse
+    (up to the RK4 error, far below this); the switch inside an interval converges at first order."""
+    coarse = optimal.point_to_point(DAHL, D, u_max=UMAX, intervals=12)
+    assert dahl_move.t_final < coarse.t_final
+    assert coarse.t_final - dahl_move.t_final < 1e-3 * dahl_move.t_final
+
+
 def test_effort_optimal_move_lands_and_costs_less(effort_move, dahl_move):
     e = effort_move
     assert e.t_final == pytest.approx(1.3 * dahl_move.t_final, rel=1e-9)
