@@ -11,11 +11,11 @@ from prefriction._validation import check_bool
 from prefriction.models import FrictionModel, Oscillator
 from prefriction.signals import Constant
 from prefriction.simulation.compiled import compiled
+from prefriction.simulation.simulate import _CAL  # eps = rtol * _CAL * sqrt(active / all states), as simulate
 from prefriction.simulation.plant import EPS_TOUCH, Layout, PlantSpec, build_integrator, has_potential
 
 __all__ = ["plant_step"]
 
-_CAL = 0.1  # as prefriction.simulation.simulate: eps = rtol * 0.1 * sqrt(active / all states)
 _NSTOP = 1e9  # no reversal limit within a step
 
 
