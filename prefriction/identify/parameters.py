@@ -289,7 +289,8 @@ def symbolic_units(model: FrictionModel, values: dict[str, Any], mass: Any) -> t
         V = Fc / ca.sqrt(mass * sigma)
         scales = _SymScales(x=Fc / sigma, F=Fc, t=ca.sqrt(mass / sigma), v=V, E=Fc * Fc / sigma)
         q = sym.runtime_params_for(scales)
-        q = ca.vertcat(*[q[i] for i in range(len(q))]) if len(q) else ca.SX(0, 1)
+        if not isinstance(q, (ca.SX, ca.MX)):
+            q = ca.vertcat(*[q[i] for i in range(len(q))]) if len(q) else ca.SX(0, 1)
     except Exception as exc:
         raise TypeError(f"fit cannot express the normalised numbers of {type(model).__name__} through CasADi "
                         f"symbols ({type(exc).__name__}: {exc}); its sigma, Fc and runtime_params_for must "
