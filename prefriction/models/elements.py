@@ -159,9 +159,8 @@ class ParallelElements(FrictionModel):
 
     @property
     def sigma(self) -> float:  # type: ignore[override]
-        """Rest stiffness ``sum k_i`` [N/m] (a CasADi sum when the fit gives symbolic stiffnesses)."""
-        k = getattr(self, self._stiffness_field)
-        return ca.sum1(k) if isinstance(k, (ca.SX, ca.MX)) else math.fsum(k.tolist())
+        """Rest stiffness ``sum k_i`` [N/m]."""
+        return math.fsum(getattr(self, self._stiffness_field).tolist())
 
     def _element_fractions(self) -> tuple[np.ndarray, np.ndarray]:
         """Normalised element stiffnesses ``kappa_i = k_i / sigma`` and slip forces at rest

@@ -215,8 +215,6 @@ class GMS(StribeckCurve, ParallelElements):
         kappa = self.k / sig
         mu = self.damping * V / Fc / kappa
         tail = [self.Fs / Fc - 1.0, V / self.vs, 0.5 * self.delta, self.C / (sig * V), self.sigma2 * V / Fc]
-        if symbolic([kappa, mu, *tail]):  # the fit's symbolic parameters (identify.parameters.symbolic_units)
-            return ca.vertcat(kappa, self.alpha, mu, *tail)
         return np.concatenate((kappa, self.alpha, mu, tail))
 
     def runtime_params(self) -> np.ndarray:
