@@ -28,6 +28,7 @@ BLOCK = 4096
 """Samples per call of the compiled block."""
 
 _CACHE: dict[Hashable, "Stepper"] = {}
+_EXACT: dict[Hashable, bool] = {}
 
 
 @dataclass(frozen=True)
@@ -94,7 +95,10 @@ class Stepper:
 def stepper(model: FrictionModel, substeps: int) -> Stepper:
     """The :class:`Stepper` of ``model``'s structure, built and compiled once per process
     (``substeps`` only matters for a model without an exact step)."""
-    key = (type(model), model.structure_key(), None if has_exact_step(model) else substeps)
+    structure = (type(model), model.structure_key())
+    if structure not in _EXACT:
+        _EXACT[structure] = has_exact_step(model)
+    key = (*structure, None if _EXACT[structure] else substeps)
     if key not in _CACHE:
         _CACHE[key] = Stepper(model, substeps)
     return _CACHE[key]
