@@ -80,8 +80,10 @@ class LuGreObserver(Compensator):
     >>> from prefriction import controllers
     >>> obs = controllers.LuGreObserver(pf.LuGre(sigma0=1e6, sigma1=100.0, sigma2=0.0, Fc=1.0, Fs=1.3,
     ...                                          vs=1e-4), gain=1e3)
-    >>> obs.gain_condition(controllers.PID(kp=2e6, ki=1e8, kd=2e3), mass=1.0)[0]
+    >>> obs.gain_condition(controllers.PID(kp=2e6, ki=1e8, kd=2e4), mass=1.0)[0]  # sigma1 kd > m sigma0
     True
+    >>> obs.gain_condition(controllers.PID(kp=2e6, ki=1e8, kd=2e3), mass=1.0)[0]
+    False
     """
 
     model: LuGre
