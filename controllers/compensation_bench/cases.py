@@ -53,7 +53,7 @@ def compensators(model: pf.FrictionModel) -> dict[str, Optional[Compensator]]:
         "PID alone": None,
         "feedforward": Feedforward(model),
         "LuGre observer": LuGreObserver(lugre_of(model), gain=2e3),
-        "friction observer": FrictionObserver(pf.Dahl(sigma=model.sigma, Fc=model.Fc), pole=300.0),
+        "friction observer": FrictionObserver(pf.Dahl(sigma=model.sigma, Fc=model.Fc), pole=1000.0),
         "disturbance observer": DisturbanceObserver(bandwidth=2.0 * math.pi * 300.0),
     }
 
