@@ -61,8 +61,9 @@ class Feedforward(Compensator):
     The model is driven along the reference samples (the motion the stage should follow), one
     sample period at a time with :func:`prefriction.identify.stepping.interval_function`: over
     ``[t_k, t_{k+1}]`` the mean velocity ``(r_{k+1} - r_k) / Ts`` and the direction of motion
-    (a reversal where it changes sign), ``n_sub`` Runge-Kutta sub-steps, events applied. The
-    force held over the period is
+    (a reversal where it changes sign), the model's exact step (Dahl, Maxwell-slip, LuGre, GMS)
+    or ``n_sub`` Runge-Kutta sub-steps for other models, events applied. The force held over
+    the period is
 
         u_ff,k = m (r'_{k+1} - r'_k) / Ts + (F_k + F_{k+1}) / 2,
 
@@ -77,7 +78,8 @@ class Feedforward(Compensator):
     model : FrictionModel
         The identified friction model (Dahl, LuGre, Maxwell-slip, GMS, ...), in SI units.
     n_sub : int, default 2
-        Runge-Kutta sub-steps per sample period, ``1 <= n_sub <= 64``.
+        Runge-Kutta sub-steps per sample period for models without an exact step,
+        ``1 <= n_sub <= 64``.
 
     Examples
     --------
