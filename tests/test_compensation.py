@@ -306,3 +306,20 @@ def test_example_script(tmp_path):
     assert 1e-9 < pid_spike < 1e-7
     assert e[("nominal", "feedforward")]["spike"] < 1e-3 * pid_spike
     assert e[("mismatch", "feedforward")]["spike"] < pid_spike / 3
+
+
+def test_force_limit_applies_to_the_total_force(pid):
+    """A PID with u_max clips controller plus compensation; the replayed plant sees the clipped force."""
+    limited = controllers.PID(kp=pid.kp, ki=pid.ki, kd=pid.kd, tau=pid.tau, u_max=0.9)
+    res = controllers.simulate_loop(stage(), limited, SINE, 0.4, Ts=TS,
+                                    compensator=controllers.Feedforward(pf.Dahl(sigma=SIGMA, Fc=FC)))
+    assert np.max(np.abs(res.u)) <= 0.9 * (1 + 1e-15) and np.any(np.abs(res.u) >= 0.9 * (1 - 1e-12))
+
+
+def test_callable_reference_with_a_compensator(pid):
+    """A plain Python callable: its velocity from central differences of the samples (second order)."""
+    res = controllers.simulate_loop(stage(), pid, lambda t: float(SINE(t)), 0.05, Ts=TS,
+                                    compensator=controllers.Feedforward(pf.Dahl(sigma=SIGMA, Fc=FC)))
+    same = controllers.simulate_loop(stage(), pid, SINE, 0.05, Ts=TS,
+                                     compensator=controllers.Feedforward(pf.Dahl(sigma=SIGMA, Fc=FC)))
+    np.testing.assert_allclose(res.x, same.x, rtol=0, atol=1e-6 * 5e-6)
