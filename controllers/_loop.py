@@ -19,7 +19,7 @@ import control
 import numpy as np
 
 import prefriction
-from prefriction._validation import check_positive, check_real_array, check_signal
+from prefriction._validation import check_count, check_nonnegative, check_positive, check_real_array, check_signal
 from prefriction.models import Oscillator
 from prefriction.signals import Signal
 from prefriction.simulation.feedback import LinearFeedback, sample_count
@@ -189,10 +189,13 @@ def simulate_loop(
         ``Ts`` different from the discrete controller's ``dt``; malformed reference samples
         (lengths differ, not increasing, not finite); an improper or non-SISO controller;
         ``t_out`` with a sampled controller, not 1-D, not strictly increasing or outside
-        ``[0, t_end]``; ``xc0`` of the wrong length or not finite.
+        ``[0, t_end]``; ``xc0`` of the wrong length or not finite; a compensator or a
+        measurement option with a continuous controller or an oscillator with its own input
+        force; negative ``quantization`` or ``noise_rms``; ``delay`` outside ``[0, 8]``;
+        ``mismatch`` without a compensator; a disturbance observer's bandwidth above ``pi / Ts``.
     TypeError
         Wrong argument types, unknown keyword arguments, a reference callable that cannot be
-        traced in a continuous loop.
+        traced in a continuous loop, a compensator that is not one of the four kinds.
     prefriction.SolverError
         If the integration fails (the message names the time, the state and what to try).
 
@@ -204,7 +207,7 @@ def simulate_loop(
     """
     _check_system(system)
     t_end = check_positive("t_end", t_end)
-    measurement = _measurement_options(quantization, noise_rms, seed, delay)
+    measurement, noise_rms = _measurement_options(quantization, noise_rms, seed, delay)
     if compensator is not None and not isinstance(compensator, Compensator):
         raise TypeError(f"compensator must be a controllers.Feedforward, LuGreObserver, FrictionObserver or "
                         f"DisturbanceObserver, got {compensator!r} of type {type(compensator).__name__}")
@@ -215,7 +218,7 @@ def simulate_loop(
             raise TypeError(f"mismatch must be a tuple (stiffness, coulomb) of factors, got {mismatch!r}")
         if hasattr(compensator, "model"):
             compensator = compensator.with_model(scaled_model(compensator.model, *mismatch))
-    special = compensator is not None or measurement.quantization > 0.0 or measurement.noise is not None or delay != 0
+    special = compensator is not None or measurement.quantization > 0.0 or noise_rms > 0.0 or measurement.delay != 0
     reference = _check_reference(reference)
     if Ts is not None:
         Ts = check_positive("Ts", Ts)
@@ -260,9 +263,9 @@ def simulate_loop(
                 params, state0 = compensator.numbers(system.mass, Ts, x0)
                 comp = Compensation(compensator.structure(), params, state0,
                                     reference_velocity(reference, tk, _evaluate(reference, tk), Ts))
-            if measurement.noise is not None:
-                rng = np.random.default_rng(seed)
-                measurement = Measurement(quantization, delay, noise_rms * rng.standard_normal(n_samples))
+            if noise_rms > 0.0:
+                noise = noise_rms * np.random.default_rng(seed).standard_normal(n_samples)
+                measurement = Measurement(measurement.quantization, measurement.delay, noise)
             sim, stats, extra = run_sampled(
                 system, fb, t_end, x0=x0, v0=v0, F0=F0, rtol=rtol, jit=jit,
                 u_max=controller.u_max if saturated else None,
@@ -284,12 +287,11 @@ def simulate_loop(
     )
 
 
-def _measurement_options(quantization: Any, noise_rms: Any, seed: Any, delay: Any) -> Measurement:
-    """The checked measurement options (noise drawn later, once the sample count is known)."""
-    from prefriction._validation import check_count, check_nonnegative
-
+def _measurement_options(quantization: Any, noise_rms: Any, seed: Any, delay: Any) -> tuple[Measurement, float]:
+    """The checked measurement options without noise, and the noise's rms [m] (the noise is
+    drawn once the sample count is known)."""
     quantization = check_nonnegative("quantization", quantization)
     noise_rms = check_nonnegative("noise_rms", noise_rms)
     check_count("seed", seed, 0)
     delay = check_count("delay", delay, 0, MAX_DELAY, why="the measurement buffer of the compiled loop")
-    return Measurement(quantization, delay, np.zeros(1) if noise_rms > 0.0 else None)
+    return Measurement(quantization, delay), noise_rms
