@@ -12,7 +12,8 @@ A signal (an input force [N], a reference position [m], ...) is split in two par
 
 Kinds: :class:`Constant`, :class:`Step`, :class:`Ramp`, :class:`Sine`, :class:`Chirp`,
 :class:`Samples` (piecewise linear data), :class:`ZeroOrderHold`
-(piecewise constant with jumps), :class:`Traced` (an arbitrary traceable Python
+(piecewise constant with jumps), :class:`PointToPoint` (S-curve and trapezoidal moves),
+:class:`Traced` (an arbitrary traceable Python
 function; compiled once *per function object*) and :class:`Sum` (made with ``+``).
 :func:`as_signal` converts the user-facing forms (number, ``(t, values)``, callable) to signals.
 
@@ -36,6 +37,7 @@ from prefriction.signals.algebra import Sum
 from prefriction.signals.base import Signal
 from prefriction.signals.compiled import compiled_form
 from prefriction.signals.conversion import as_signal
+from prefriction.signals.motion import PointToPoint
 from prefriction.signals.periodic import Chirp, Sine
 from prefriction.signals.piecewise import Constant, Ramp, Step
 from prefriction.signals.samples import MAX_SAMPLES, Samples
@@ -46,6 +48,7 @@ __all__ = [
     "compiled_form",
     "Chirp",
     "Constant",
+    "PointToPoint",
     "Ramp",
     "Samples",
     "Signal",

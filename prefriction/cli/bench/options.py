@@ -33,7 +33,9 @@ examples:
   prefriction bench --repeats 9      more warm repeats per point
   prefriction bench --models         Maxwell-slip, LuGre and GMS against scipy
   prefriction bench --sweep          parameter sweeps in cold and warm processes
-  prefriction bench --loops          compiled PID loop against python-control"""
+  prefriction bench --loops          compiled PID loop against python-control
+  prefriction bench --compensation   PID alone against PID with each friction compensator
+                                     (writes compensation_*.png to --out)"""
 
 
 def repeats(text: str) -> int:
@@ -102,7 +104,7 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
     -------
     argparse.Namespace
         ``out`` (pathlib.Path, an existing directory; None with ``--loops``), ``quick``, ``repeats`` (int or None), and at most one of
-        ``stability``, ``models``, ``sweep``, ``loops`` set.
+        ``stability``, ``models``, ``sweep``, ``loops``, ``compensation`` set.
 
     Raises
     ------
@@ -134,7 +136,13 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
                       help="instead: the positioning-loop benchmark (python -m prefriction.controllers.benchmark): "
                            "compiled PID loop against python-control, tuning sweep, loop lengths; "
                            "--repeats sets its warm repeats (default 3)")
+    what.add_argument("--compensation", action="store_true",
+                      help="instead: PID alone against PID with each friction compensator (feedforward, LuGre, "
+                           "friction and disturbance observers) on Dahl, LuGre and GMS stages, nominal, mismatched "
+                           "and quantised (docs/compensation.md#bench)")
     args = ap.parse_args(argv)
+    if args.compensation and (args.quick or args.repeats is not None):
+        ap.error("--quick and --repeats do not apply to --compensation")
     if args.repeats is not None and (args.sweep or args.models):
         ap.error("--repeats applies to the headline and stability sections, not to --sweep or --models")
     if args.loops and args.quick:
