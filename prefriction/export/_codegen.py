@@ -55,14 +55,16 @@ def directory_of(directory: Any) -> Path:
     return path
 
 
-def c_text(fun: ca.Function, name: str) -> str:
-    """The C99 source of ``fun`` under the symbol ``name`` (CasADi's code generator, no casadi header).
+def c_text(functions: dict[str, ca.Function], prefix: str) -> str:
+    """The C99 source of ``functions`` (symbol name -> Function), CasADi's code generator without
+    a casadi header; ``prefix`` prefixes the internal symbols.
 
-    The entry point is ``int name(const double **arg, double **res, long *iw, double *w, int mem)``;
-    numbers that are constants of ``fun`` are literals of the text.
+    Each entry point is ``int name(const double **arg, double **res, long *iw, double *w, int mem)``;
+    numbers that are constants of a Function are literals of the text.
     """
-    cg = ca.CodeGenerator(name, _OPTIONS)
-    cg.add(_renamed(fun, name))
+    cg = ca.CodeGenerator(prefix, _OPTIONS)
+    for name, fun in functions.items():
+        cg.add(_renamed(fun, name))
     return cg.dump()
 
 

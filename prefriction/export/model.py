@@ -228,13 +228,13 @@ def c_source(model: FrictionModel, name: str, directory: Any, *, Ts: Optional[fl
     header = _HEADER.format(name=name, what=what, sampling=sampling, nz1=nz1, i_s=n - 2, i_x=n - 1,
                             guard=f"{name.upper()}_H", n=n)
     virgin = ", ".join(repr(v) for v in virgin_state(model, 0.0))
-    body = c_text(fun, step) + _WRAPPER.format(
+    body = c_text({step: fun}, f"{name}_casadi") + _WRAPPER.format(
         name=name, n=n, virgin=virgin, i_x=n - 1, sz_arg=max(sz_arg, 2), sz_res=max(sz_res, 2),
         sz_iw1=max(sz_iw, 1), sz_w1=max(sz_w, 1), step=step)
     h_path, c_path = path / f"{name}.h", path / f"{name}.c"
     h_path.write_text(header)
     c_path.write_text(body)
-    return CSource(name, h_path, c_path, "model", what, fun, n, model)
+    return CSource(name, h_path, c_path, "model", what, fun, n, model, {"Ts": Ts, "n_sub": n_sub})
 
 
 def _describe(model: FrictionModel) -> str:

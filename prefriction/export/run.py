@@ -22,7 +22,7 @@ from prefriction._validation import check_count, check_real_array
 from .model import virgin_state
 from .source import CSource
 
-__all__ = ["CRun", "evaluate", "gcc", "run_c"]
+__all__ = ["CRun", "compile_and_run", "evaluate", "gcc", "run_c"]
 
 MAX_SAMPLES = 50_000_000
 """Largest number of positions :func:`run_c` and :func:`evaluate` take (memory: 16 bytes each)."""
@@ -143,24 +143,33 @@ def run_c(source: CSource, x: Any, *, rounds: int = 1) -> CRun:
     source = _source(source)
     x = _positions(x)
     rounds = check_count("rounds", rounds, 1, 1000)
+    out, ns = compile_and_run(source, _DRIVER, x, x.size, rounds)
+    return CRun(out, ns, rounds)
+
+
+def compile_and_run(source: CSource, driver: str, data: np.ndarray, n_out: int, rounds: int) -> tuple[np.ndarray, float]:
+    """Compile ``driver`` (``NAME`` replaced by the export's name) with the export, run it on the
+    doubles ``data``; the ``n_out`` doubles it writes and the time per step [ns] it prints."""
     cc = gcc()
     if cc is None:
-        raise FileNotFoundError("run_c needs gcc on the PATH to compile the exported code; install gcc")
+        raise FileNotFoundError(f"running {source.name} needs gcc on the PATH to compile the exported code; install gcc")
     with tempfile.TemporaryDirectory(prefix="pf-export-") as tmp:
         d = Path(tmp)
-        (d / "driver.c").write_text(_DRIVER.replace("NAME", source.name))
+        (d / "driver.c").write_text(driver.replace("NAME", source.name))
         exe = d / "driver"
         cmd = [cc, *CFLAGS, "-I", str(source.header.parent), str(d / "driver.c"), str(source.source), "-lm", "-o", str(exe)]
         done = subprocess.run(cmd, capture_output=True, text=True)
         if done.returncode != 0:
             raise RuntimeError(f"gcc failed to compile {source.source}:\n{done.stderr.strip()}")
-        x.tofile(d / "x.bin")
-        done = subprocess.run([str(exe), str(d / "x.bin"), str(d / "F.bin"), str(x.size), str(rounds)],
+        np.ascontiguousarray(data, dtype=float).tofile(d / "in.bin")
+        done = subprocess.run([str(exe), str(d / "in.bin"), str(d / "out.bin"), str(data.size), str(rounds)],
                               capture_output=True, text=True)
         if done.returncode != 0:
             raise RuntimeError(f"the compiled driver of {source.name} failed with exit code {done.returncode}")
-        F = np.fromfile(d / "F.bin", dtype=float)
-    return CRun(F, float(done.stdout), rounds)
+        out = np.fromfile(d / "out.bin", dtype=float)
+    if out.size != n_out:
+        raise RuntimeError(f"the compiled driver of {source.name} wrote {out.size} numbers, expected {n_out}")
+    return out, float(done.stdout)
 
 
 def evaluate(source: CSource, x: Any) -> np.ndarray:

@@ -32,8 +32,10 @@ class CSource:
         numbers as the C code (to rounding).
     state_size : int
         Number of doubles in ``<name>_state``'s array ``w``.
-    model : FrictionModel or None
-        The exported friction model (kind ``"model"``), else ``None``.
+    model : FrictionModel or Oscillator or None
+        The exported friction model (kind ``"model"``) or stage (kind ``"plant"``).
+    options : dict
+        The export's keyword values (``Ts``, ``n_sub``, ``F0``, ``rtol``, ``force_scale``, ...).
     """
 
     name: str
@@ -44,6 +46,7 @@ class CSource:
     function: ca.Function = field(repr=False)
     state_size: int
     model: Any = field(default=None, repr=False)
+    options: dict = field(default_factory=dict, repr=False)
 
     def __repr__(self) -> str:
         return f"CSource({self.name!r}, {self.kind}: {self.what}; {self.header.name} + {self.source.name} in {self.source.parent})"
