@@ -147,9 +147,12 @@ def run_c(source: CSource, x: Any, *, rounds: int = 1) -> CRun:
     return CRun(out, ns, rounds)
 
 
-def compile_and_run(source: CSource, driver: str, data: np.ndarray, n_out: int, rounds: int) -> tuple[np.ndarray, float]:
-    """Compile ``driver`` (``NAME`` replaced by the export's name) with the export, run it on the
-    doubles ``data``; the ``n_out`` doubles it writes and the time per step [ns] it prints."""
+def compile_and_run(source: CSource | list[CSource], driver: str, data: np.ndarray, n_out: int,
+                    rounds: int) -> tuple[np.ndarray, float]:
+    """Compile ``driver`` with the export(s) (``NAME`` in it replaced by the first one's name),
+    run it on the doubles ``data``; the ``n_out`` doubles it writes and the time per step [ns] it prints."""
+    sources = source if isinstance(source, list) else [source]
+    source = sources[0]
     cc = gcc()
     if cc is None:
         raise FileNotFoundError(f"running {source.name} needs gcc on the PATH to compile the exported code; install gcc")
@@ -157,10 +160,11 @@ def compile_and_run(source: CSource, driver: str, data: np.ndarray, n_out: int, 
         d = Path(tmp)
         (d / "driver.c").write_text(driver.replace("NAME", source.name))
         exe = d / "driver"
-        cmd = [cc, *CFLAGS, "-I", str(source.header.parent), str(d / "driver.c"), str(source.source), "-lm", "-o", str(exe)]
+        incs = [a for src in sources for a in ("-I", str(src.header.parent))]
+        cmd = [cc, *CFLAGS, *incs, str(d / "driver.c"), *[str(src.source) for src in sources], "-lm", "-o", str(exe)]
         done = subprocess.run(cmd, capture_output=True, text=True)
         if done.returncode != 0:
-            raise RuntimeError(f"gcc failed to compile {source.source}:\n{done.stderr.strip()}")
+            raise RuntimeError(f"gcc failed to compile {', '.join(str(src.source) for src in sources)}:\n{done.stderr.strip()}")
         np.ascontiguousarray(data, dtype=float).tofile(d / "in.bin")
         done = subprocess.run([str(exe), str(d / "in.bin"), str(d / "out.bin"), str(data.size), str(rounds)],
                               capture_output=True, text=True)
