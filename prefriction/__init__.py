@@ -3,11 +3,14 @@
 Public API, re-exported from private modules:
 
 - models (:mod:`prefriction.models`): :class:`FrictionModel` (the protocol), :class:`Dahl`,
-  :class:`MaxwellSlip`, :class:`GMS`, :class:`LuGre`, :class:`Oscillator`, :class:`Parameter`
+  :class:`MaxwellSlip`, :class:`GMS`, :class:`LuGre`, :class:`Viscous`, :class:`Parallel` (``a + b``),
+  :class:`Oscillator`, :class:`Parameter`
 - input signals: :mod:`prefriction.signals` (``Constant``, ``Step``, ``Ramp``, ``Sine``,
   ``Chirp``, ``Samples`` and sums; compiled once per kind)
 - analytics: :mod:`prefriction.dahl` (exact and approximate reversal maps, energies; Dahl only)
 - exact reference: :func:`exact_reversals` (Dahl only)
+- the force along a prescribed or measured motion: :func:`friction_along` (:class:`AlongResult`),
+  sample by sample :class:`FrictionStream` (:mod:`prefriction.along`)
 - simulation: :func:`simulate` (closed linear loops: :class:`LinearFeedback`), :func:`sweep`
 - energy analysis: :mod:`prefriction.energy`
 - model checks for new models: :mod:`prefriction.testing`
@@ -21,7 +24,8 @@ Public API, re-exported from private modules:
 from __future__ import annotations
 
 from prefriction.errors import PrefrictionError, SolverError
-from prefriction.models import GMS, Dahl, FrictionModel, LuGre, MaxwellSlip, Oscillator, Parameter
+from prefriction.along import AlongResult, FrictionStream, friction_along
+from prefriction.models import GMS, Dahl, FrictionModel, LuGre, MaxwellSlip, Oscillator, Parallel, Parameter, Viscous
 from prefriction.reversals import ReversalTable
 from prefriction.units import Scales
 from prefriction.simulation.simulate import SimulationResult, simulate
@@ -33,13 +37,16 @@ from prefriction.sensitivity import sensitivities
 from prefriction.analysis.exact import exact_reversals
 
 __all__ = [
+    "AlongResult",
     "Dahl",
     "FrictionModel",
+    "FrictionStream",
     "GMS",
     "LinearFeedback",
     "LuGre",
     "MaxwellSlip",
     "Oscillator",
+    "Parallel",
     "Parameter",
     "PrefrictionError",
     "ReversalTable",
@@ -47,10 +54,12 @@ __all__ = [
     "SimulationResult",
     "SolverError",
     "SweepResult",
+    "Viscous",
     "controllers",
     "dahl",
     "energy",
     "exact_reversals",
+    "friction_along",
     "describing",
     "identify",
     "sensitivities",
