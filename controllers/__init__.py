@@ -10,6 +10,11 @@
 - :func:`simulate_loop` runs any SISO proper controller, continuous or sampled (ZOH), around
   the reversal-aware plant of :func:`prefriction.simulate`; a :class:`PID` with a force limit
   ``u_max`` adds back-calculation anti-windup (sampled loops). Returns a :class:`LoopResult`.
+- Friction compensators for sampled loops (``simulate_loop(..., compensator=...)``,
+  ``docs/compensation.md``): :class:`Feedforward` (an identified model along the reference,
+  plus inertia), :class:`LuGreObserver` (Canudas de Wit et al. 1995), :class:`FrictionObserver`
+  (Ruderman's reduced-order observer) and :class:`DisturbanceObserver` (Q-filter); measurement
+  quantisation, noise, delay and model mismatch are options of :func:`simulate_loop`.
 - :func:`plant_iosys` is the same stage as a ``control.NonlinearIOSystem`` for
   ``control.interconnect``; it does not locate reversals (see its notes and
   ``python -m prefriction.controllers.benchmark`` for the measured shortfall and run times).
@@ -24,8 +29,13 @@ from ._linear import UnstableLoopWarning, closed_loop, design_pd, design_pid, li
 from ._margins import Margins, margins
 from ._loop import LoopResult, simulate_loop
 from ._pid import PID, pd, pid
+from .compensators import DisturbanceObserver, Feedforward, FrictionObserver, LuGreObserver
 
 __all__ = [
+    "DisturbanceObserver",
+    "Feedforward",
+    "FrictionObserver",
+    "LuGreObserver",
     "LoopResult",
     "Margins",
     "PID",

@@ -24,10 +24,14 @@ from prefriction.models import Oscillator
 from prefriction.signals import Signal
 from prefriction.simulation.feedback import LinearFeedback, sample_count
 from prefriction.simulation.loops import run_sampled
+from prefriction.simulation.loops.compiled_loop import MAX_DELAY
+from prefriction.simulation.loops.runner import Compensation, Measurement
 
 from ._linear import _check_system, _sample_time, as_lti, closed_loop
 from ._loop_result import LoopResult
 from ._pid import PID
+from ._reference import reference_velocity
+from .compensators import Compensator, scaled_model
 
 Reference = Union[float, Callable[[Any], Any], tuple]
 
@@ -98,6 +102,12 @@ def simulate_loop(
     t_out: Any = None,
     rtol: float = 1e-8,
     jit: bool = True,
+    compensator: Optional[Compensator] = None,
+    quantization: float = 0.0,
+    noise_rms: float = 0.0,
+    seed: int = 0,
+    delay: int = 0,
+    mismatch: Optional[tuple[float, float]] = None,
 ) -> LoopResult:
     """Simulate the positioning loop ``u = C(r - x)`` around a friction stage, every reversal located.
 
@@ -149,6 +159,23 @@ def simulate_loop(
         Relative tolerance of the simulator, ``1e-13 <= rtol <= 1e-2``.
     jit : bool, default True
         Let the simulator compile its integrator (cached on disk).
+    compensator : controllers.Feedforward, LuGreObserver, FrictionObserver or DisturbanceObserver, optional
+        A friction compensator whose force is added to the controller's at every sample
+        (sampled loops without an input force of the oscillator; ``docs/compensation.md``).
+    quantization : float, default 0.0
+        Encoder step [m], ``>= 0``: the measured position is rounded to it (0: exact).
+    noise_rms : float, default 0.0
+        Standard deviation [m] of white Gaussian measurement noise, ``>= 0``, drawn from
+        ``numpy.random.default_rng(seed)``.
+    seed : int, default 0
+        Seed of the measurement noise.
+    delay : int, default 0
+        Measurement delay in whole samples, ``0 <= delay <= 8``: the controller and the
+        compensator see ``x(t_{k - delay})``.
+    mismatch : (float, float), optional
+        Factors ``(stiffness, coulomb)`` applied to the compensator's friction model
+        (:func:`controllers.compensators.scaled_model`): the compensator's model differs from
+        the plant's. No effect on the model-free :class:`DisturbanceObserver`.
 
     Returns
     -------
@@ -177,6 +204,18 @@ def simulate_loop(
     """
     _check_system(system)
     t_end = check_positive("t_end", t_end)
+    measurement = _measurement_options(quantization, noise_rms, seed, delay)
+    if compensator is not None and not isinstance(compensator, Compensator):
+        raise TypeError(f"compensator must be a controllers.Feedforward, LuGreObserver, FrictionObserver or "
+                        f"DisturbanceObserver, got {compensator!r} of type {type(compensator).__name__}")
+    if mismatch is not None:
+        if compensator is None:
+            raise ValueError(f"mismatch needs a compensator (it scales the compensator's model), got mismatch={mismatch!r}")
+        if not (isinstance(mismatch, tuple) and len(mismatch) == 2):
+            raise TypeError(f"mismatch must be a tuple (stiffness, coulomb) of factors, got {mismatch!r}")
+        if hasattr(compensator, "model"):
+            compensator = compensator.with_model(scaled_model(compensator.model, *mismatch))
+    special = compensator is not None or measurement.quantization > 0.0 or measurement.noise is not None or delay != 0
     reference = _check_reference(reference)
     if Ts is not None:
         Ts = check_positive("Ts", Ts)
@@ -192,10 +231,14 @@ def simulate_loop(
     elif Ts is not None:
         C = control.c2d(C, Ts, method=discretization)
     if Ts is not None:
-        sample_count(t_end, Ts, t_end / Ts)  # refuse runs that would exhaust the memory
+        n_samples = sample_count(t_end, Ts, t_end / Ts)  # refuse runs that would exhaust the memory
+    if special and (Ts is None or system.forced):
+        raise ValueError("a compensator, quantization, noise_rms and delay need a sampled controller (Ts or a "
+                         "discrete controller) and an oscillator without its own input force (system.u = None)")
     closed_loop(system, C, regime="presliding", warn=True)
     fb_reference = reference
     stats = None
+    extra: dict = {}
     if Ts is not None:
         if t_out is not None:
             raise ValueError("t_out is not allowed with a sampled controller: its outputs are at the sample instants k Ts")
@@ -211,10 +254,20 @@ def simulate_loop(
         if system.forced:  # a disturbance force: the Python loop of prefriction.simulate
             sim = prefriction.simulate(system, v0, x0=x0, F0=F0, t_end=t_end, rtol=rtol, feedback=fb, jit=jit)
         else:
-            sim, stats = run_sampled(
+            comp = None
+            if compensator is not None:
+                tk = Ts * np.arange(n_samples)
+                params, state0 = compensator.numbers(system.mass, Ts, x0)
+                comp = Compensation(compensator.structure(), params, state0,
+                                    reference_velocity(reference, tk, _evaluate(reference, tk), Ts))
+            if measurement.noise is not None:
+                rng = np.random.default_rng(seed)
+                measurement = Measurement(quantization, delay, noise_rms * rng.standard_normal(n_samples))
+            sim, stats, extra = run_sampled(
                 system, fb, t_end, x0=x0, v0=v0, F0=F0, rtol=rtol, jit=jit,
                 u_max=controller.u_max if saturated else None,
                 k_aw=controller.back_calculation_gain() if saturated else None,
+                measurement=measurement, compensation=comp,
             )
     else:
         dense = np.linspace(0.0, t_end, 2001) if t_out is None else _check_t_out(t_out, t_end)
@@ -226,5 +279,17 @@ def simulate_loop(
     return LoopResult(
         t=t, reference=r, x=sim.x, v=sim.v, F=sim.F, u=sim.u, error=r - sim.x, xc=sim.xc,
         reversals=sim.reversals, Ts=Ts, controller=C, system=system, kp=None if saturated else _dc_gain(C),
-        simulation=sim, loop_stats=stats,
+        simulation=sim, loop_stats=stats, compensator=compensator,
+        measured=extra.get("y"), compensation=extra.get("comp"),
     )
+
+
+def _measurement_options(quantization: Any, noise_rms: Any, seed: Any, delay: Any) -> Measurement:
+    """The checked measurement options (noise drawn later, once the sample count is known)."""
+    from prefriction._validation import check_count, check_nonnegative
+
+    quantization = check_nonnegative("quantization", quantization)
+    noise_rms = check_nonnegative("noise_rms", noise_rms)
+    check_count("seed", seed, 0)
+    delay = check_count("delay", delay, 0, MAX_DELAY, why="the measurement buffer of the compiled loop")
+    return Measurement(quantization, delay, np.zeros(1) if noise_rms > 0.0 else None)

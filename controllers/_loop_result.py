@@ -40,7 +40,9 @@ class LoopResult:
     x, v, F : numpy.ndarray
         Position [m], velocity [m/s], friction force [N].
     u : numpy.ndarray
-        Control force [N] (for a sampled controller the value held from ``t[k]`` on).
+        Total force applied to the stage [N]: the controller's plus the compensator's (after
+        the force limit), for a sampled controller the value held from ``t[k]`` on (a
+        zero-order hold: anyone can replay the plant from it).
     error : numpy.ndarray
         ``r - x`` [m].
     xc : numpy.ndarray
@@ -63,6 +65,14 @@ class LoopResult:
     loop_stats : prefriction.simulation.loops.LoopStats or None
         Blocks, integrated and resting periods of the compiled sampled loop; ``None`` for the
         other paths.
+    compensator : controllers.compensators.Compensator or None
+        The compensator that ran (with the mismatched model if ``mismatch`` was given).
+    measured : numpy.ndarray or None
+        Position the controller saw at each sample [m] (noise, encoder step, delay); ``None``
+        outside the compiled sampled loop.
+    compensation : numpy.ndarray or None
+        Compensation force at each sample [N] (0 without a compensator); ``None`` outside the
+        compiled sampled loop.
     """
 
     t: np.ndarray
@@ -80,6 +90,9 @@ class LoopResult:
     kp: Optional[float]
     simulation: SimulationResult
     loop_stats: Optional[LoopStats] = None
+    compensator: Optional[object] = None
+    measured: Optional[np.ndarray] = None
+    compensation: Optional[np.ndarray] = None
 
     @property
     def Fc(self) -> float:

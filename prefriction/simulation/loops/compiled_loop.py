@@ -2,9 +2,13 @@
 
 One sample period ``[t_k, t_{k+1}]`` of the loop (docs/controllers.md#compiled-loop):
 
-1. the error ``e_k = r_k - x(t_k)`` [m] and the controller output ``v_k = C xc_k + D e_k`` [N];
-   the applied force ``u_k = clip(v_k, -u_max, u_max)``, held over the period (zero-order hold);
-2. the controller update ``xc_{k+1} = A xc_k + B e_k + Ts k_aw (u_k - v_k)`` (back-calculation
+1. the measurement ``y_k`` [m]: the position ``x(t_{k-d})`` of ``d`` samples ago (``d <=
+   MAX_DELAY``) plus a noise sample, rounded to the encoder step ``q`` (``q = 0``: no rounding);
+   the error ``e_k = r_k - y_k`` [m], the controller output ``v_k = C xc_k + D e_k`` [N], the
+   compensation force ``c_k`` of the compensator's step (its state, ``[y_k, u_{k-1}]``, the
+   reference samples ``[r_k, r_{k+1}, r'_k, r'_{k+1}]`` and its numbers) and the applied force
+   ``u_k = clip(v_k + c_k, -u_max, u_max)``, held over the period (zero-order hold);
+2. the controller update ``xc_{k+1} = A xc_k + B e_k + Ts k_aw (u_k - v_k - c_k)`` (back-calculation
    anti-windup; ``k_aw = 0`` and ``u_max = 1e300`` give the linear law);
 3. a mass at rest whose net force ``u_k + d(t_k) - F`` leaves the rest threshold starts to move
    (a reversal at ``t_k`` if it leaves backwards), exactly as
@@ -16,8 +20,9 @@ One sample period ``[t_k, t_{k+1}]`` of the loop (docs/controllers.md#compiled-l
 
 :func:`loop_function` repeats this with ``Function.mapaccum`` over ``block`` samples. Every
 number is a run-time input: the controller matrices, ``u_max``, ``k_aw``, ``Ts``, the reference
-samples, the model's numbers and the tolerance; the structure is the plant's, the controller
-order and the block length.
+samples, the compensator's numbers, the encoder step, the delay, the model's numbers and the
+tolerance; the structure is the plant's, the controller order, the compensator's structure and
+the block length.
 """
 
 from __future__ import annotations
@@ -28,7 +33,10 @@ import casadi as ca
 
 from prefriction.simulation.plant import EPS_REST, Layout, PlantSpec, build_integrator
 
-__all__ = ["LoopLayout", "LoopSpec", "loop_function"]
+__all__ = ["MAX_DELAY", "LoopLayout", "LoopSpec", "NoCompensation", "loop_function"]
+
+MAX_DELAY = 8
+"""Most samples of measurement delay (a run-time number up to this structural limit)."""
 
 NSTOP = 2.0
 """Reversals after which the plant stops within one period (its register length ``K``): a
@@ -36,12 +44,32 @@ period with more reversals is finished by the Python loop (:mod:`.runner`)."""
 
 
 @dataclass(frozen=True)
+class NoCompensation:
+    """The structure of a loop without compensator: no state, no numbers, zero force.
+
+    A compensator structure is hashable (equal structures share one compiled loop) and gives
+    ``n_state``, ``n_param`` and :meth:`function`, its step ``(state, meas, ref, par) ->
+    (state_next, force)`` with ``meas = [y_k, u_{k-1}]`` [m, N] and ``ref = [r_k, r_{k+1}, r'_k,
+    r'_{k+1}]`` [m, m/s] (SI)."""
+
+    n_state: int = 0
+    n_param: int = 0
+
+    def function(self) -> ca.Function:
+        """The step ``(state, meas, ref, par) -> (state_next, force)``: zero force."""
+        c, me, r, p = ca.SX.sym("c", 0), ca.SX.sym("meas", 2), ca.SX.sym("ref", 4), ca.SX.sym("par", 0)
+        return ca.Function("no_compensation", [c, me, r, p], [c, ca.SX.zeros(1, 1)])
+
+
+@dataclass(frozen=True)
 class LoopSpec:
-    """Structure of a compiled loop: the plant's structure, the controller order, the block length."""
+    """Structure of a compiled loop: the plant's structure, the controller order, the block
+    length and the compensator's structure."""
 
     plant: PlantSpec
     n_c: int
     block: int
+    comp: object = NoCompensation()
 
 
 class LoopLayout:
@@ -53,9 +81,12 @@ class LoopLayout:
         nz, nm, n = L.nz, L.nm, spec.n_c
         names = ["x", "v"] + [f"z{i}" for i in range(nz)] + [f"m{i}" for i in range(nm)]
         names += ["s", "rest", "W", "Amax"] + [f"xc{i}" for i in range(n)]
+        self.n_comp = spec.comp.n_state
+        names += [f"c{i}" for i in range(self.n_comp)] + [f"y{i}" for i in range(MAX_DELAY)] + ["uprev"]
         self.state = {k: i for i, k in enumerate(names)}
         self.nS = len(names)
-        self.inp = {k: i for i, k in enumerate(["t0", "t1", "r", "active", "tl", "da", "db"])}
+        inputs = ["t0", "t1", "r", "active", "tl", "da", "db", "rn", "vr", "vrn", "noise"]
+        self.inp = {k: i for i, k in enumerate(inputs)}
         self.nw = len(self.inp)
         self.p_plant = slice(0, L.np)
         o = L.np
@@ -63,11 +94,14 @@ class LoopLayout:
         self.p_B = slice(self.p_A.stop, self.p_A.stop + n)
         self.p_C = slice(self.p_B.stop, self.p_B.stop + n)
         self.p_kaw = slice(self.p_C.stop, self.p_C.stop + n)
-        rest = ["D", "umax", "Ts", "force_scale"]
+        rest = ["D", "umax", "Ts", "force_scale", "quant"]
         self.param = {k: self.p_kaw.stop + i for i, k in enumerate(rest)}
-        self.npar = self.p_kaw.stop + len(rest)
+        o = self.p_kaw.stop + len(rest)
+        self.p_delay = slice(o, o + MAX_DELAY + 1)  # one-hot: which sample of the measurement is used
+        self.p_comp = slice(self.p_delay.stop, self.p_delay.stop + spec.comp.n_param)
+        self.npar = self.p_comp.stop
         K = spec.plant.K
-        rec = ["F", "u", "moved", "lr", "lr_t", "lr_x", "lr_F", "lr_W", "n_new"]
+        rec = ["F", "u", "moved", "lr", "lr_t", "lr_x", "lr_F", "lr_W", "n_new", "y", "comp"]
         self.rec = {k: self.nS + i for i, k in enumerate(rec)}
         self.reg = self.nS + len(rec)
         self.nrec = self.reg + 4 * K
@@ -90,9 +124,18 @@ def _step(spec: LoopSpec, LL: LoopLayout) -> ca.Function:
     xc = ca.vertcat(*[st[f"xc{i}"] for i in range(n)]) if n else ca.SX(0, 1)
     F = model.force(z, m, v, s, q)
     active = wi["active"] > 0.5
-    # controller (SI): error, raw output, clipped force, update with back-calculation
-    e = wi["r"] - x * pl["xunit"]
-    raw = (ca.dot(par[LL.p_C], xc) if n else 0.0) + pp["D"] * e
+    # measurement (SI): noise, encoder rounding, delay of whole samples
+    y_now = x * pl["xunit"] + wi["noise"]
+    qs = pp["quant"]
+    y_now = ca.if_else(qs > 0.0, qs * ca.floor(y_now / ca.fmax(qs, 1e-300) + 0.5), y_now)
+    past = [st[f"y{i}"] for i in range(MAX_DELAY)]
+    y_meas = ca.dot(par[LL.p_delay], ca.vertcat(y_now, *past))
+    # compensator and controller (SI): error, raw output, clipped force, update with back-calculation
+    cs = ca.vertcat(*[st[f"c{i}"] for i in range(LL.n_comp)]) if LL.n_comp else ca.SX(0, 1)
+    cs_next, comp = spec.comp.function()(cs, ca.vertcat(y_meas, st["uprev"]),
+                                         ca.vertcat(wi["r"], wi["rn"], wi["vr"], wi["vrn"]), par[LL.p_comp])
+    e = wi["r"] - y_meas
+    raw = (ca.dot(par[LL.p_C], xc) if n else 0.0) + pp["D"] * e + comp
     u = ca.fmin(ca.fmax(raw, -pp["umax"]), pp["umax"])
     t_si = wi["t0"] * pl["tunit"]
     u_total = u + wi["da"] + wi["db"] * (t_si - wi["tl"])  # with the oscillator's own input
@@ -164,14 +207,20 @@ def _step(spec: LoopSpec, LL: LoopLayout) -> ca.Function:
     S_next[LL.state["Amax"]] = Amax
     for i in range(n):
         S_next[LL.state[f"xc{i}"]] = xc_next[i]
+    for i in range(LL.n_comp):
+        S_next[LL.state[f"c{i}"]] = ca.if_else(active, cs_next[i], cs[i])
+    for i, yi in enumerate([y_now] + past[:-1]):
+        S_next[LL.state[f"y{i}"]] = yi
+    S_next[LL.state["uprev"]] = u
     rec = ca.SX.zeros(LL.nrec)
     rec[: LL.nS] = S
     r = LL.rec
     rec[r["F"]], rec[r["u"]], rec[r["moved"]] = F, u_total, moved
+    rec[r["y"]], rec[r["comp"]] = y_meas, comp
     rec[r["lr"]], rec[r["lr_t"]], rec[r["lr_x"]], rec[r["lr_F"]], rec[r["lr_W"]] = back, wi["t0"], x, F, W
     rec[r["n_new"]] = ca.if_else(moved, Xe[ix["n"]], 0.0)
     rec[LL.reg:] = Xe[L.reg:]
-    post = ca.Function("post", [S, w, par, Xe], [S_next, rec])
+    post = ca.Function("post", [S, w, par, Xe], [ca.densify(S_next), ca.densify(rec)])
     # glue (MX): the plant runs only in the branch that integrates
     plant = build_integrator(spec.plant)
     Xs, Us, Ps = ca.MX.sym("X", L.nx), ca.MX.sym("U", L.nu), ca.MX.sym("P", L.np)
@@ -191,4 +240,6 @@ def loop_function(spec: LoopSpec) -> ca.Function:
     LL = LoopLayout(spec)
     step = _step(spec, LL)
     name = f"{type(spec.plant.model).__name__.lower()}_loop{spec.n_c}_{spec.block}"
+    if spec.comp.n_state or spec.comp.n_param:
+        name += "_" + spec.comp.function().name()
     return step.mapaccum(name, spec.block, 1)

@@ -4,8 +4,6 @@ periods finished by the Python loop of :func:`prefriction.simulate`, and its fai
 from __future__ import annotations
 
 import math
-from typing import Optional
-
 import numpy as np
 
 from prefriction.errors import SolverError
@@ -21,13 +19,12 @@ from .compiled_loop import LoopLayout
 __all__ = ["collect", "failure", "finish_in_python", "initial_state"]
 
 
-def initial_state(system: Oscillator, fb: LinearFeedback, LL: LoopLayout, x0: float, v0: float, F0: float,
-                   xc0: np.ndarray, u_max: Optional[float]) -> tuple[np.ndarray, float]:
-    """Loop state at ``t = 0`` and the initial direction (as ``prefriction.simulate`` starts a loop)."""
+def initial_state(system: Oscillator, LL: LoopLayout, x0: float, v0: float, F0: float, xc0: np.ndarray,
+                   u0: float, comp0: np.ndarray, y0: float) -> tuple[np.ndarray, float]:
+    """Loop state at ``t = 0`` and the initial direction (as ``prefriction.simulate`` starts a
+    loop), with the force ``u0`` [N] applied at ``t = 0``, the compensator's state ``comp0`` and
+    the measurements before ``t = 0`` all ``y0`` [m]."""
     model, sc, Fc = system.friction, Scales.of(system), system.friction.Fc
-    u0 = float(fb.C[0] @ fb.xc0 + fb.D[0, 0] * (float(fb.reference(0.0)) - x0))
-    if u_max is not None:
-        u0 = min(max(u0, -u_max), u_max)
     acc0 = (u0 - F0) / Fc
     s0, rest = initial_direction(v0, acc0, F0)
     z, m = model.initial_state(F0 / Fc, s0)
@@ -39,6 +36,11 @@ def initial_state(system: Oscillator, fb: LinearFeedback, LL: LoopLayout, x0: fl
     for i, mi in enumerate(m):
         S[ix[f"m{i}"]] = mi
     S[ix["xc0"]: ix["xc0"] + len(xc0)] = xc0
+    for i, ci in enumerate(comp0):
+        S[ix[f"c{i}"]] = ci
+    for key, i in ix.items():
+        if key[0] == "y" and key[1:].isdigit():
+            S[i] = y0
     return S, s0
 
 
@@ -59,19 +61,13 @@ def collect(rev: list, R: np.ndarray, LL: LoopLayout, K: int, *, skip_last: bool
 
 
 def finish_in_python(system: Oscillator, fb: LinearFeedback, plant: PlantSpec, eps: float, rtol: float, jit: bool,
-                      S: np.ndarray, LL: LoopLayout, tk: np.ndarray, j: int, r: float, par: np.ndarray,
-                      rev: list, u_max: Optional[float], lr_recorded: bool) -> np.ndarray:
-    """Redo period ``j`` from the state ``S`` at its start with :class:`Run` (any number of
-    reversals); append its reversals (except one at ``t_k``, already recorded); return the state after it."""
-    sc, ix = Scales.of(system), LL.state
-    n = LL.p_B.stop - LL.p_B.start
-    A = par[LL.p_A].reshape(n, n).T
-    B, C = par[LL.p_B], par[LL.p_C]
-    kaw = par[LL.p_kaw]
-    xc = S[ix["xc0"]: ix["xc0"] + n]
-    e = r - S[ix["x"]] * sc.x
-    raw = float(C @ xc + fb.D[0, 0] * e)
-    u = raw if u_max is None else min(max(raw, -u_max), u_max)
+                      S: np.ndarray, after: np.ndarray, LL: LoopLayout, tk: np.ndarray, j: int, u: float,
+                      par: np.ndarray, rev: list, lr_recorded: bool) -> np.ndarray:
+    """Redo the plant over period ``j`` from the state ``S`` at its start with :class:`Run` (any
+    number of reversals), the force ``u`` [N] held; append its reversals (except one at ``t_k``,
+    already recorded); return the state after it: the plant's from the Python loop, the
+    controller's, the compensator's and the measurements' from ``after`` (the compiled step's)."""
+    ix = LL.state
     run = Run(system, plant, fb, eps, jit)
     run.snap = rtol
     run.P0 = run._constant_params(run.L)
@@ -84,7 +80,7 @@ def finish_in_python(system: Oscillator, fb: LinearFeedback, plant: PlantSpec, e
     run.st = {"x": S[ix["x"]], "v": S[ix["v"]], "F": F, "z": z, "m": m, "t": tk[j], "s": s, "rest": S[ix["rest"]],
               "W": S[ix["W"]], "Ef": 0.0, "xc": np.zeros(0), "uhold": u}
     run.advance(tk[j + 1], math.inf)
-    out = S.copy()
+    out = after.copy()
     st = run.st
     # a reversal at t_k when leaving rest is in the block's record already
     rev.extend(run.rev[1:] if lr_recorded else run.rev)
@@ -95,7 +91,6 @@ def finish_in_python(system: Oscillator, fb: LinearFeedback, plant: PlantSpec, e
     for i, mi in enumerate(st["m"]):
         out[ix[f"m{i}"]] = mi
     out[ix["Amax"]] = run.A_max
-    out[ix["xc0"]: ix["xc0"] + n] = A @ xc + B * e + fb.Ts * kaw * (u - raw)
     return out
 
 

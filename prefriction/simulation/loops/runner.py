@@ -28,10 +28,10 @@ from prefriction.simulation.result import RunStats, SimulationResult
 from prefriction.simulation.simulate import _CAL, _reversal_table
 from prefriction.units import Scales
 
-from .compiled_loop import NSTOP, LoopLayout, LoopSpec, loop_function
+from .compiled_loop import MAX_DELAY, NSTOP, LoopLayout, LoopSpec, NoCompensation, loop_function
 from .records import collect, failure, finish_in_python, initial_state
 
-__all__ = ["BLOCK", "LoopStats", "run_sampled"]
+__all__ = ["BLOCK", "LoopStats", "Measurement", "Compensation", "run_sampled"]
 
 BLOCK = 256
 """Sample periods per compiled call (a structure; the last block of a run is padded)."""
@@ -85,6 +85,7 @@ class _Block:
     def __init__(self, spec: LoopSpec, jit: bool) -> None:
         start = time.perf_counter()
         self.LL = LL = LoopLayout(spec)
+        self.comp_fun = spec.comp.function()
         mapped = loop_function(spec)
         S0 = ca.MX.sym("S0", LL.nS)
         W = ca.MX.sym("W", LL.nw, spec.block)
@@ -123,6 +124,36 @@ def _block(spec: LoopSpec, jit: bool) -> tuple[_Block, float, str]:
     return blk, blk.setup_time, blk.mode
 
 
+@dataclass(frozen=True)
+class Measurement:
+    """What the loop's controller sees of the position: ``y_k = round_q(x(t_{k-d}) + n_{k-d})``.
+
+    Attributes
+    ----------
+    quantization : float
+        Encoder step ``q`` [m], ``>= 0`` (0: no rounding).
+    delay : int
+        Delay ``d`` in whole samples, ``0 <= d <= MAX_DELAY``.
+    noise : numpy.ndarray or None
+        Noise ``n_k`` [m] at each sample instant, or ``None`` (no noise).
+    """
+
+    quantization: float = 0.0
+    delay: int = 0
+    noise: Optional[np.ndarray] = None
+
+
+@dataclass(frozen=True)
+class Compensation:
+    """A compensator in the compiled loop: its structure (``NoCompensation``'s interface), its
+    numbers, its initial state and the reference velocity [m/s] at the sample instants."""
+
+    structure: object
+    params: np.ndarray
+    state0: np.ndarray
+    velocity: np.ndarray
+
+
 def _padded(M: np.ndarray, n: int, shape: tuple[int, int]) -> np.ndarray:
     out = np.zeros(shape)
     out[: M.shape[0], : M.shape[1]] = M
@@ -132,7 +163,7 @@ def _padded(M: np.ndarray, n: int, shape: tuple[int, int]) -> np.ndarray:
 def run_sampled(
     system: Oscillator, fb: LinearFeedback, t_end: float, *, x0: float, v0: float, F0: float,
     rtol: float, jit: bool, u_max: Optional[float] = None, k_aw: Optional[np.ndarray] = None,
-    block: int = BLOCK,
+    block: int = BLOCK, measurement: Measurement = Measurement(), compensation: Optional[Compensation] = None,
 ) -> tuple[SimulationResult, LoopStats]:
     """Run the sampled loop ``fb`` (``fb.Ts`` set) on ``system`` (no input force) up to ``t_end`` [s].
 
@@ -156,12 +187,17 @@ def run_sampled(
         Back-calculation gains per controller state [1/(N s)] (with ``u_max``).
     block : int, default BLOCK
         Sample periods per compiled call.
+    measurement : Measurement
+        Encoder step, delay and noise of the measured position (default: the exact position).
+    compensation : Compensation, optional
+        A compensator whose force is added to the controller's (default: none).
 
     Returns
     -------
-    (SimulationResult, LoopStats)
-        Samples at the sample instants (``t, x, v, F, E_k, u, xc``), the reversal table, and
-        the loop's statistics.
+    (SimulationResult, LoopStats, dict)
+        Samples at the sample instants (``t, x, v, F, E_k, u, xc``), the reversal table, the
+        loop's statistics, and the measured positions ``y`` [m] and compensation forces
+        ``comp`` [N] at the sample instants.
     """
     if system.forced:
         raise ValueError("the compiled sampled loop needs an oscillator without an input force (system.u = None)")
@@ -170,7 +206,8 @@ def run_sampled(
     n = max(n_user, _MIN_ORDER)
     plant = PlantSpec.of(model, Constant(0.0), None, fb="none", n_c=0, energy=False, K=_K, n_out=1,
                          method="erk", compact=True)
-    spec = LoopSpec(plant, n, block)
+    comp = compensation.structure if compensation is not None else NoCompensation()
+    spec = LoopSpec(plant, n, block, comp)
     L = Layout(plant)
     eps = rtol * _CAL * math.sqrt(L.n_active / L.nx)
     Ts_n, t_end_n = fb.Ts / sc.t, t_end / sc.t
@@ -196,6 +233,10 @@ def run_sampled(
     par[LL.param["umax"]] = 1e300 if u_max is None else u_max
     par[LL.param["Ts"]] = fb.Ts
     par[LL.param["force_scale"]] = applied_force_scale(system, fb, x0, t_end) / Fc
+    par[LL.param["quant"]] = measurement.quantization
+    par[LL.p_delay.start + measurement.delay] = 1.0
+    if compensation is not None:
+        par[LL.p_comp] = compensation.params
     # per-sample inputs
     Wall = np.zeros((n_s + block, LL.nw))
     ii = LL.inp
@@ -205,8 +246,18 @@ def run_sampled(
     Wall[: n_s - 1, ii["t1"]] = tk[1:]
     Wall[: n_s - 1, ii["active"]] = 1.0
     Wall[:n_s, ii["r"]] = np.asarray(fb.reference(tk * sc.t), dtype=float)
+    Wall[: n_s - 1, ii["rn"]] = Wall[1:n_s, ii["r"]]
+    Wall[n_s - 1, ii["rn"]] = Wall[n_s - 1, ii["r"]]
+    if compensation is not None:
+        Wall[:n_s, ii["vr"]] = compensation.velocity
+        Wall[: n_s - 1, ii["vrn"]] = compensation.velocity[1:]
+    if measurement.noise is not None:
+        Wall[:n_s, ii["noise"]] = measurement.noise
     xc0 = _padded(fb.xc0.reshape(1, -1), n, (1, n))[0]
-    S, s0 = initial_state(system, fb, LL, x0, v0, F0, xc0, u_max)
+    comp0 = compensation.state0 if compensation is not None else np.zeros(0)
+    u0 = _first_force(blk, Wall[0], par, xc0, comp0, x0, measurement, u_max)
+    y0 = x0 if measurement.quantization == 0.0 else measurement.quantization * math.floor(x0 / measurement.quantization + 0.5)
+    S, s0 = initial_state(system, LL, x0, v0, F0, xc0, u0, comp0, y0)
     recs = np.empty((n_s, LL.nrec))
     rev: list = []
     blocks = finished = 0
@@ -236,8 +287,9 @@ def run_sampled(
         collect(rev, R[:upto], LL, _K, skip_last=bool(over.size))
         if over.size:  # finish this period with the Python loop of prefriction.simulate
             j = k + upto - 1
-            S = finish_in_python(system, fb, plant, eps, rtol, jit, R[upto - 1, : LL.nS].copy(), LL, tk, j,
-                                  Wall[j, ii["r"]], par, rev, u_max, bool(R[upto - 1, LL.rec["lr"]] > 0.5))
+            after = R[upto, : LL.nS] if upto < block else blk.S
+            S = finish_in_python(system, fb, plant, eps, rtol, jit, R[upto - 1, : LL.nS].copy(), after, LL, tk, j,
+                                  float(R[upto - 1, LL.rec["u"]]), par, rev, bool(R[upto - 1, LL.rec["lr"]] > 0.5))
             finished += 1
         else:
             S = blk.S.copy()
@@ -255,4 +307,20 @@ def run_sampled(
         t=t, x=x, v=v, F=recs[:, LL.rec["F"]] * sc.F, E_k=0.5 * system.mass * v * v, u=recs[:, LL.rec["u"]],
         xc=np.array(xc),
     )
-    return sim, LoopStats(n_s, blocks, integrated, finished, wall, setup, inside, mode)
+    extra = {"y": recs[:, LL.rec["y"]], "comp": recs[:, LL.rec["comp"]]}
+    return sim, LoopStats(n_s, blocks, integrated, finished, wall, setup, inside, mode), extra
+
+
+def _first_force(blk: "_Block", w: np.ndarray, par: np.ndarray, xc0: np.ndarray, comp0: np.ndarray, x0: float,
+                 m: Measurement, u_max: Optional[float]) -> float:
+    """The force [N] the loop applies at ``t = 0`` (controller and compensator, clipped), for the
+    initial direction of motion: the compiled step's law, evaluated once in Python."""
+    LL = blk.LL
+    y0 = x0 + (w[LL.inp["noise"]] if m.delay == 0 else 0.0)
+    if m.quantization > 0.0:
+        y0 = m.quantization * math.floor(y0 / m.quantization + 0.5)
+    raw = float(par[LL.p_C] @ xc0) + par[LL.param["D"]] * (w[LL.inp["r"]] - y0)
+    if LL.n_comp or LL.p_comp.stop > LL.p_comp.start:
+        ref = [w[LL.inp["r"]], w[LL.inp["rn"]], w[LL.inp["vr"]], w[LL.inp["vrn"]]]
+        raw += float(blk.comp_fun(comp0, [y0, 0.0], ref, par[LL.p_comp])[1])
+    return raw if u_max is None else min(max(raw, -u_max), u_max)
