@@ -156,17 +156,20 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
     if mass0 is not None:
         raise ValueError(f"mass0 = {mass0!r} is for Motion data with a free mass; force-displacement data "
                          f"involve no mass (allowed: mass0=None)")
-    from prefriction.identify.structures import fit_structures
+    from prefriction.identify.structures import fit_structures, gamma_entry
 
     scale = float(np.std(data.F)) if offset else None
 
     def one(start: FrictionModel) -> FitResult:
         return _fit_prescribed(start, data, free, fixed, bounds, scale, substeps, max_iter, tol, limit)
 
-    gamma_free = (free is None or "gamma" in ([free] if isinstance(free, str) else list(free))) and \
-        "gamma" not in ([fixed] if isinstance(fixed, str) else list(fixed or []))
-    user_gamma = isinstance(bounds, dict) and "gamma" in bounds
-    return fit_structures(model, one, compare=structures == "both" and gamma_free and not user_gamma)
+    gamma = gamma_entry(model) if structures == "both" else None
+    if gamma is not None and not (
+            (free is None or gamma in ([free] if isinstance(free, str) else list(free)))
+            and gamma not in ([fixed] if isinstance(fixed, str) else list(fixed or []))
+            and not (isinstance(bounds, dict) and gamma in bounds)):
+        gamma = None  # gamma held, or bounded to one side by the user
+    return fit_structures(model, one, compare=gamma)
 
 
 def _fit_prescribed(model: FrictionModel, data: ForceDisplacement, free: Any, fixed: Any, bounds: Any,

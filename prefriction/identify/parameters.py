@@ -35,9 +35,17 @@ class _Entry:
     value: float
     low: float
     high: float
+    part: int | None = None
+    local: str = ""
 
 
 def _entries(model: FrictionModel) -> list[_Entry]:
+    from prefriction.models.parallel import Parallel, qualified_names
+
+    if isinstance(model, Parallel):  # a sum: each model's entries under its names in the sum
+        names = qualified_names(model.models)
+        return [dataclasses.replace(e, name=names[i][j], part=i, local=e.name)
+                for i, m in enumerate(model.models) for j, e in enumerate(_entries(m))]
     out = []
     for par in type(model).parameters:
         val = getattr(model, par.name)
@@ -133,8 +141,10 @@ class ParameterSpace:
         if offset is not None:
             self._scale["offset"] = check_positive("offset scale", offset)
         self.why_low, self.why_high = {}, {}
+        parts = getattr(model, "models", ())
         for e in entries:
-            self.why_low[e.name], self.why_high[e.name] = _structure_bound(model, e.name, e.value)
+            owner = parts[e.part] if e.part is not None else model
+            self.why_low[e.name], self.why_high[e.name] = _structure_bound(owner, e.local or e.name, e.value)
         for name, lim in _bound_items(bounds):
             self._set_bound(name, lim, names)
         for name in self.free:
@@ -210,17 +220,8 @@ class ParameterSpace:
         ValueError
             If the model rejects the values (e.g. LuGre with ``Fs < Fc``); the message says so.
         """
-        kwargs: dict[str, Any] = {}
-        for e in self.entries:
-            if e.field in ("mass", "offset"):
-                continue
-            if e.index is None:
-                kwargs[e.field] = values[e.name]
-            else:
-                kwargs.setdefault(e.field, np.array(getattr(self.model, e.field), dtype=float).copy())
-                kwargs[e.field][e.index] = values[e.name]
         try:
-            return dataclasses.replace(self.model, **kwargs)
+            return _build(self.model, [e for e in self.entries if e.field not in ("mass", "offset")], values)
         except ValueError as exc:
             raise ValueError(f"the fitted values do not make a valid {type(self.model).__name__}: {exc}; "
                              f"bound the parameters (bounds=...) or fix some (fixed=...)") from exc
@@ -235,6 +236,25 @@ def _bound_items(bounds: Any) -> list[tuple[str, Any]]:
                         f"bounds={{'sigma': (1e3, 1e6)}}, got {bounds!r} of type {type(bounds).__name__} "
                         f"(a list cannot say which parameter each pair bounds)")
     return list(bounds.items())
+
+
+def _build(model: FrictionModel, entries: list[_Entry], values: dict[str, float]) -> FrictionModel:
+    """A model of ``model``'s class (a sum: of each term's class) with the entries' ``values``."""
+    from prefriction.models.parallel import Parallel
+
+    if isinstance(model, Parallel):
+        return Parallel(tuple(
+            _build(m, [dataclasses.replace(e, name=e.local, part=None) for e in entries if e.part == i],
+                   {e.local: values[e.name] for e in entries if e.part == i})
+            for i, m in enumerate(model.models)))
+    kwargs: dict[str, Any] = {}
+    for e in entries:
+        if e.index is None:
+            kwargs[e.field] = values[e.name]
+        else:
+            kwargs.setdefault(e.field, np.array(getattr(model, e.field), dtype=float).copy())
+            kwargs[e.field][e.index] = values[e.name]
+    return dataclasses.replace(model, **kwargs)
 
 
 def _names(arg: str, value: Any, names: list[str], model: FrictionModel) -> list[str] | None:
@@ -285,7 +305,14 @@ def symbolic_units(model: FrictionModel, values: dict[str, Any], mass: Any) -> t
         symbols (it uses ``math`` functions on its numbers).
     """
     from prefriction.models.maxwell_slip import MaxwellSlip
+    from prefriction.models.parallel import Parallel
 
+    if isinstance(model, Parallel):  # each term in its own units, composed (Parallel.compose)
+        entries = _entries(model)
+        units = [symbolic_units(m, {e.local: values[e.name] for e in entries if e.part == i}, mass)
+                 for i, m in enumerate(model.models)]
+        sigma, Fc, q = model.compose(units)
+        return sigma, Fc, ca.vertcat(*q)
     fields: dict[str, Any] = {}
     for par in type(model).parameters:
         val = getattr(model, par.name)

@@ -10,6 +10,7 @@ import numpy as np
 
 from prefriction.identify.data import ForceDisplacement, Motion
 from prefriction.identify.statistics import Statistics
+from prefriction.identify.validation import model_name
 from prefriction.models.base import FrictionModel
 
 if TYPE_CHECKING:
@@ -158,13 +159,13 @@ class FitResult:
     def __repr__(self) -> str:
         est = ", ".join(f"{n}={v:.4g}+-{s:.2g}" for n, v, s in zip(self.names, self.estimates, self.stderr))
         tail = "" if self.success else ", NOT CONVERGED"
-        return f"FitResult({type(self.model).__name__}: {est}; rms {self.rms:.3g}, {len(self.residuals)} samples{tail})"
+        return f"FitResult({model_name(self.model)}: {est}; rms {self.rms:.3g}, {len(self.residuals)} samples{tail})"
 
     def summary(self) -> str:
         """A few lines: the fitted model, the residual level and any unidentifiable parameter."""
         st = self.statistics
         unit = "N" if isinstance(self.data, ForceDisplacement) else "m"
-        lines = [f"{type(self.model).__name__} fitted to {len(self.residuals)} samples of "
+        lines = [f"{model_name(self.model)} fitted to {len(self.residuals)} samples of "
                  f"{type(self.data).__name__}: residual sd {st.sigma_hat:.4g} {unit}, {st.dof} dof"]
         for i, (n, u, v, lo, hi) in enumerate(zip(self.names, self.units, self.estimates, self.low, self.high)):
             lines.append(f"  {n:<14} {v:< 12.6g} [{lo:.6g}, {hi:.6g}] {u}" + self._flag(i, "  "))
@@ -229,7 +230,7 @@ class FitResult:
 
         d = self.data
         fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7.0, 6.5), height_ratios=[2.2, 1.0], layout="constrained")
-        name = type(self.model).__name__
+        name = model_name(self.model)
         if isinstance(d, ForceDisplacement):
             ax1.plot(d.x * 1e6, d.F, ".", ms=3, color="0.55", label="data")
             ax1.plot(d.x * 1e6, self.fitted, "-", lw=1.2, color="C0", label=f"fitted {name}")

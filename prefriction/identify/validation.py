@@ -31,7 +31,18 @@ from prefriction.identify.data import ForceDisplacement, Motion
 if TYPE_CHECKING:
     from prefriction.identify.result import FitResult
 
-__all__ = ["Validation", "predict", "predict_force", "validate"]
+__all__ = ["Validation", "model_name", "predict", "predict_force", "validate"]
+
+
+def model_name(model: Any) -> str:
+    """``"Dahl"``, or ``"Dahl + Viscous"`` for a sum of models.
+
+    Parameters
+    ----------
+    model : FrictionModel
+        A model.
+    """
+    return " + ".join(type(m).__name__ for m in getattr(model, "models", (model,)))
 
 _D0 = 30.0
 """Largest virtual virgin distance (normalised) tried for the initial state."""
@@ -242,4 +253,4 @@ def validate(result: "FitResult", data: ForceDisplacement | Motion, *, skip: flo
                          f"{data.t[-1] - data.t[0]:.6g} s")
     y = data.F if isinstance(data, ForceDisplacement) else data.x
     unit = "N" if isinstance(data, ForceDisplacement) else "m"
-    return Validation(data.t[keep], np.asarray(y)[keep], y_hat[keep], unit, type(result.model).__name__)
+    return Validation(data.t[keep], np.asarray(y)[keep], y_hat[keep], unit, model_name(result.model))
