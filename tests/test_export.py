@@ -4,7 +4,8 @@ Each export is compiled with ``gcc -std=c99 -Wall -Werror`` (and ``-pedantic``),
 samples and compared with the CasADi Function it came from (to 1e-12 of the force range) and
 with references written from the models' equations, independent of the toolbox's code: Dahl's
 exponential branches (gamma = 1, 3.2), the stop operators of Maxwell-slip, and LuGre's exact
-solution at a constant velocity over each sample interval.
+solution at a constant velocity over each sample interval; and with ``pf.friction_along``, which
+it streams.
 """
 
 from __future__ import annotations
@@ -21,12 +22,14 @@ from prefriction import export
 
 needs_gcc = pytest.mark.skipif(export.gcc() is None, reason="gcc is not on the PATH: the exported C cannot be compiled")
 N = 100_000
-TS = 1e-4
+TS = 2.0**-13
+"""Sample time [s] (8.2 kHz), exact in binary: ``np.diff(t)`` of ``t = k Ts`` is ``Ts`` itself, so
+friction_along sees the intervals the C code assumes."""
 
 
 @pytest.fixture(scope="module")
 def motion():
-    """1e5 positions at 10 kHz: a 3 Hz sine of growing and shrinking amplitude (minor loops,
+    """1e5 positions at 8.2 kHz: a 3 Hz sine of growing and shrinking amplitude (minor loops,
     1 um to 20 um), plus a stretch at rest and repeated equal samples."""
     t = np.arange(N) * TS
     x = 1e-5 * np.sin(2 * np.pi * 3 * t) * (1.0 + 0.9 * np.sin(2 * np.pi * 0.7 * t)) + 2e-6
@@ -113,6 +116,18 @@ def test_c_matches_its_function_in_python_on_1e5_samples(runs, motion, name):
 
 
 @needs_gcc
+@pytest.mark.parametrize("name", list(CASES))
+def test_c_matches_friction_along_on_1e5_samples(runs, motion, name):
+    """The streaming form of friction_along: equal from the second sample on; at the first the
+    stream returns the virgin force 0 (friction_along takes the rate-dependent part of its first
+    sample from the first interval's velocity, which a stream does not know yet)."""
+    src, run = runs[name]
+    along = pf.friction_along(src.model, np.arange(N) * TS, motion)
+    assert run.F[0] == 0.0
+    assert np.max(np.abs(run.F[1:] - along.F[1:])) <= 1e-12 * np.max(np.abs(along.F))
+
+
+@needs_gcc
 def test_dahl_gamma_1_matches_its_exponential_branches(runs, motion):
     m = CASES["dahl1"][0]
     assert _rel(runs["dahl1"][1].F, dahl1_reference(m.sigma, m.Fc, motion)) <= 1e-12
@@ -126,9 +141,8 @@ def test_maxwell_slip_matches_stop_operators(runs, motion):
 
 @needs_gcc
 def test_lugre_matches_the_exact_interval_solution(runs, motion):
-    """Within the error of 8 RK4 sub-steps (the stiff sliding intervals dominate)."""
     m = CASES["lugre"][0]
-    assert _rel(runs["lugre"][1].F, lugre_reference(m, motion, TS)) <= 1e-6
+    assert _rel(runs["lugre"][1].F, lugre_reference(m, motion, TS)) <= 1e-12
 
 
 @needs_gcc
@@ -151,7 +165,7 @@ def test_header_has_the_fixed_interface(runs):
     assert "typedef struct {" in h and "} lugre_state;" in h
     assert "void lugre_reset(lugre_state *s, double x0);" in h
     assert "double lugre_force(lugre_state *s, double x);" in h
-    assert repr(src).startswith("CSource('lugre', model: LuGre(") and "Ts = 0.0001 s" in src.summary()
+    assert repr(src).startswith("CSource('lugre', model: LuGre(") and f"Ts = {TS!r} s" in src.summary()
 
 
 def test_rate_dependent_models_need_the_sample_time(tmp_path):

@@ -1,12 +1,18 @@
 """A friction model sampled along measured positions, as C99: ``force = <name>_force(state, x)``.
 
-One call moves the model from the previous position to ``x`` [m] with the per-interval step of
-:func:`prefriction.identify.stepping.interval_function` (the step that the force-displacement
-fit uses), at the constant velocity ``(x - x_prev) / Ts`` over the interval, and returns the
-force at ``x``. The interval's direction is the sign of ``x - x_prev`` (the previous one where
+One call moves the model from the previous position to ``x`` [m] with the interval step of
+:func:`prefriction.friction_along` and :class:`prefriction.FrictionStream`
+(:func:`prefriction.along.step.interval_function`: the model's exact step at constant velocity
+where it has one, Dahl, Maxwell-slip, LuGre, GMS, Viscous and sums; Runge-Kutta sub-steps
+otherwise), at the constant velocity ``(x - x_prev) / Ts`` over the interval, and returns the
+force at ``x`` (its rate-dependent part at that velocity, as ``friction_along`` by default). The interval's direction is the sign of ``x - x_prev`` (the previous one where
 the position does not change, ``+1`` before the first move); a change of direction is a
 reversal (the model's ``reverse``). Rate-dependent models (LuGre, GMS) need the fixed sample
 time ``Ts``; rate-independent ones (Dahl, Maxwell-slip) depend on the positions alone.
+
+Before the first move the state is virgin (force 0) and its force is returned unchanged, as
+:class:`prefriction.FrictionStream` does; ``friction_along`` takes the rate-dependent part of
+its first sample from the first interval's velocity, which a stream does not know yet.
 
 The step is one CasADi ``SX`` Function (:func:`sample_function`) whose constants (the model's
 parameters, the units, ``Ts``) are literals; :func:`c_source` writes its code with a small
@@ -21,7 +27,7 @@ from typing import Any, Optional
 import casadi as ca
 
 from prefriction._validation import check_count, check_positive
-from prefriction.identify.stepping import interval_function
+from prefriction.along.step import has_exact_step, interval_function
 from prefriction.models.base import FrictionModel
 
 from ._codegen import c_text, check_name, directory_of, work_sizes
@@ -29,8 +35,8 @@ from .source import CSource
 
 __all__ = ["c_source", "sample_function"]
 
-MAX_SUBSTEPS = 256
-"""Largest number of Runge-Kutta sub-steps per sample (the generated code grows with it)."""
+MAX_SUBSTEPS = 64
+"""Largest number of Runge-Kutta sub-steps per sample (as :func:`prefriction.friction_along`)."""
 
 
 def _model(model: Any) -> FrictionModel:
@@ -52,7 +58,7 @@ def _sample_time(model: FrictionModel, Ts: Optional[float]) -> Optional[float]:
     return check_positive("Ts", Ts)
 
 
-def sample_function(model: FrictionModel, *, Ts: Optional[float] = None, n_sub: int = 4) -> ca.Function:
+def sample_function(model: FrictionModel, *, Ts: Optional[float] = None, n_sub: int = 16) -> ca.Function:
     """The model's step from one measured position to the next, as a CasADi ``Function``.
 
     ``(w, x) -> (w_next, F)``: the state ``w = [z, m, s_prev, x_prev]`` (the model's normalised
@@ -69,9 +75,9 @@ def sample_function(model: FrictionModel, *, Ts: Optional[float] = None, n_sub: 
         Fixed sample time [s], ``0 < Ts < inf``; required for rate-dependent models (LuGre, GMS),
         whose velocity over an interval is ``(x - x_prev) / Ts``. ``None`` for a rate-independent
         model: each interval then takes one time unit (the force depends on the positions alone).
-    n_sub : int, default 4
-        Runge-Kutta sub-steps per sample interval (:func:`prefriction.identify.stepping.interval_function`),
-        1 to 256. Dahl with ``gamma = 1``, ``gamma < 1`` and Maxwell-slip are exact with one sub-step.
+    n_sub : int, default 16
+        Runge-Kutta sub-steps per sample interval for a model without an exact step, 1 to 64
+        (as ``substeps`` of :func:`prefriction.friction_along`); unused for the others.
 
     Returns
     -------
@@ -87,7 +93,7 @@ def sample_function(model: FrictionModel, *, Ts: Optional[float] = None, n_sub: 
     """
     model = _model(model)
     Ts = _sample_time(model, Ts)
-    n_sub = check_count("n_sub", n_sub, 1, MAX_SUBSTEPS, "sub-steps per sample; the generated code grows with it")
+    n_sub = check_count("n_sub", n_sub, 1, MAX_SUBSTEPS, "Runge-Kutta sub-steps per sample")
     nz, nm = model.n_states, model.n_flags
     w = ca.SX.sym("w", nz + nm + 2)
     x = ca.SX.sym("x")
@@ -95,13 +101,11 @@ def sample_function(model: FrictionModel, *, Ts: Optional[float] = None, n_sub: 
     dx = x - x_prev
     s_last = ca.if_else(s_prev == 0.0, 1.0, s_prev)
     s = ca.if_else(dx > 0.0, 1.0, ca.if_else(dx < 0.0, -1.0, s_last))
-    d = dx * (model.sigma / model.Fc)                 # normalised displacement
     if Ts is None:
-        v, dt = d, 1.0
-    else:
-        T = 1.0 / math.sqrt(model.sigma)              # time unit of a unit mass (runtime_params())
-        dt = Ts / T
-        v = d / dt
+        v, dt = dx * (model.sigma / model.Fc), 1.0    # normalised displacement in one time unit
+    else:  # the units of a unit mass (runtime_params()), as friction_along computes them
+        dt = Ts / (1.0 / math.sqrt(model.sigma))
+        v = dx / Ts / (model.Fc / math.sqrt(model.sigma))
     step = interval_function(model, n_sub)
     X1, F = step(X, v, dt, s_prev, s, v, ca.DM(model.runtime_params()))
     w1 = ca.vertcat(X1, ca.if_else(dx == 0.0, s_prev, s), x)
@@ -179,7 +183,7 @@ double {name}_force({name}_state *s, double x) {{
 
 
 def c_source(model: FrictionModel, name: str, directory: Any, *, Ts: Optional[float] = None,
-             n_sub: int = 4) -> CSource:
+             n_sub: int = 16) -> CSource:
     """Write ``<name>.h`` and ``<name>.c``: the model sampled along measured positions, in C99.
 
     The header defines ``typedef struct {...} <name>_state;`` and declares
@@ -199,8 +203,8 @@ def c_source(model: FrictionModel, name: str, directory: Any, *, Ts: Optional[fl
         Where to write the two files (created if missing; existing files of that name are replaced).
     Ts : float, optional
         Fixed sample time [s]; required for rate-dependent models (LuGre, GMS), see :func:`sample_function`.
-    n_sub : int, default 4
-        Runge-Kutta sub-steps per sample (:func:`sample_function`).
+    n_sub : int, default 16
+        Runge-Kutta sub-steps per sample for a model without an exact step (:func:`sample_function`).
 
     Returns
     -------
@@ -224,7 +228,8 @@ def c_source(model: FrictionModel, name: str, directory: Any, *, Ts: Optional[fl
     step = f"{name}_step"
     sampling = (f"Sample time Ts = {Ts!r} s: the velocity over an interval is (x - x_prev) / Ts."
                 if Ts is not None else "Rate-independent: the force depends on the positions alone.")
-    what = f"{_describe(model)}, {'Ts = %r s' % Ts if Ts is not None else 'rate-independent'}, {n_sub} sub-steps"
+    stepping = "exact step" if has_exact_step(model) else f"{n_sub} RK4 sub-steps"
+    what = f"{_describe(model)}, {'Ts = %r s' % Ts if Ts is not None else 'rate-independent'}, {stepping}"
     header = _HEADER.format(name=name, what=what, sampling=sampling, nz1=nz1, i_s=n - 2, i_x=n - 1,
                             guard=f"{name.upper()}_H", n=n)
     virgin = ", ".join(repr(v) for v in virgin_state(model, 0.0))

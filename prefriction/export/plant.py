@@ -66,6 +66,7 @@ class _Period:
         par[LL.param["umax"]] = 0.0     # the loop's own controller is off: the force comes in as u
         par[LL.param["Ts"]] = Ts
         par[LL.param["force_scale"]] = force_scale / sc.F
+        par[LL.p_delay.start] = 1.0     # the measurement of this sample (no delay; unused: no controller)
         self.par = par
         self.q = model.runtime_params_for(sc)
 
@@ -74,11 +75,9 @@ class _Period:
         LL, sc, model = self.LL, self.sc, self.model
         S, u, k = ca.MX.sym("w", LL.nS), ca.MX.sym("u"), ca.MX.sym("k")
         Ts_n = self.Ts / sc.t
-        ii = LL.inp
-        parts = [None] * LL.nw
-        for key, val in (("t0", k * Ts_n), ("t1", (k + 1.0) * Ts_n), ("r", 0.0), ("active", 1.0), ("tl", 0.0),
-                         ("da", u), ("db", 0.0)):
-            parts[ii[key]] = val
+        parts: list[Any] = [0.0] * LL.nw  # no reference, noise, input slope: zero
+        for key, val in (("t0", k * Ts_n), ("t1", (k + 1.0) * Ts_n), ("active", 1.0), ("da", u)):
+            parts[LL.inp[key]] = val
         S1, rec = self.step(S, ca.vertcat(*parts), ca.DM(self.par))
         n_new = rec[LL.rec["n_new"]]
         y = ca.vertcat(*self.outputs(S1), n_new + rec[LL.rec["lr"]], n_new < NSTOP - 0.5)
