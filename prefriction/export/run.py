@@ -7,6 +7,7 @@ the same forces from the CasADi Function the code was generated from (``Function
 
 from __future__ import annotations
 
+import hashlib
 import shutil
 import subprocess
 import tempfile
@@ -156,15 +157,14 @@ def compile_and_run(source: CSource | list[CSource], driver: str, data: np.ndarr
     cc = gcc()
     if cc is None:
         raise FileNotFoundError(f"running {source.name} needs gcc on the PATH to compile the exported code; install gcc")
+    objects = [_object(cc, src) for src in sources]
     with tempfile.TemporaryDirectory(prefix="pf-export-") as tmp:
         d = Path(tmp)
         (d / "driver.c").write_text(driver.replace("NAME", source.name))
         exe = d / "driver"
         incs = [a for src in sources for a in ("-I", str(src.header.parent))]
-        cmd = [cc, *CFLAGS, *incs, str(d / "driver.c"), *[str(src.source) for src in sources], "-lm", "-o", str(exe)]
-        done = subprocess.run(cmd, capture_output=True, text=True)
-        if done.returncode != 0:
-            raise RuntimeError(f"gcc failed to compile {', '.join(str(src.source) for src in sources)}:\n{done.stderr.strip()}")
+        cmd = [cc, *CFLAGS, *incs, str(d / "driver.c"), *map(str, objects), "-lm", "-o", str(exe)]
+        _gcc(cmd, "the driver of " + source.name)
         np.ascontiguousarray(data, dtype=float).tofile(d / "in.bin")
         done = subprocess.run([str(exe), str(d / "in.bin"), str(d / "out.bin"), str(data.size), str(rounds)],
                               capture_output=True, text=True)
@@ -174,6 +174,31 @@ def compile_and_run(source: CSource | list[CSource], driver: str, data: np.ndarr
     if out.size != n_out:
         raise RuntimeError(f"the compiled driver of {source.name} wrote {out.size} numbers, expected {n_out}")
     return out, float(done.stdout)
+
+
+def _gcc(cmd: list[str], what: str) -> None:
+    done = subprocess.run(cmd, capture_output=True, text=True)
+    if done.returncode != 0:
+        raise RuntimeError(f"gcc failed to compile {what}:\n{done.stderr.strip()}")
+
+
+def _object(cc: str, source: CSource) -> Path:
+    """The object file of an export, compiled once per process and content (the generated plant
+    takes seconds at ``-O2``)."""
+    global _OBJ_DIR
+    text = source.source.read_bytes() + source.header.read_bytes()
+    key = hashlib.sha256(text + repr(CFLAGS).encode()).hexdigest()[:20]
+    if _OBJ_DIR is None:
+        _OBJ_DIR = tempfile.TemporaryDirectory(prefix="pf-export-obj-")
+    obj = Path(_OBJ_DIR.name) / f"{source.name}-{key}.o"
+    if not obj.exists():
+        part = obj.with_suffix(".part.o")
+        _gcc([cc, *CFLAGS, "-c", str(source.source), "-I", str(source.header.parent), "-o", str(part)], str(source.source))
+        part.replace(obj)
+    return obj
+
+
+_OBJ_DIR: tempfile.TemporaryDirectory | None = None
 
 
 def evaluate(source: CSource, x: Any) -> np.ndarray:
