@@ -204,3 +204,23 @@ def test_public_names_have_numpydoc_docstrings(name):
     params = [p for p in inspect.signature(obj).parameters if p != "self"] if inspect.isfunction(obj) else []
     if params:
         assert "Parameters\n----------" in doc
+
+
+@needs_gcc
+@pytest.mark.parametrize("model", [pf.Dahl(sigma=40384.0, Fc=2.3444, gamma=0.024824),
+                                   pf.MaxwellSlip([3e4, 1.5e4, 5e3], [0.8, 0.9, 0.7])], ids=["dahl", "maxwell"])
+def test_tribometer_record_in_c_matches_friction_along(tmp_path, model):
+    """The measured tribometer record (42,579 samples at uneven steps of 5-10 ms) through the
+    Dahl model fitted to it in docs/export.md (parameters rounded) and a 3-element Maxwell-slip
+    model; rate-independent, so the uneven steps need no sample time."""
+    from prefriction import data
+
+    rec = data.tribometer()
+    src = export.c_source(model, "tribo", tmp_path)
+    run = export.run_c(src, rec.x)
+    along = pf.friction_along(model, rec.t, rec.x)
+    assert np.max(np.abs(run.F - along.F)) <= 1e-12 * np.max(np.abs(along.F))
+    assert along.reversals.size > 100  # the record's 117 reversals
+    loaded = (rec.t >= 12.0) & (rec.t <= 60.0)  # the fitted window, under the normal load
+    miss = run.F[loaded] - rec.F[loaded]
+    assert np.sqrt(np.mean((miss - miss.mean()) ** 2)) < 0.3  # it describes the record [N]
