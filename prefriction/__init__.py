@@ -59,6 +59,7 @@ __all__ = [
     "dahl",
     "energy",
     "exact_reversals",
+    "export",
     "friction_along",
     "describing",
     "identify",
@@ -72,7 +73,7 @@ __version__ = "0.2.0"
 del annotations  # bound by the __future__ import; not part of the API
 
 
-_LAZY = ("controllers", "describing", "identify")  # python-control (1.6 s) and scipy.stats (0.6 s) on first use
+_LAZY = ("controllers", "describing", "export", "identify")  # python-control (1.6 s) and scipy.stats (0.6 s) on first use
 
 
 def __getattr__(name: str):

@@ -224,3 +224,16 @@ def test_tribometer_record_in_c_matches_friction_along(tmp_path, model):
     loaded = (rec.t >= 12.0) & (rec.t <= 60.0)  # the fitted window, under the normal load
     miss = run.F[loaded] - rec.F[loaded]
     assert np.sqrt(np.mean((miss - miss.mean()) ** 2)) < 0.3  # it describes the record [N]
+
+
+def test_bench_export_option_is_checked():
+    from prefriction.cli.bench.options import parse
+
+    assert parse(["--export", "--repeats", "3"]).export
+    with pytest.raises(SystemExit) as exc:
+        parse(["--export", "--quick"])
+    assert exc.value.code == 2
+
+
+def test_export_is_a_lazy_subpackage_of_prefriction():
+    assert pf.export is export and "export" in pf.__all__

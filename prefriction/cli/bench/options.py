@@ -32,7 +32,8 @@ examples:
   prefriction bench --repeats 9      more warm repeats per point
   prefriction bench --models         Maxwell-slip, LuGre and GMS against scipy
   prefriction bench --sweep          parameter sweeps in cold and warm processes
-  prefriction bench --loops          compiled PID loop against python-control"""
+  prefriction bench --loops          compiled PID loop against python-control
+  prefriction bench --export         exported C code: ns per step against friction_along"""
 
 
 def repeats(text: str) -> int:
@@ -130,7 +131,12 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
                       help="instead: the positioning-loop benchmark (python -m prefriction.controllers.benchmark): "
                            "compiled PID loop against python-control, tuning sweep, loop lengths; "
                            "--repeats sets its warm repeats (default 3)")
+    what.add_argument("--export", action="store_true",
+                      help="instead: ns per step of the exported C code (prefriction.export) against friction_along "
+                           "and FrictionStream, and the exported plant and loop; --repeats sets its passes (default 5)")
     args = ap.parse_args(argv)
+    if args.export and (args.quick or args.out is not None):
+        ap.error("--quick and --out do not apply to --export (it writes no files; its table goes to stdout)")
     if args.repeats is not None and (args.sweep or args.models):
         ap.error("--repeats applies to the headline and stability sections, not to --sweep or --models")
     if args.loops and args.quick:
@@ -138,6 +144,6 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
                  "python -m prefriction.controllers.benchmark --help lists its sizes)")
     if args.loops and args.out is not None:
         ap.error("--out does not apply to --loops (it writes no files; its table goes to stdout)")
-    if not args.loops:
+    if not (args.loops or args.export):
         args.out = make_out_dir(ap, Path(DEFAULT_OUT) if args.out is None else args.out)
     return args
