@@ -26,7 +26,9 @@ from .source import CSource
 __all__ = ["CRun", "compile_and_run", "evaluate", "gcc", "run_c"]
 
 MAX_SAMPLES = 50_000_000
-"""Largest number of positions :func:`run_c` and :func:`evaluate` take (memory: 16 bytes each)."""
+"""Largest number of positions :func:`run_c` takes (memory: 16 bytes each)."""
+MAX_EVALUATE = 1_000_000
+"""Largest number of positions :func:`evaluate` takes (CasADi's virtual machine: about 20 us each)."""
 CFLAGS = ("-std=c99", "-Wall", "-Werror", "-O2")
 """The compiler flags of :func:`run_c` (the code is also clean under ``-pedantic``)."""
 
@@ -110,10 +112,10 @@ def _source(source: Any) -> CSource:
     return source
 
 
-def _positions(x: Any) -> np.ndarray:
+def _positions(x: Any, limit: int = MAX_SAMPLES) -> np.ndarray:
     x = check_real_array("x", x, "m")
-    if x.ndim != 1 or not 1 <= x.size <= MAX_SAMPLES:
-        raise ValueError(f"x must be a 1-d array of 1 to {MAX_SAMPLES} positions [m], got shape {x.shape}")
+    if x.ndim != 1 or not 1 <= x.size <= limit:
+        raise ValueError(f"x must be a 1-d array of 1 to {limit} positions [m], got shape {x.shape}")
     return np.ascontiguousarray(x, dtype=float)
 
 
@@ -220,7 +222,7 @@ def evaluate(source: CSource, x: Any) -> np.ndarray:
         The friction force [N] at each position.
     """
     source = _source(source)
-    x = _positions(x)
+    x = _positions(x, MAX_EVALUATE)
     fun = source.function
     w0 = virgin_state(source.model, float(x[0]))
     run = fun.mapaccum("stream", x.size)
