@@ -252,3 +252,16 @@ def test_run_arguments_are_checked(tmp_path):
         export.run_c("d.c", [0.0])
     with pytest.raises(ValueError, match="rounds"):
         export.run_c(src, [0.0], rounds=0)
+
+
+@needs_gcc
+def test_a_sum_of_models_exports_like_friction_along(tmp_path, motion):
+    model = pf.Dahl(2e5, 1.5, 0.5) + pf.Viscous(2.0)
+    with pytest.raises(ValueError, match="Ts is required for Parallel"):
+        export.c_source(model, "sum", tmp_path)
+    src = export.c_source(model, "sum", tmp_path, Ts=TS)
+    assert "Dahl(sigma=200000.0, Fc=1.5, gamma=0.5) + Viscous(b=2.0)" in repr(src)
+    n = 20_000
+    run = export.run_c(src, motion[:n])
+    along = pf.friction_along(model, np.arange(n) * TS, motion[:n])
+    assert np.max(np.abs(run.F[1:] - along.F[1:])) <= 1e-12 * np.max(np.abs(along.F))

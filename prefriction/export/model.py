@@ -243,6 +243,8 @@ def c_source(model: FrictionModel, name: str, directory: Any, *, Ts: Optional[fl
 
 
 def _describe(model: FrictionModel) -> str:
+    if not type(model).parameters:  # a sum of models: its own repr names the terms
+        return repr(model)
     pars = ", ".join(f"{p.name}={_short(getattr(model, p.name))}" for p in type(model).parameters)
     return f"{type(model).__name__}({pars})"
 
