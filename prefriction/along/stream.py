@@ -57,10 +57,10 @@ class FrictionStream:
         self.t = check_finite("t0", t0)
         self.substeps = check_count("substeps", substeps, 1, 64)
         self.F0, _ = initial_state(model, F0, 1.0)
-        self._run = stepper(model, self.substeps)
+        self._step = stepper(model, self.substeps).buffered()
+        self._step.inputs[6][:] = np.asarray(model.runtime_params(), dtype=float)
         self._units = Units.of(model)
-        self._q = np.asarray(model.runtime_params(), dtype=float)
-        self._X: np.ndarray | None = None  # built at the first motion, when its direction is known
+        self._started = False  # the state is built at the first motion, when its direction is known
         self._s = 1.0
         self.F = self.F0
         """The force [N] at the last sample."""
@@ -99,17 +99,21 @@ class FrictionStream:
         v_end = vi if v is None else check_finite("v", v)
         s_prev = self._s
         s = s_prev if dx == 0.0 else (1.0 if dx > 0.0 else -1.0)
-        if self._X is None:
+        if not self._started:
             if dx == 0.0:
                 self.x, self.t = x, t
                 return self.F
-            _F0, self._X = initial_state(self.model, self.F0, s)
-            s_prev = s
+            self._step.inputs[0][:] = initial_state(self.model, self.F0, s)[1]
+            self._started, s_prev = True, s
         U = self._units
-        X, F, ev = self._run.step(self._X, vi / U.v, dt / U.t, s_prev, s, v_end / U.v, self._q)
-        self._X = np.asarray(X).ravel()
+        F, ev = self._step(vi / U.v, dt / U.t, s_prev, s, v_end / U.v)
         self.reversals += int(s != s_prev)
         self.events += int(ev)
         self._s, self.x, self.t = s, x, t
-        self.F = U.F * float(F)
+        self.F = U.F * F
+        if not np.isfinite(self.F):
+            from prefriction.errors import SolverError
+
+            raise SolverError(f"the model's force is not finite at t = {t!r} s, x = {x!r} m; check the model's "
+                              f"parameters, or give more substeps for a model without an exact step")
         return self.F
