@@ -201,6 +201,10 @@ class LoopResult:
         lines += [
             f"  friction force at t_end {self.F[-1]: .6e} N  (|F|/Fc = {abs(self.F[-1]) / self.Fc:.4f})",
             f"  peak control force      {np.max(np.abs(self.u)): .6e} N",
+        ]
+        if self.compensator is not None and self.compensation is not None:
+            lines.append(f"  compensator             {self.compensator}, peak force {np.max(np.abs(self.compensation)):.6e} N")
+        lines += [
             f"  velocity reversals      {len(self.reversals)}",
         ]
         return "\n".join(lines)

@@ -63,7 +63,10 @@ class Compensator(ABC):
             outputs the next state and the force [N]. With :meth:`numbers` this is all a
             code generator needs (``Function.generate``).
         """
-        return self.structure().function()
+        f = self.structure().function()
+        names = ["state", "meas", "ref", "params"]
+        syms = [ca.SX.sym(n, f.size1_in(i)) for i, n in enumerate(names)]
+        return ca.Function(f.name(), syms, f(*syms), names, ["state_next", "force"])
 
     def with_model(self, model: FrictionModel) -> "Compensator":
         """The same compensator with another friction model (model mismatch); model-free

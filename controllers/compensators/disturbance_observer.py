@@ -62,8 +62,8 @@ class DisturbanceObserver(Compensator):
     >>> from prefriction import controllers
     >>> dob = controllers.DisturbanceObserver(bandwidth=2000.0)
     >>> params, state0 = dob.numbers(mass=1.0, Ts=1e-4, x0=0.0)
-    >>> params.shape, state0.tolist()
-    ((12,), [0.0, 0.0, 0.0])
+    >>> params.shape, state0.shape
+    ((12,), (3,))
     """
 
     bandwidth: float

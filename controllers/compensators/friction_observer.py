@@ -104,7 +104,7 @@ class FrictionObserver(Compensator):
     >>> from prefriction import controllers
     >>> obs = controllers.FrictionObserver(pf.Dahl(sigma=1e6, Fc=1.0), pole=500.0)
     >>> round(obs.max_velocity(), 6)  # m/s
-    0.002365
+    0.002338
     """
 
     model: FrictionModel

@@ -58,7 +58,10 @@ class LuGreObserver(Compensator):
 
         H(s) = (sigma1 s + sigma0) / (m s^2 + C(s)),
 
-    is strictly positive real (``C`` the controller, :meth:`gain_condition`). ``z~`` then goes
+    is strictly positive real (``C`` the controller, :meth:`gain_condition`; for an unfiltered
+    PID ``Re H(jw)`` has the sign of ``sigma0 kp - sigma1 ki + (sigma1 kd - m sigma0) w^2``, so
+    the condition is ``sigma0 kp >= sigma1 ki`` and ``sigma1 kd >= m sigma0``; a derivative
+    filter ``tau`` can break it at high frequency). ``z~`` then goes
     to zero while the stage moves (``|v| > 0``); at rest it is constant.
 
     In the sampled loop the velocity is the encoder difference of the last period,
@@ -80,8 +83,10 @@ class LuGreObserver(Compensator):
     >>> from prefriction import controllers
     >>> obs = controllers.LuGreObserver(pf.LuGre(sigma0=1e6, sigma1=100.0, sigma2=0.0, Fc=1.0, Fs=1.3,
     ...                                          vs=1e-4), gain=1e3)
-    >>> obs.gain_condition(controllers.PID(kp=2e6, ki=1e8, kd=2e3), mass=1.0)[0]
+    >>> obs.gain_condition(controllers.PID(kp=2e6, ki=1e8, kd=2e4, tau=1e-7), mass=1.0)[0]
     True
+    >>> obs.gain_condition(controllers.PID(kp=2e6, ki=1e8, kd=2e3, tau=1e-7), mass=1.0)[0]  # sigma1 kd < m sigma0
+    False
     """
 
     model: LuGre

@@ -11,7 +11,7 @@ A signal (an input force [N], a reference position [m], ...) is split in two par
   with different amplitudes share one compiled function.
 
 Kinds: :class:`Constant`, :class:`Step`, :class:`Ramp`, :class:`Sine`, :class:`Chirp`,
-:class:`Samples` (piecewise linear data), :class:`Traced` (an arbitrary traceable Python
+:class:`Samples` (piecewise linear data), :class:`PointToPoint` (S-curve and trapezoidal moves), :class:`Traced` (an arbitrary traceable Python
 function; compiled once *per function object*) and :class:`Sum` (made with ``+``).
 :func:`as_signal` converts the user-facing forms (number, ``(t, values)``, callable) to signals.
 
@@ -35,6 +35,7 @@ from prefriction.signals.algebra import Sum
 from prefriction.signals.base import Signal
 from prefriction.signals.compiled import compiled_form
 from prefriction.signals.conversion import as_signal
+from prefriction.signals.motion import PointToPoint
 from prefriction.signals.periodic import Chirp, Sine
 from prefriction.signals.piecewise import Constant, Ramp, Step
 from prefriction.signals.samples import MAX_SAMPLES, Samples
@@ -44,6 +45,7 @@ __all__ = [
     "compiled_form",
     "Chirp",
     "Constant",
+    "PointToPoint",
     "Ramp",
     "Samples",
     "Signal",

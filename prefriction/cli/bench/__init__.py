@@ -18,9 +18,9 @@ reported separately. Peers integrate the same normalised equations
 (``docs/mathematics.md#normalised-units``), with ``rtol = tol`` and ``atol = tol / 100``. The
 error definition, the cases and the targets are described in ``docs/bench.md``.
 
-``--models``, ``--sweep`` and ``--loops`` run other benchmarks instead:
-:mod:`prefriction.cli.bench.models`, :mod:`prefriction.cli.bench.sweep` and
-:mod:`prefriction.cli.bench_loops`. The modules of this package: ``options`` (the command
+``--models``, ``--sweep``, ``--loops`` and ``--compensation`` run other benchmarks instead:
+:mod:`prefriction.cli.bench.models`, :mod:`prefriction.cli.bench.sweep`,
+:mod:`prefriction.cli.bench_loops` and :mod:`prefriction.controllers.compensation_bench`. The modules of this package: ``options`` (the command
 line), ``cases`` (cases, error, reference), ``peers``, ``work_precision`` (headline rows),
 ``stiff`` (stiff and extreme cases), ``reference_rows`` (rows against independent references),
 ``restarts`` (scipy DOP853 with restarts), ``costs`` (target 3, exact analytics), ``report``
@@ -90,6 +90,10 @@ def main(argv: Optional[list[str]] = None) -> int:
         return sweep.main(["--out", str(args.out)] + (["--quick"] if args.quick else []))
     if args.models:
         return _models_main(args.out, args.quick)
+    if args.compensation:
+        from prefriction.controllers.compensation_bench import main as compensation_main
+
+        return compensation_main(["--out", str(args.out)])
     out: Path = args.out
     ladder = QUICK_LADDER if args.quick else LADDER
     repeats = args.repeats or (1 if args.quick else 5)

@@ -34,6 +34,8 @@ examples:
   prefriction bench --models         Maxwell-slip, LuGre and GMS against scipy
   prefriction bench --sweep          parameter sweeps in cold and warm processes
   prefriction bench --loops          compiled PID loop against python-control
+  prefriction bench --compensation   PID alone against PID with each friction compensator
+                                     (writes compensation_*.png to --out)
   prefriction bench --export         exported C code: ns per step against friction_along"""
 
 
@@ -103,7 +105,7 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
     -------
     argparse.Namespace
         ``out`` (pathlib.Path, an existing directory; None with ``--loops``), ``quick``, ``repeats`` (int or None), and at most one of
-        ``stability``, ``models``, ``sweep``, ``loops`` set.
+        ``stability``, ``models``, ``sweep``, ``loops``, ``compensation`` set.
 
     Raises
     ------
@@ -135,10 +137,16 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
                       help="instead: the positioning-loop benchmark (python -m prefriction.controllers.benchmark): "
                            "compiled PID loop against python-control, tuning sweep, loop lengths; "
                            "--repeats sets its warm repeats (default 3)")
+    what.add_argument("--compensation", action="store_true",
+                      help="instead: PID alone against PID with each friction compensator (feedforward, LuGre, "
+                           "friction and disturbance observers) on Dahl, LuGre and GMS stages, nominal, mismatched "
+                           "and quantised (docs/compensation.md#bench)")
     what.add_argument("--export", action="store_true",
                       help="instead: ns per step of the exported C code (prefriction.export) against friction_along "
                            "and FrictionStream, and the exported plant and loop; --repeats sets its passes (default 5)")
     args = ap.parse_args(argv)
+    if args.compensation and (args.quick or args.repeats is not None):
+        ap.error("--quick and --repeats do not apply to --compensation")
     if args.export and (args.quick or args.out is not None):
         ap.error("--quick and --out do not apply to --export (it writes no files; its table goes to stdout)")
     if args.repeats is not None and (args.sweep or args.models):
