@@ -9,6 +9,8 @@ Public API, re-exported from private modules:
   ``Chirp``, ``Samples`` and sums; compiled once per kind)
 - analytics: :mod:`prefriction.dahl` (exact and approximate reversal maps, energies; Dahl only)
 - exact reference: :func:`exact_reversals` (Dahl only)
+- the force along a prescribed or measured motion: :func:`friction_along` (:class:`AlongResult`),
+  sample by sample :class:`FrictionStream` (:mod:`prefriction.along`)
 - simulation: :func:`simulate` (closed linear loops: :class:`LinearFeedback`), :func:`sweep`
 - energy analysis: :mod:`prefriction.energy`
 - model checks for new models: :mod:`prefriction.testing`
@@ -22,6 +24,7 @@ Public API, re-exported from private modules:
 from __future__ import annotations
 
 from prefriction.errors import PrefrictionError, SolverError
+from prefriction.along import AlongResult, FrictionStream, friction_along
 from prefriction.models import GMS, Dahl, FrictionModel, LuGre, MaxwellSlip, Oscillator, Parallel, Parameter, Viscous
 from prefriction.reversals import ReversalTable
 from prefriction.units import Scales
@@ -34,8 +37,10 @@ from prefriction.sensitivity import sensitivities
 from prefriction.analysis.exact import exact_reversals
 
 __all__ = [
+    "AlongResult",
     "Dahl",
     "FrictionModel",
+    "FrictionStream",
     "GMS",
     "LinearFeedback",
     "LuGre",
@@ -54,6 +59,7 @@ __all__ = [
     "dahl",
     "energy",
     "exact_reversals",
+    "friction_along",
     "describing",
     "identify",
     "sensitivities",

@@ -32,7 +32,8 @@ examples:
   prefriction bench --repeats 9      more warm repeats per point
   prefriction bench --models         Maxwell-slip, LuGre and GMS against scipy
   prefriction bench --sweep          parameter sweeps in cold and warm processes
-  prefriction bench --loops          compiled PID loop against python-control"""
+  prefriction bench --loops          compiled PID loop against python-control
+  prefriction bench --along          friction_along per 100,000 samples against scipy"""
 
 
 def repeats(text: str) -> int:
@@ -126,6 +127,9 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
     what.add_argument("--sweep", action="store_true",
                       help="instead: parameter sweeps, compiles and end-to-end time of cold and warm "
                            "processes against scipy DOP853")
+    what.add_argument("--along", action="store_true",
+                      help="instead: friction_along, warm time per 100,000 samples per model and error against "
+                           "scipy references restarted at every interval and event (docs/along.md)")
     what.add_argument("--loops", action="store_true",
                       help="instead: the positioning-loop benchmark (python -m prefriction.controllers.benchmark): "
                            "compiled PID loop against python-control, tuning sweep, loop lengths; "
