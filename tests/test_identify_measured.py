@@ -162,9 +162,9 @@ def test_argument_checks(small, kwargs, exc, match):
         identify.fit(pf.Dahl(sigma=3e4, Fc=2.0, gamma=0.5), small, **kwargs)
 
 
-def test_offset_is_refused_for_motion_data():
+def test_offset_is_refused_for_a_free_decay():
     t = np.linspace(0.0, 1.0, 50)
-    with pytest.raises(ValueError, match="offset=True is for ForceDisplacement"):
+    with pytest.raises(ValueError, match="offset=True"):   # no force to tell an offset from
         identify.fit(pf.Dahl(sigma=3e4, Fc=2.0, gamma=1.5), identify.Motion(t, 1e-5 * np.sin(t)), offset=True,
                      mass0=1.0)
 
