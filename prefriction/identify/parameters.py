@@ -77,7 +77,7 @@ def _structure_bound(model: FrictionModel, name: str, value: float) -> tuple[str
     from prefriction.models.dahl import Dahl
 
     if isinstance(model, Dahl) and name == "gamma":
-        side = "the Dahl structure boundary gamma = 1 (gamma >= 1 and gamma < 1 use different states)"
+        side = "the Dahl structure boundary gamma = 1"
         return (side, "the declared range") if value >= 1.0 else ("the declared range", side)
     return "the declared range", "the declared range"
 
