@@ -101,3 +101,15 @@ def test_plant_arguments_are_checked(tmp_path):
         export.plant_source(system, "p", tmp_path, Ts=TS, F0=2.0)
     with pytest.raises(ValueError, match="rtol must be in"):
         export.plant_source(system, "p", tmp_path, Ts=TS, rtol=2.0)
+
+
+@needs_gcc
+def test_a_period_with_more_reversals_than_the_plant_resolves_is_reported(tmp_path):
+    """A 1 mg stage on a 1e5 N/m Dahl contact rings at 50 kHz: a 0.1 ms period holds several
+    reversals, more than the two the exported period resolves; every step says so (status 1)."""
+    stage = pf.Oscillator(pf.Dahl(SIGMA, FC), mass=1e-6)
+    src = export.plant_source(stage, "fast", tmp_path, Ts=TS)
+    u = np.full(3, 0.5)
+    run, ref = export.run_plant_c(src, u), export.evaluate_plant(src, u)
+    assert np.all(run.status == 1) and np.all(ref.status == 1)
+    assert "1 not completed" not in repr(run) and "3 not completed" in repr(run)
