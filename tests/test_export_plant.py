@@ -87,6 +87,10 @@ def test_plant_header_and_status(exported):
     assert "int stage_step(stage_state *s, double u);" in h and "void stage_reset(stage_state *s, double x0, double v0);" in h
     assert run.ns_per_step > 0 and "periods" in run.summary()
     assert src.kind == "plant" and "Dahl stage of 0.5 kg" in repr(src)
+    text = src.source.read_text()
+    includes = {line.split()[1] for line in text.splitlines() if line.startswith("#include")}
+    assert includes == {"<math.h>", '"stage.h"'}  # CasADi's erk integrator generated in, no casadi header
+    assert "malloc" not in text and "printf" not in text
 
 
 def test_plant_arguments_are_checked(tmp_path):
