@@ -265,3 +265,11 @@ def test_a_sum_of_models_exports_like_friction_along(tmp_path, motion):
     run = export.run_c(src, motion[:n])
     along = pf.friction_along(model, np.arange(n) * TS, motion[:n])
     assert np.max(np.abs(run.F[1:] - along.F[1:])) <= 1e-12 * np.max(np.abs(along.F))
+
+
+@needs_gcc
+def test_unoptimised_compile_gives_the_same_forces(runs, motion, tmp_path):
+    src, run = runs["dahl_sat"]
+    assert np.array_equal(export.run_c(src, motion[:20_000], optimize=False).F, run.F[:20_000])
+    with pytest.raises(TypeError, match="optimize"):
+        export.run_c(src, motion[:10], optimize="yes")

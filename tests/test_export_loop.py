@@ -1,7 +1,7 @@
 """prefriction.export.controller_source with plant_source: the sampled positioning loop in C.
 
 The exported controller and the exported plant, compiled together with ``gcc -std=c99 -Wall
--Werror``, run the loop of :func:`prefriction.controllers.simulate_loop` (its compiled sampled
+-Werror`` (``-O0``: a quick compile, the same numbers), run the loop of :func:`prefriction.controllers.simulate_loop` (its compiled sampled
 loop: one Function with controller and plant) and must give its samples: a reference the
 python-control discretisation of the same PID, the same plant, computed in another program.
 """
@@ -45,7 +45,7 @@ def plant(tmp_path_factory):
 def test_c_loop_gives_the_samples_of_simulate_loop(plant, tmp_path, pid):
     res = controllers.simulate_loop(STAGE, pid, reference, T_END, Ts=TS, rtol=RTOL, jit=False)
     ctl = export.controller_source(pid, "pid", tmp_path, Ts=TS)
-    run = export.run_loop_c(ctl, plant, reference(np.arange(res.t.size) * TS))
+    run = export.run_loop_c(ctl, plant, reference(np.arange(res.t.size) * TS), optimize=False)
     assert np.count_nonzero(np.diff(np.sign(run.v[run.v != 0.0]))) >= 2  # the stage reverses
     _compare(run, res)
     if pid.u_max is not None:
@@ -77,7 +77,7 @@ def test_c_compensated_loop_gives_the_samples_of_simulate_loop(tmp_path, case):
     r = np.asarray(res.reference)
     plant = export.plant_source(stage, "stage", tmp_path, Ts=TS, rtol=RTOL)
     ctl = export.controller_source(pid, "ctl", tmp_path, Ts=TS, compensator=comp, mass=stage.mass)
-    run = export.run_loop_c(ctl, plant, r, reference_velocity(ref, tk, r, TS))
+    run = export.run_loop_c(ctl, plant, r, reference_velocity(ref, tk, r, TS), optimize=False)
     assert np.all(run.status == 0) and np.max(np.abs(res.compensation)) > 0.05 * stage.friction.Fc
     assert np.max(np.abs(run.x - res.x)) <= tol_x * np.max(np.abs(res.x))
     assert np.max(np.abs(run.u[:-1] - res.u[:-1])) <= tol_u * np.max(np.abs(res.u))

@@ -33,7 +33,7 @@ def exported(tmp_path_factory, forces):
         pytest.skip("gcc is not on the PATH: the exported C cannot be compiled")
     system = pf.Oscillator(pf.Dahl(SIGMA, FC, 1.0), mass=MASS)
     src = export.plant_source(system, "stage", tmp_path_factory.mktemp("plant"), Ts=TS, rtol=1e-10)
-    return src, export.run_plant_c(src, forces)
+    return src, export.run_plant_c(src, forces, optimize=False)  # -O0: a quick compile, the same numbers
 
 
 def scipy_reference(u):
@@ -114,6 +114,6 @@ def test_a_period_with_more_reversals_than_the_plant_resolves_is_reported(tmp_pa
     stage = pf.Oscillator(pf.Dahl(SIGMA, FC), mass=1e-6)
     src = export.plant_source(stage, "fast", tmp_path, Ts=TS)
     u = np.full(3, 0.5)
-    run, ref = export.run_plant_c(src, u), export.evaluate_plant(src, u)
+    run, ref = export.run_plant_c(src, u, optimize=False), export.evaluate_plant(src, u)
     assert np.all(run.status == 1) and np.all(ref.status == 1)
     assert "1 not completed" not in repr(run) and "3 not completed" in repr(run)

@@ -107,7 +107,7 @@ class LoopRun:
 
 
 def run_loop_c(controller: CSource, plant: CSource, r: Any, v_ref: Any = None, x0: float = 0.0, *,
-               rounds: int = 1) -> LoopRun:
+               rounds: int = 1, optimize: bool = True) -> LoopRun:
     """Compile the exported controller and plant with a loop driver and run them over the reference.
 
     Parameters
@@ -124,6 +124,8 @@ def run_loop_c(controller: CSource, plant: CSource, r: Any, v_ref: Any = None, x
         Initial position [m] of the stage (at rest).
     rounds : int, default 1
         Passes (1 to 1000); the time per sample is the least over them.
+    optimize : bool, default True
+        Compile with ``-O2`` (``False``: ``-O0``, faster to compile, the same numbers).
 
     Returns
     -------
@@ -157,6 +159,6 @@ def run_loop_c(controller: CSource, plant: CSource, r: Any, v_ref: Any = None, x
     rows[n, :2] = r[-1], vr[-1]
     data = np.concatenate([[float(x0), 0.0], rows.ravel()])  # r, v_ref, unused; the last row repeats
     driver = _DRIVER.replace("CTRL", controller.name).replace("PLANT", plant.name)
-    out, ns = compile_and_run([controller, plant], driver, data, 5 * n, rounds)
+    out, ns = compile_and_run([controller, plant], driver, data, 5 * n, rounds, optimize)
     out = out.reshape(-1, 5)
     return LoopRun(out[:, 0], out[:, 1], out[:, 2], out[:, 3], out[:, 4].astype(int), ns)

@@ -105,7 +105,8 @@ def _args(source: Any, u: Any) -> tuple[CSource, np.ndarray]:
     return source, u
 
 
-def run_plant_c(source: CSource, u: Any, x0: float = 0.0, v0: float = 0.0, *, rounds: int = 1) -> PlantRun:
+def run_plant_c(source: CSource, u: Any, x0: float = 0.0, v0: float = 0.0, *, rounds: int = 1,
+                optimize: bool = True) -> PlantRun:
     """Compile the exported plant with a driver and hold each force ``u[k]`` [N] over period ``k``.
 
     Parameters
@@ -118,6 +119,8 @@ def run_plant_c(source: CSource, u: Any, x0: float = 0.0, v0: float = 0.0, *, ro
         Initial position [m] and velocity [m/s] (``<name>_reset``).
     rounds : int, default 1
         Passes (1 to 1000); the time per period is the least over them.
+    optimize : bool, default True
+        Compile with ``-O2`` (``False``: ``-O0``, faster to compile, the same numbers).
 
     Returns
     -------
@@ -134,7 +137,7 @@ def run_plant_c(source: CSource, u: Any, x0: float = 0.0, v0: float = 0.0, *, ro
     source, u = _args(source, u)
     rounds = check_count("rounds", rounds, 1, 1000)
     data = np.concatenate([[float(x0), float(v0)], u])
-    out, ns = compile_and_run(source, _DRIVER, data, 4 * u.size, rounds)
+    out, ns = compile_and_run(source, _DRIVER, data, 4 * u.size, rounds, optimize)
     out = out.reshape(-1, 4)
     return PlantRun(out[:, 0], out[:, 1], out[:, 2], out[:, 3].astype(int), ns)
 

@@ -18,7 +18,7 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
-from prefriction._validation import check_count, check_real_array
+from prefriction._validation import check_bool, check_count, check_real_array
 
 from .model import virgin_state
 from .source import CSource
@@ -29,8 +29,10 @@ MAX_SAMPLES = 50_000_000
 """Largest number of positions :func:`run_c` takes (memory: 16 bytes each)."""
 MAX_EVALUATE = 1_000_000
 """Largest number of positions :func:`evaluate` takes (CasADi's virtual machine: about 20 us each)."""
-CFLAGS = ("-std=c99", "-Wall", "-Werror", "-O2")
-"""The compiler flags of :func:`run_c` (the code is also clean under ``-pedantic``)."""
+CFLAGS = ("-std=c99", "-Wall", "-Werror")
+"""The compiler flags of :func:`run_c` (the code is also clean under ``-pedantic``), with ``-O2``
+(``optimize=True``, timings) or ``-O0`` (a quick compile: the same numbers, IEEE arithmetic
+without contraction under ``-std=c99``)."""
 
 _DRIVER = r"""
 #define _POSIX_C_SOURCE 199309L
@@ -119,7 +121,7 @@ def _positions(x: Any, limit: int = MAX_SAMPLES) -> np.ndarray:
     return np.ascontiguousarray(x, dtype=float)
 
 
-def run_c(source: CSource, x: Any, *, rounds: int = 1) -> CRun:
+def run_c(source: CSource, x: Any, *, rounds: int = 1, optimize: bool = True) -> CRun:
     """Compile the exported model with a driver and run it over the positions ``x``.
 
     Parameters
@@ -130,6 +132,8 @@ def run_c(source: CSource, x: Any, *, rounds: int = 1) -> CRun:
         Positions [m], one per sample; the state is reset at ``x[0]`` (virgin).
     rounds : int, default 1
         Passes over ``x`` (1 to 1000); the time per step is the least over them.
+    optimize : bool, default True
+        Compile with ``-O2`` (``False``: ``-O0``, which compiles faster and gives the same forces).
 
     Returns
     -------
@@ -146,12 +150,12 @@ def run_c(source: CSource, x: Any, *, rounds: int = 1) -> CRun:
     source = _source(source)
     x = _positions(x)
     rounds = check_count("rounds", rounds, 1, 1000)
-    out, ns = compile_and_run(source, _DRIVER, x, x.size, rounds)
+    out, ns = compile_and_run(source, _DRIVER, x, x.size, rounds, optimize)
     return CRun(out, ns, rounds)
 
 
 def compile_and_run(source: CSource | list[CSource], driver: str, data: np.ndarray, n_out: int,
-                    rounds: int) -> tuple[np.ndarray, float]:
+                    rounds: int, optimize: bool = True) -> tuple[np.ndarray, float]:
     """Compile ``driver`` with the export(s) (``NAME`` in it replaced by the first one's name),
     run it on the doubles ``data``; the ``n_out`` doubles it writes and the time per step [ns] it prints."""
     sources = source if isinstance(source, list) else [source]
@@ -159,13 +163,14 @@ def compile_and_run(source: CSource | list[CSource], driver: str, data: np.ndarr
     cc = gcc()
     if cc is None:
         raise FileNotFoundError(f"running {source.name} needs gcc on the PATH to compile the exported code; install gcc")
-    objects = [_object(cc, src) for src in sources]
+    flags = (*CFLAGS, "-O2" if check_bool("optimize", optimize) else "-O0")
+    objects = [_object(cc, src, flags) for src in sources]
     with tempfile.TemporaryDirectory(prefix="pf-export-") as tmp:
         d = Path(tmp)
         (d / "driver.c").write_text(driver.replace("NAME", source.name))
         exe = d / "driver"
         incs = [a for src in sources for a in ("-I", str(src.header.parent))]
-        cmd = [cc, *CFLAGS, *incs, str(d / "driver.c"), *map(str, objects), "-lm", "-o", str(exe)]
+        cmd = [cc, *flags, *incs, str(d / "driver.c"), *map(str, objects), "-lm", "-o", str(exe)]
         _gcc(cmd, "the driver of " + source.name)
         np.ascontiguousarray(data, dtype=float).tofile(d / "in.bin")
         done = subprocess.run([str(exe), str(d / "in.bin"), str(d / "out.bin"), str(data.size), str(rounds)],
@@ -184,18 +189,18 @@ def _gcc(cmd: list[str], what: str) -> None:
         raise RuntimeError(f"gcc failed to compile {what}:\n{done.stderr.strip()}")
 
 
-def _object(cc: str, source: CSource) -> Path:
+def _object(cc: str, source: CSource, flags: tuple[str, ...]) -> Path:
     """The object file of an export, compiled once per process and content (the generated plant
     takes seconds at ``-O2``)."""
     global _OBJ_DIR
     text = source.source.read_bytes() + source.header.read_bytes()
-    key = hashlib.sha256(text + repr(CFLAGS).encode()).hexdigest()[:20]
+    key = hashlib.sha256(text + repr(flags).encode()).hexdigest()[:20]
     if _OBJ_DIR is None:
         _OBJ_DIR = tempfile.TemporaryDirectory(prefix="pf-export-obj-")
     obj = Path(_OBJ_DIR.name) / f"{source.name}-{key}.o"
     if not obj.exists():
         part = obj.with_suffix(".part.o")
-        _gcc([cc, *CFLAGS, "-c", str(source.source), "-I", str(source.header.parent), "-o", str(part)], str(source.source))
+        _gcc([cc, *flags, "-c", str(source.source), "-I", str(source.header.parent), "-o", str(part)], str(source.source))
         part.replace(obj)
     return obj
 
