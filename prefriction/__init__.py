@@ -14,6 +14,7 @@ Public API, re-exported from private modules:
 - simulation: :func:`simulate` (closed linear loops: :class:`LinearFeedback`), :func:`sweep`
 - energy analysis: :mod:`prefriction.energy`
 - model checks for new models: :mod:`prefriction.testing`
+- measured records: :mod:`prefriction.data` (``tribometer()``, a reciprocating tribometer record)
 - identification: :mod:`prefriction.identify` (``fit``, ``ForceDisplacement``, ``Motion``,
   ``FitResult``, ``IdentifiabilityWarning``)
 - derivatives through the simulator and the exact map: :func:`sensitivities`
@@ -61,10 +62,12 @@ __all__ = [
     "dahl",
     "energy",
     "exact_reversals",
+    "export",
     "friction_along",
     "describing",
     "identify",
     "optimal",
+    "data",
     "sensitivities",
     "sensitivity",
     "signals",
@@ -76,7 +79,7 @@ __version__ = "0.2.0"
 del annotations  # bound by the __future__ import; not part of the API
 
 
-_LAZY = ("controllers", "describing", "identify")  # python-control (1.6 s) and scipy.stats (0.6 s) on first use
+_LAZY = ("controllers", "data", "describing", "export", "identify")  # python-control (1.6 s) and scipy.stats (0.6 s) on first use
 
 
 def __getattr__(name: str):

@@ -78,6 +78,12 @@ def main(argv: Optional[list[str]] = None) -> int:
         return along_bench.main(args.repeats, args.quick)
     if args.loops:
         return _loops(args.repeats)
+    if args.export:
+        from prefriction.export import bench as export_bench
+
+        text = export_bench.run(args.repeats or 5)
+        print(text)
+        return 0 if text.rstrip().endswith("PASS") else 1
     if args.sweep:
         from prefriction.cli.bench import sweep
 

@@ -35,7 +35,8 @@ examples:
   prefriction bench --sweep          parameter sweeps in cold and warm processes
   prefriction bench --loops          compiled PID loop against python-control
   prefriction bench --compensation   PID alone against PID with each friction compensator
-                                     (writes compensation_*.png to --out)"""
+                                     (writes compensation_*.png to --out)
+  prefriction bench --export         exported C code: ns per step against friction_along"""
 
 
 def repeats(text: str) -> int:
@@ -140,9 +141,14 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
                       help="instead: PID alone against PID with each friction compensator (feedforward, LuGre, "
                            "friction and disturbance observers) on Dahl, LuGre and GMS stages, nominal, mismatched "
                            "and quantised (docs/compensation.md#bench)")
+    what.add_argument("--export", action="store_true",
+                      help="instead: ns per step of the exported C code (prefriction.export) against friction_along "
+                           "and FrictionStream, and the exported plant and loop; --repeats sets its passes (default 5)")
     args = ap.parse_args(argv)
     if args.compensation and (args.quick or args.repeats is not None):
         ap.error("--quick and --repeats do not apply to --compensation")
+    if args.export and (args.quick or args.out is not None):
+        ap.error("--quick and --out do not apply to --export (it writes no files; its table goes to stdout)")
     if args.repeats is not None and (args.sweep or args.models):
         ap.error("--repeats applies to the headline and stability sections, not to --sweep or --models")
     if args.loops and args.quick:
@@ -150,6 +156,6 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
                  "python -m prefriction.controllers.benchmark --help lists its sizes)")
     if args.loops and args.out is not None:
         ap.error("--out does not apply to --loops (it writes no files; its table goes to stdout)")
-    if not args.loops:
+    if not (args.loops or args.export):
         args.out = make_out_dir(ap, Path(DEFAULT_OUT) if args.out is None else args.out)
     return args

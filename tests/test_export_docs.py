@@ -1,0 +1,57 @@
+"""docs/export.md: every python block runs and prints what the page shows after it.
+
+Lines that name a temporary directory are compared up to it, the time per step by its form
+(it is this machine's); every other line exactly.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import re
+from pathlib import Path
+
+import pytest
+
+from prefriction import export
+
+PAGE = (Path(__file__).resolve().parent.parent / "docs" / "export.md").read_text()
+BLOCKS = re.findall(r"```(\w*)\n(.*?)```", PAGE, flags=re.S)
+PYTHON = [(i, body) for i, (lang, body) in enumerate(BLOCKS) if lang == "python"]
+
+
+def _run(code: str) -> str:
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        exec(compile(code, "docs/export.md", "exec"), {})
+    return out.getvalue()
+
+
+def _same(shown: str, printed: str) -> bool:
+    if " in /tmp/" in shown:
+        return printed.startswith(shown.split(" in /tmp/")[0] + " in /")
+    if shown.endswith("ns per step"):
+        return re.fullmatch(r"\d+ ns per step", printed) is not None
+    if shown == "/usr/bin/gcc":
+        return printed.endswith("gcc")
+    return printed == shown
+
+
+@pytest.mark.skipif(export.gcc() is None, reason="gcc is not on the PATH: the page's examples compile C")
+@pytest.mark.parametrize(("index", "code"), PYTHON, ids=[f"block{i}" for i, _ in PYTHON])
+def test_block_prints_what_the_page_shows(index, code):
+    lang, shown = BLOCKS[index + 1]
+    assert lang == "", f"block {index} is not followed by its output"
+    printed = _run(code).splitlines()
+    shown_lines = shown.splitlines()
+    assert len(printed) == len(shown_lines), (printed, shown_lines)
+    for s, p in zip(shown_lines, printed):
+        assert _same(s, p), (s, p)
+
+
+def test_page_has_its_timing_table_and_examples_of_every_public_name():
+    assert "TIMING_TABLE" not in PAGE
+    code = "\n".join(body for _i, body in PYTHON)
+    for name in export.__all__:
+        if name not in ("CRun", "CSource", "PlantRun", "LoopRun"):  # results, shown by their use
+            assert f"export.{name}" in code, name
