@@ -123,9 +123,10 @@ class FitResult:
             The record: force [N] along its ``x`` for :class:`ForceDisplacement` (the fitted
             offset added), position [m] for :class:`Motion`.
         **kwargs
-            ``F0`` [N] for :class:`ForceDisplacement`: the force at the first sample that sets
-            the initial state (default: the first measured force); see
-            :func:`prefriction.identify.validation.predict`.
+            For :class:`ForceDisplacement`: ``F0`` [N], the force at the first sample that sets
+            the initial state (default: the first measured force), or ``warmup`` [s], the
+            initial state fitted to the first seconds instead; see
+            :func:`prefriction.identify.validation.predict_force` (``docs/identify.md#validate``).
 
         Returns
         -------

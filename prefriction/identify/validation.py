@@ -123,7 +123,7 @@ def predict(result: "FitResult", data: ForceDisplacement | Motion, **kwargs: Any
     data : ForceDisplacement or Motion
         A record of the kind fitted.
     **kwargs
-        For :class:`ForceDisplacement`: ``F0`` [N] (see :func:`predict_force`). For
+        For :class:`ForceDisplacement`: ``F0`` [N] or ``warmup`` [s] (see :func:`predict_force`). For
         :class:`Motion`: passed to ``prefriction.identify.motion_predict.predict_motion``.
 
     Returns
