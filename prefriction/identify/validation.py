@@ -139,7 +139,11 @@ def predict(result: "FitResult", data: ForceDisplacement | Motion, **kwargs: Any
     if type(data) is not type(result.data):
         raise TypeError(f"data must be {type(result.data).__name__} like the fitted record, got {type(data).__name__}")
     if isinstance(data, Motion):
-        from prefriction.identify.motion_predict import predict_motion
+        try:
+            from prefriction.identify.motion_predict import predict_motion
+        except ImportError as exc:  # the Motion predictor ships with the Motion fits
+            raise NotImplementedError("predicting Motion data needs prefriction.identify.motion_predict, which this "
+                                      "installation lacks; ForceDisplacement records are supported") from exc
 
         return predict_motion(result, data, **kwargs)
     offset = result.estimate("offset") if "offset" in result.names else 0.0
