@@ -7,6 +7,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
@@ -86,7 +88,7 @@ def stop_operator(x, k, W, d0):
 
 
 def virgin_deflections(k, W, F0):
-    y = brentq(lambda y: np.minimum(k * y, W).sum() - abs(F0), 0.0, float(np.max(W / k)))
+    y = brentq(lambda y: np.minimum(k * y, W).sum() - abs(F0), 0.0, float(np.max(W / k)), xtol=1e-22, rtol=1e-15)
     return math.copysign(1.0, F0) * np.minimum(y, W / k)
 
 
@@ -273,3 +275,26 @@ def test_fit_recovers_gms_from_the_scipy_reference(short_motion):
     got = dict(zip(res.names, res.estimates))
     want = {"k[0]": 6e4, "k[1]": 3e4, "k[2]": 1e4, "Fc": 1.0, "Fs": 1.5, "vs": 1e-4}
     assert got == pytest.approx(want, rel=1e-6)
+
+
+@settings(max_examples=25, deadline=None)
+@given(steps=st.lists(st.integers(-6, 6), min_size=2, max_size=60), F0=st.floats(-0.99, 0.99))
+def test_maxwell_slip_on_random_walks(steps, F0):
+    """Random walks on a grid (repeated samples, reversals at every sample, slips): the stop operator."""
+    k, W = np.array([6e4, 3e4, 1e4]), np.array([0.3, 0.4, 0.3])
+    x = np.concatenate(([0.0], np.cumsum(steps))) * 2.5e-6
+    t = np.arange(x.size) * 1e-3
+    res = pf.friction_along(pf.MaxwellSlip(k, W), t, x, F0=F0)
+    ref, slips = stop_operator(x, k, W, virgin_deflections(k, W, F0) if F0 else np.zeros(3))
+    assert np.max(np.abs(res.F - ref)) <= 1e-12
+    assert res.n_events <= slips + 3  # elements at their limit from F0 count when they start to slip
+
+
+def test_still_and_two_sample_motions():
+    model = pf.Dahl(1e5, 1.0, 0.5)
+    still = pf.friction_along(model, np.linspace(0.0, 1.0, 5), np.full(5, 1e-3), F0=0.4)
+    np.testing.assert_array_equal(still.F, 0.4)
+    assert still.reversals.size == 0 and still.n_events == 0
+    two = pf.friction_along(model, [0.0, 1.0], [0.0, 2e-6])
+    ref = dahl_reference(np.array([0.0, 2e-6]), 1e5, 1.0, 0.5)[0]
+    close(two.F, ref)

@@ -28,6 +28,7 @@ BLOCK = 4096
 """Samples per call of the compiled block."""
 
 _CACHE: dict[Hashable, "Stepper"] = {}
+_EXACT: dict[Hashable, bool] = {}
 
 
 @dataclass(frozen=True)
@@ -69,32 +70,42 @@ class Stepper:
 
     def run(self, X0: np.ndarray, rows: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """States, normalised forces and event counts at the ends of the intervals ``rows``
-        (``5 x n``: ``v, dt, s_prev, s, v_end``, normalised), from the state ``X0``."""
-        n = rows.shape[1]
-        X = np.empty((self.n_x, n))
+        (``5 x n``: ``v, dt, s_prev, s, v_end``, normalised), from the state ``X0``.
+
+        The block is called through CasADi's buffer interface on numpy arrays (no conversions);
+        the last block is padded with intervals of zero duration in the last direction."""
+        n, nx = rows.shape[1], self.n_x
+        X = np.empty((nx, n))
         F = np.empty(n)
         ev = np.empty(n)
-        x_k = ca.DM(X0)
+        call = BufferedStep(self.block)
+        ins, outs = call.inputs, call.outputs
+        ins[0][:] = X0
+        ins[6][:] = np.tile(q, BLOCK)  # the block maps q too: one column per interval
         for lo in range(0, n, BLOCK):
             hi = min(lo + BLOCK, n)
-            chunk = rows[:, lo:hi]
-            if hi - lo < BLOCK:  # pad: intervals of zero duration in the last direction
-                pad = np.zeros((5, BLOCK - (hi - lo)))
-                pad[2:4, :] = chunk[3, -1]
-                chunk = np.hstack((chunk, pad))
-            Xb, Fb, Eb = self.block(x_k, chunk[0], chunk[1], chunk[2], chunk[3], chunk[4], q)
-            Xb = np.asarray(Xb)
-            X[:, lo:hi] = Xb[:, : hi - lo]
-            F[lo:hi] = np.asarray(Fb).ravel()[: hi - lo]
-            ev[lo:hi] = np.asarray(Eb).ravel()[: hi - lo]
-            x_k = ca.DM(Xb[:, hi - lo - 1])
+            m = hi - lo
+            for r in range(5):
+                ins[r + 1][:m] = rows[r, lo:hi]
+            if m < BLOCK:
+                ins[1][m:] = ins[2][m:] = ins[5][m:] = 0.0
+                ins[3][m:] = ins[4][m:] = rows[3, hi - 1]
+            call.call()
+            Xb = outs[0].reshape(BLOCK, nx).T  # column-major nx x BLOCK
+            X[:, lo:hi] = Xb[:, :m]
+            F[lo:hi] = outs[1][:m]
+            ev[lo:hi] = outs[2][:m]
+            ins[0][:] = Xb[:, m - 1]
         return X, F, ev
 
 
 def stepper(model: FrictionModel, substeps: int) -> Stepper:
     """The :class:`Stepper` of ``model``'s structure, built and compiled once per process
     (``substeps`` only matters for a model without an exact step)."""
-    key = (type(model), model.structure_key(), None if has_exact_step(model) else substeps)
+    structure = (type(model), model.structure_key())
+    if structure not in _EXACT:
+        _EXACT[structure] = has_exact_step(model)
+    key = (*structure, None if _EXACT[structure] else substeps)
     if key not in _CACHE:
         _CACHE[key] = Stepper(model, substeps)
     return _CACHE[key]
@@ -118,6 +129,10 @@ class BufferedStep:
             self._buffer.set_arg(i, memoryview(a))
         for i, a in enumerate(self.outputs):
             self._buffer.set_res(i, memoryview(a))
+
+    def call(self) -> None:
+        """Evaluate on the current ``inputs`` into ``outputs``."""
+        self._call()
 
     def __call__(self, v: float, dt: float, s_prev: float, s: float, v_end: float) -> tuple[float, float]:
         """Advance the state held in ``inputs[0]`` by one interval; the normalised force and the

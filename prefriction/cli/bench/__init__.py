@@ -18,9 +18,9 @@ reported separately. Peers integrate the same normalised equations
 (``docs/mathematics.md#normalised-units``), with ``rtol = tol`` and ``atol = tol / 100``. The
 error definition, the cases and the targets are described in ``docs/bench.md``.
 
-``--models``, ``--sweep``, ``--loops`` and ``--along`` run other benchmarks instead:
-:mod:`prefriction.cli.bench.models`, :mod:`prefriction.cli.bench.sweep`,
-:mod:`prefriction.cli.bench_loops` and :mod:`prefriction.along.bench`. The modules of this package: ``options`` (the command
+``--models``, ``--sweep`` and ``--loops`` run other benchmarks instead:
+:mod:`prefriction.cli.bench.models`, :mod:`prefriction.cli.bench.sweep` and
+:mod:`prefriction.cli.bench_loops`. The modules of this package: ``options`` (the command
 line), ``cases`` (cases, error, reference), ``peers``, ``work_precision`` (headline rows),
 ``stiff`` (stiff and extreme cases), ``reference_rows`` (rows against independent references),
 ``restarts`` (scipy DOP853 with restarts), ``costs`` (target 3, exact analytics), ``report``
@@ -72,12 +72,12 @@ def main(argv: Optional[list[str]] = None) -> int:
         0 if every target line says PASS, else 1 (argparse errors exit with status 2).
     """
     args = parse(argv)
-    if args.loops:
-        return _loops(args.repeats)
-    if args.along:
+    if args.along:  # prefriction.along.bench (docs/along.md#speed)
         from prefriction.along import bench as along_bench
 
         return along_bench.main(args.repeats, args.quick)
+    if args.loops:
+        return _loops(args.repeats)
     if args.sweep:
         from prefriction.cli.bench import sweep
 

@@ -28,12 +28,12 @@ output (in --out): bench.csv (every measured point), work_precision.png, stabili
 
 examples:
   prefriction bench --quick          two tolerances, one repeat, 500 long reversals
+  prefriction bench --along          friction_along per 100,000 samples against scipy
   prefriction bench --stability      simulate only: stiff and extreme cases, no peers
   prefriction bench --repeats 9      more warm repeats per point
   prefriction bench --models         Maxwell-slip, LuGre and GMS against scipy
   prefriction bench --sweep          parameter sweeps in cold and warm processes
-  prefriction bench --loops          compiled PID loop against python-control
-  prefriction bench --along          friction_along per 100,000 samples against scipy"""
+  prefriction bench --loops          compiled PID loop against python-control"""
 
 
 def repeats(text: str) -> int:
@@ -119,6 +119,9 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
                     help=f"warm repeats per point, 1..{MAX_REPEATS}; the minimum time is kept "
                          "(default: 5, 1 with --quick)")
     what = ap.add_mutually_exclusive_group()
+    what.add_argument("--along", action="store_true",
+                      help="instead: friction_along, warm time per 100,000 samples per model and error against "
+                           "scipy references restarted at every interval and event (docs/along.md#speed)")
     what.add_argument("--stability", action="store_true",
                       help="simulate only: the stiff and extreme cases, no peers (target 2 not measured)")
     what.add_argument("--models", action="store_true",
@@ -127,9 +130,6 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
     what.add_argument("--sweep", action="store_true",
                       help="instead: parameter sweeps, compiles and end-to-end time of cold and warm "
                            "processes against scipy DOP853")
-    what.add_argument("--along", action="store_true",
-                      help="instead: friction_along, warm time per 100,000 samples per model and error against "
-                           "scipy references restarted at every interval and event (docs/along.md)")
     what.add_argument("--loops", action="store_true",
                       help="instead: the positioning-loop benchmark (python -m prefriction.controllers.benchmark): "
                            "compiled PID loop against python-control, tuning sweep, loop lengths; "
