@@ -163,7 +163,8 @@ class FitResult:
         return f"FitResult({model_name(self.model)}: {est}; rms {self.rms:.3g}, {len(self.residuals)} samples{tail})"
 
     def summary(self) -> str:
-        """A few lines: the fitted model, the residual level and any unidentifiable parameter."""
+        """A few lines: the fitted model, the residual level, estimates with intervals and bound
+        flags, any unidentifiable parameter, what was compared, and non-convergence."""
         st = self.statistics
         unit = "N" if isinstance(self.data, ForceDisplacement) else "m"
         lines = [f"{model_name(self.model)} fitted to {len(self.residuals)} samples of "
@@ -172,6 +173,7 @@ class FitResult:
             lines.append(f"  {n:<14} {v:< 12.6g} [{lo:.6g}, {hi:.6g}] {u}" + self._flag(i, "  "))
         for n, why in st.unidentifiable:
             lines.append(f"  not identifiable: {n} ({why})")
+        lines.extend(f"  {note}" for note in self.notes)
         if not self.success:
             lines.append(f"  NOT CONVERGED: {self.message}")
         return "\n".join(lines)
