@@ -269,6 +269,12 @@ class GMS(StribeckCurve, ParallelElements):
                 mn[j] = 1.0
         return list(z), mn
 
+    def reverse(self, z: Sequence[Any], m: Sequence[Any], s_new: Any, q: Any, snap: Any) -> tuple[list[Any], list[Any]]:
+        """A sticking element within ``snap`` of its limit ``alpha_j S~(0)`` is put on it."""
+        n = self.n_elements
+        S0 = 1.0 + q[3 * n]  # S~ at v = 0: Fs / Fc
+        return self._put_on_limits(z, m, s_new, q, snap, [q[n + j] * S0 for j in range(n)], sticking_only=True)
+
     def advance(self, z: Sequence[Any], m: Sequence[Any], v: Any, dt: Any, s: Any,
                 q: Any) -> tuple[list[Any], list[Any]]:
         """Exact step over ``dt`` at the constant velocity ``v`` (``docs/along.md#exact-steps``).
@@ -294,12 +300,6 @@ class GMS(StribeckCurve, ParallelElements):
             zn[i] = pick(m[i] > 0.5, slipped, pick(reach, slipped, z[i] + kappa * v * dt))
             mn[i] = pick(reach, 1.0, m[i])
         return zn, mn
-
-    def reverse(self, z: Sequence[Any], m: Sequence[Any], s_new: Any, q: Any, snap: Any) -> tuple[list[Any], list[Any]]:
-        """A sticking element within ``snap`` of its limit ``alpha_j S~(0)`` is put on it."""
-        n = self.n_elements
-        S0 = 1.0 + q[3 * n]  # S~ at v = 0: Fs / Fc
-        return self._put_on_limits(z, m, s_new, q, snap, [q[n + j] * S0 for j in range(n)], sticking_only=True)
 
 
 @dataclass(frozen=True)
