@@ -166,7 +166,7 @@ class FitResult:
         """A few lines: the fitted model, the residual level, estimates with intervals and bound
         flags, any unidentifiable parameter, what was compared, and non-convergence."""
         st = self.statistics
-        unit = "N" if isinstance(self.data, ForceDisplacement) else "m"
+        unit = "m" if isinstance(self.data, Motion) else "N"
         lines = [f"{model_name(self.model)} fitted to {len(self.residuals)} samples of "
                  f"{type(self.data).__name__}: residual sd {st.sigma_hat:.4g} {unit}, {st.dof} dof"]
         for i, (n, u, v, lo, hi) in enumerate(zip(self.names, self.units, self.estimates, self.low, self.high)):
