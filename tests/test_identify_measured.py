@@ -5,8 +5,8 @@ References independent of the fitter: Dahl forces from the closed-form branches
 (prefriction.analysis.branch.force_after_distance via prefriction.identify.synthetic), the
 offset of the tribometer record from the midpoint of its two gross-sliding plateaus, the fit %
 of a hand-made case, and the measured record itself (held-out cycles never seen by the fit).
-The real-record fits use every 4th sample (50 Hz) of 12-60 s to stay fast; the held-out score
-uses every 4th sample of 150-198 s.
+The real-record fits use every 4th (Dahl) or 8th (GMS, Maxwell-slip) sample of 12-60 s to stay
+fast; the held-out score uses every 4th sample of 150-198 s.
 """
 
 from __future__ import annotations
@@ -53,6 +53,28 @@ def test_real_record_dahl_with_offset_holds_on_held_out_cycles(dahl_fit, record)
     lo, hi = res.interval("offset")
     assert lo > 0.0 and abs(res.estimate("offset") - mid) < 0.03, (res.interval("offset"), mid)
     assert res.success and "offset" in res.report()
+
+
+GMS_FIXED = ["alpha[0]", "alpha[1]", "alpha[2]", "vs", "delta", "sigma2", "damping[0]", "damping[1]", "damping[2]"]
+
+
+@pytest.mark.parametrize(("start", "kwargs"), [
+    (pf.GMS(k=[2e5, 4e4, 1e4], alpha=[0.4, 0.33, 0.27], Fc=2.35, Fs=2.5, vs=1e-4, C=20.0, sigma2=1.0,
+            damping=[1e-3] * 3), dict(fixed=GMS_FIXED)),
+    (pf.MaxwellSlip(stiffness=[1e5, 4e4, 5e3], slip_force=[0.3, 1.8, 0.2]), dict(max_iter=1000)),
+], ids=["GMS3", "MaxwellSlip3"])
+def test_real_record_element_models_with_offset_hold_on_held_out_cycles(record, start, kwargs):
+    """Fitted on every 8th sample (25 Hz) of 12-60 s to stay fast (the example uses 200 Hz)."""
+    data = tribometer().window(12.0, 60.0, step=8)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", identify.IdentifiabilityWarning)   # C, or a vanishing element
+        warnings.simplefilter("ignore", BoundWarning)
+        res = identify.fit(start, data, offset=True, **kwargs)
+    assert res.success
+    assert res.validate(record[1], skip=2.0).rms <= HELD_OUT_RMS
+    F = data.F
+    mid = 0.5 * (np.median(F[F > 2.0]) + np.median(F[F < -2.0]))
+    assert abs(res.estimate("offset") - mid) < 0.03
 
 
 def test_dahl_started_at_gamma_above_one_warns_on_the_structure_bound(record):
@@ -182,3 +204,13 @@ def test_user_bound_interval_stays_inside(small):
                            bounds={"sigma": (1e4, 3.5e4)})
     lo, hi = res.interval("sigma")
     assert hi == 3.5e4 and lo < hi
+
+
+def test_plots_refuse_a_missing_directory(small, tmp_path):
+    res = identify.fit(pf.Dahl(sigma=3e4, Fc=2.0, gamma=0.5), small, offset=True, structures="given")
+    missing = tmp_path / "nowhere" / "x.png"
+    with pytest.raises(ValueError, match="path must be in an existing directory"):
+        res.plot(missing)
+    with pytest.raises(ValueError, match="path must be in an existing directory"):
+        res.validate(small).plot(missing)
+    assert "residual sd" in res.summary() and res.summary().count("\n") < 12

@@ -7,8 +7,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from prefriction.identify.data import ForceDisplacement
-from prefriction.identify.validation import model_name
+from prefriction.identify.data import ForceDisplacement, Motion
+from prefriction.identify.validation import check_directory, model_name
 
 if TYPE_CHECKING:
     from prefriction.identify.result import FitResult
@@ -47,7 +47,7 @@ def report_text(res: "FitResult") -> str:
     for n, row in zip(res.names, res.correlation):
         rows.append(f"  {n:<{width}} " + " ".join(f"{c:>6.3f}" for c in row))
     rows.append("")
-    unit = "N" if isinstance(res.data, ForceDisplacement) else "m"
+    unit = "m" if isinstance(res.data, Motion) else "N"
     rows.append(f"residual sd {st.sigma_hat:.4g} {unit} ({st.dof} degrees of freedom), "
                 f"condition number {st.condition:.3g} (Jacobi-scaled)")
     for key, val in res.nuisance.items():
@@ -84,6 +84,7 @@ def plot_fit(res: "FitResult", path: str | Path, show: bool) -> Path:
     """
     import matplotlib.pyplot as plt
 
+    check_directory(path)
     d = res.data
     fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7.0, 6.5), height_ratios=[2.2, 1.0], layout="constrained")
     name = model_name(res.model)

@@ -123,9 +123,10 @@ class FitResult:
             The record: force [N] along its ``x`` for :class:`ForceDisplacement` (the fitted
             offset added), position [m] for :class:`Motion`.
         **kwargs
-            ``F0`` [N] for :class:`ForceDisplacement`: the force at the first sample that sets
-            the initial state (default: the first measured force); see
-            :func:`prefriction.identify.validation.predict`.
+            For :class:`ForceDisplacement`: ``F0`` [N], the force at the first sample that sets
+            the initial state (default: the first measured force), or ``warmup`` [s], the
+            initial state fitted to the first seconds instead; see
+            :func:`prefriction.identify.validation.predict_force` (``docs/identify.md#validate``).
 
         Returns
         -------
@@ -162,15 +163,17 @@ class FitResult:
         return f"FitResult({model_name(self.model)}: {est}; rms {self.rms:.3g}, {len(self.residuals)} samples{tail})"
 
     def summary(self) -> str:
-        """A few lines: the fitted model, the residual level and any unidentifiable parameter."""
+        """A few lines: the fitted model, the residual level, estimates with intervals and bound
+        flags, any unidentifiable parameter, what was compared, and non-convergence."""
         st = self.statistics
-        unit = "N" if isinstance(self.data, ForceDisplacement) else "m"
+        unit = "m" if isinstance(self.data, Motion) else "N"
         lines = [f"{model_name(self.model)} fitted to {len(self.residuals)} samples of "
                  f"{type(self.data).__name__}: residual sd {st.sigma_hat:.4g} {unit}, {st.dof} dof"]
         for i, (n, u, v, lo, hi) in enumerate(zip(self.names, self.units, self.estimates, self.low, self.high)):
             lines.append(f"  {n:<14} {v:< 12.6g} [{lo:.6g}, {hi:.6g}] {u}" + self._flag(i, "  "))
         for n, why in st.unidentifiable:
             lines.append(f"  not identifiable: {n} ({why})")
+        lines.extend(f"  {note}" for note in self.notes)
         if not self.success:
             lines.append(f"  NOT CONVERGED: {self.message}")
         return "\n".join(lines)

@@ -33,7 +33,20 @@ from prefriction.identify.data import ForceDisplacement, Motion
 if TYPE_CHECKING:
     from prefriction.identify.result import FitResult
 
-__all__ = ["Validation", "model_name", "predict", "predict_force", "validate"]
+__all__ = ["Validation", "check_directory", "model_name", "predict", "predict_force", "validate"]
+
+
+def check_directory(path: str | Path) -> None:
+    """Raise ``ValueError`` if the directory of the file ``path`` does not exist.
+
+    Parameters
+    ----------
+    path : str or Path
+        A file to write.
+    """
+    if not Path(path).parent.is_dir():
+        raise ValueError(f"path must be in an existing directory: {Path(path).parent} does not exist "
+                         f"(create it first), got path = {str(path)!r}")
 
 
 def model_name(model: Any) -> str:
@@ -123,7 +136,7 @@ def predict(result: "FitResult", data: ForceDisplacement | Motion, **kwargs: Any
     data : ForceDisplacement or Motion
         A record of the kind fitted.
     **kwargs
-        For :class:`ForceDisplacement`: ``F0`` [N] (see :func:`predict_force`). For
+        For :class:`ForceDisplacement`: ``F0`` [N] or ``warmup`` [s] (see :func:`predict_force`). For
         :class:`Motion`: passed to ``prefriction.identify.motion_predict.predict_motion``.
 
     Returns
@@ -139,7 +152,11 @@ def predict(result: "FitResult", data: ForceDisplacement | Motion, **kwargs: Any
     if type(data) is not type(result.data):
         raise TypeError(f"data must be {type(result.data).__name__} like the fitted record, got {type(data).__name__}")
     if isinstance(data, Motion):
-        from prefriction.identify.motion_predict import predict_motion
+        try:
+            from prefriction.identify.motion_predict import predict_motion
+        except ImportError as exc:  # the Motion predictor ships with the Motion fits
+            raise NotImplementedError("predicting Motion data needs prefriction.identify.motion_predict, which this "
+                                      "installation lacks; ForceDisplacement records are supported") from exc
 
         return predict_motion(result, data, **kwargs)
     offset = result.estimate("offset") if "offset" in result.names else 0.0
@@ -201,15 +218,21 @@ class Validation:
         Parameters
         ----------
         path : str or Path, default "validation.png"
-            Image file to write (the format from the suffix).
+            Image file to write (the format from the suffix), in an existing directory.
 
         Returns
         -------
         Path
             The file written.
+
+        Raises
+        ------
+        ValueError
+            If the directory of ``path`` does not exist.
         """
         import matplotlib.pyplot as plt
 
+        check_directory(path)
         k = 1e6 if self.unit == "m" else 1.0
         unit = "µm" if self.unit == "m" else "N"
         what = "position x" if self.unit == "m" else "friction force F"
