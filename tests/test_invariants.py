@@ -92,11 +92,13 @@ def test_clockwise_dahl_loop_area(gamma, A, sigma, Fc):
     kinks = [saturation] if saturation < 2 * A else None
     branch = quad(lambda q: 1.0 - float(_gap_after(1.0 + a, np.array(q), gamma)), 0.0, 2 * A, limit=200, points=kinks)[0]
     ref = 2 * branch * Fc**2 / sigma
+    floor = 1e-12 * Fc**2 / sigma * A  # round-off of the trapezoid sum over a loop of size A
     if gamma == 0.0 and A <= 1.0:
-        assert abs(E) <= 1e-12 * Fc**2 / sigma * A  # elastic: the linear spring of (2.6)
+        assert abs(E) <= floor  # elastic: the linear spring of (2.6)
     else:
         assert E > 0.0  # clockwise hysteresis (2.7)
-        assert E == pytest.approx(ref, rel=1e-6)
+        # gamma = 0 just past saturation (A = 1 + 1e-11) dissipates less than the floor itself
+        assert E == pytest.approx(ref, rel=1e-6, abs=floor)
 
 
 # --------------------------------------------------------------------------- (2.12) for any state
