@@ -7,6 +7,8 @@ import io
 import re
 from pathlib import Path
 
+import pytest
+
 README = (Path(__file__).resolve().parent.parent / "README.md").read_text()
 BLOCKS = re.findall(r"```(\w*)\n(.*?)```", README, flags=re.S)
 
@@ -37,7 +39,7 @@ def test_quick_start_prints_what_the_readme_shows():
 
 
 def test_controllers_example_runs_and_respects_the_pd_bound():
-    code = next(body for lang, body in BLOCKS if lang == "python" and "controllers" in body)
+    code = next(body for lang, body in BLOCKS if lang == "python" and "design_pd" in body)
     out = _run(code)
     ratio = float(re.search(r"\|e\| / bound = ([0-9.]+)", out).group(1))
     assert 0.0 < ratio <= 1.0
@@ -51,3 +53,44 @@ def test_sweep_example_matches_the_exact_reference():
 
     exact = abs(pf.exact_reversals(pf.Oscillator(pf.Dahl(1e4, 1.0, 3.0)), 1.0, 50).F[-1])
     assert float(re.search(r"gamma = 3: ([0-9.]+) N", out).group(1)) == round(exact, 6)
+
+
+_NUMBER = re.compile(r"[-+]?\d+(?:\.\d*)?(?:[eE][-+]?\d+)?")
+
+
+def _same_line(printed: str, shown: str) -> bool:
+    """Equal text; every number equal to the digits shown (2 units of the last digit, 1e-3 relative)."""
+    if _NUMBER.sub("#", printed) != _NUMBER.sub("#", shown):
+        return False
+    for got, want in zip(_NUMBER.findall(printed), _NUMBER.findall(shown)):
+        mantissa = want.lower().split("e")[0]
+        digits = len(mantissa.split(".")[1]) if "." in mantissa else 0
+        exponent = int(want.lower().split("e")[1]) if "e" in want.lower() else 0
+        unit = 10.0 ** (exponent - digits)
+        if abs(float(got) - float(want)) > max(2 * unit, 1e-3 * abs(float(want))):
+            return False
+    return True
+
+
+PRINTING = [(i, body) for i, (lang, body) in enumerate(BLOCKS)
+            if lang == "python" and i + 1 < len(BLOCKS) and BLOCKS[i + 1][0] == ""]
+
+
+@pytest.mark.parametrize("index", [i for i, _ in PRINTING])
+def test_every_python_block_prints_what_the_readme_shows(index):
+    """Every README block followed by a 'prints' block: the same lines, numbers to the shown digits."""
+    code = BLOCKS[index][1]
+    if "|F_50|" in code:  # the quick start's timing-free lines are compared exactly above
+        pytest.skip("checked by test_quick_start_prints_what_the_readme_shows")
+    printed = _run(code).strip().splitlines()
+    shown = BLOCKS[index + 1][1].strip().splitlines()
+    assert len(printed) == len(shown), (printed, shown)
+    for got, want in zip(printed, shown):
+        assert _same_line(got, want), (got, want)
+
+
+def test_every_python_block_runs():
+    """The blocks without a 'prints' block run without error too."""
+    for i, (lang, body) in enumerate(BLOCKS):
+        if lang == "python" and i not in dict(PRINTING):
+            _run(body)
