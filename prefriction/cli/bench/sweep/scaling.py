@@ -1,0 +1,159 @@
+"""The scaling section of ``prefriction bench --sweep``: large sweeps serially, on a process
+pool and on dask (``docs/bench.md#sweep-scaling``).
+
+The same unforced Dahl systems (gamma uniform in [1, 3], ``sigma`` log-uniform in
+[1e3, 1e5] N/m, ``Fc = 1`` N, ``m = 1`` kg, ``v0 = 1`` m/s, 50 reversals, ``rtol = 1e-8``,
+random generator seed 0) are swept serially, on ``ProcessPoolExecutor(2)`` and on a dask
+``LocalCluster`` of 2 worker processes with 1 thread each, at each size (1,000 and 10,000;
+``--quick``: 200 and 1,000). The pool and the cluster are started and warmed (each worker has
+imported prefriction and run the structure) before the clock starts, as a user's long-lived pool
+would be; each time is the end-to-end :func:`prefriction.sweep` call.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+from concurrent.futures import ProcessPoolExecutor
+from contextlib import ExitStack
+from dataclasses import dataclass
+from typing import Any, Optional
+
+import numpy as np
+
+from prefriction.cli.bench.timing import progress
+from prefriction.models import Dahl, Oscillator
+
+SIZES, QUICK_SIZES = (1_000, 10_000), (200, 1_000)
+WORKERS = 2
+N_REV = 50
+POOL_TARGET, DASK_TARGET = 1.6, 1.4  # least speed-up over serial: pool at every size, dask at the largest
+SEED = 0
+
+
+@dataclass
+class ScaleRow:
+    """One size of the scaling section: end-to-end times [s] and failures (NaN: not measured)."""
+
+    n: int
+    load: float
+    serial_s: float
+    pool_s: float
+    dask_s: float
+    failed: int
+
+    @property
+    def pool_speedup(self) -> float:
+        """Serial time over the pool's."""
+        return self.serial_s / self.pool_s
+
+    @property
+    def dask_speedup(self) -> float:
+        """Serial time over dask's (NaN without dask)."""
+        return self.serial_s / self.dask_s
+
+
+def scale_systems(n: int) -> list[Oscillator]:
+    """The ``n`` systems of the scaling section (seeded, the same in every run).
+
+    Parameters
+    ----------
+    n : int
+        Number of systems.
+
+    Returns
+    -------
+    list of Oscillator
+        Unforced Dahl oscillators, gamma in [1, 3], ``sigma`` in [1e3, 1e5] N/m, ``Fc = 1`` N,
+        ``m = 1`` kg.
+    """
+    rng = np.random.default_rng(SEED)
+    gammas = rng.uniform(1.0, 3.0, n)
+    sigmas = 10.0 ** rng.uniform(3.0, 5.0, n)
+    return [Oscillator(Dahl(sigma=float(s), Fc=1.0, gamma=float(g)), mass=1.0) for g, s in zip(gammas, sigmas)]
+
+
+def _timed(systems: list, executor: Any) -> tuple[float, int]:
+    """End-to-end time of one sweep [s] and its number of failed runs."""
+    from prefriction.simulation.sweep import sweep
+
+    start = time.perf_counter()
+    res = sweep(systems, 1.0, reversals=N_REV, executor=executor, progress=False)
+    return time.perf_counter() - start, len(res.failed)
+
+
+def _dask_client(stack: ExitStack) -> Optional[Any]:
+    """A dask ``Client`` on a ``LocalCluster(2 workers x 1 thread)``, or None without dask."""
+    try:
+        from dask.distributed import Client, LocalCluster
+    except ImportError:
+        return None
+    cluster = stack.enter_context(LocalCluster(n_workers=WORKERS, threads_per_worker=1, processes=True,
+                                               dashboard_address=None))
+    return stack.enter_context(Client(cluster))
+
+
+def measure_scaling(sizes: tuple[int, ...]) -> list[ScaleRow]:
+    """Sweep ``scale_systems(n)`` serially, on the pool and on dask for each ``n`` of ``sizes``.
+
+    Parameters
+    ----------
+    sizes : tuple of int
+        Numbers of systems.
+
+    Returns
+    -------
+    list of ScaleRow
+        One row per size (``dask_s`` NaN if dask.distributed is not installed).
+    """
+    rows = []
+    with ExitStack() as stack:
+        pool = stack.enter_context(ProcessPoolExecutor(WORKERS))
+        client = _dask_client(stack)
+        warm = scale_systems(8 * WORKERS)
+        _timed(warm[:1], None)
+        _timed(warm, pool)  # both workers have run the structure
+        if client is not None:
+            _timed(warm, client)
+        for n in sizes:
+            systems = scale_systems(n)
+            load = os.getloadavg()[0]
+            progress(f"scaling: {n:,} systems serially")
+            serial, failed = _timed(systems, None)
+            progress(f"scaling: {n:,} systems on ProcessPoolExecutor({WORKERS}) (serial {serial:.1f} s)")
+            pool_s, f_pool = _timed(systems, pool)
+            dask_s, f_dask = math.nan, 0
+            if client is not None:
+                progress(f"scaling: {n:,} systems on dask LocalCluster({WORKERS} x 1) (pool {pool_s:.1f} s)")
+                dask_s, f_dask = _timed(systems, client)
+            rows.append(ScaleRow(n, load, serial, pool_s, dask_s, failed + f_pool + f_dask))
+    return rows
+
+
+def format_scaling(rows: list[ScaleRow]) -> str:
+    """The table of the scaling section."""
+    lines = [f"Scaling: unforced Dahl, gamma in [1, 3], sigma in [1e3, 1e5] N/m, {N_REV} reversals, rtol 1e-8; "
+             f"end-to-end sweep time, pool and cluster started and warm; load: the machine's 1-minute load "
+             f"average before the size (another process on a core halves a {WORKERS}-worker speed-up)",
+             f"{'systems':>8} {'load':>5} {'serial s':>9} {'ms/system':>9} {'pool(2) s':>10} {'speed-up':>8} "
+             f"{'dask(2x1) s':>11} {'speed-up':>8} {'failed':>6}"]
+    for r in rows:
+        lines.append(f"{r.n:>8,} {r.load:>5.1f} {r.serial_s:>9.2f} {r.serial_s / r.n * 1e3:>9.3f} {r.pool_s:>10.2f} "
+                     f"{r.pool_speedup:>7.2f}x {r.dask_s:>11.2f} {r.dask_speedup:>7.2f}x {r.failed:>6}")
+    return "\n".join(lines)
+
+
+def scaling_targets(rows: list[ScaleRow], quick: bool) -> list[str]:
+    """The target line T3 (pool and dask speed-ups; not checked with ``--quick``)."""
+    pool_ok = all(r.pool_speedup >= POOL_TARGET for r in rows)
+    largest = rows[-1]
+    dask_ok = math.isnan(largest.dask_s) or largest.dask_speedup >= DASK_TARGET
+    ok = (pool_ok and dask_ok and all(r.failed == 0 for r in rows)) or quick
+    pools = ", ".join(f"{r.n:,}: {r.pool_speedup:.2f}x" for r in rows)
+    dask = "dask.distributed not installed" if math.isnan(largest.dask_s) else \
+        f"dask at {largest.n:,}: {largest.dask_speedup:.2f}x"
+    note = "speed not checked in --quick; " if quick else ""
+    return [f"T3 (ProcessPoolExecutor({WORKERS}) >= {POOL_TARGET:g}x faster than serial at every size, dask "
+            f"LocalCluster({WORKERS} x 1) >= {DASK_TARGET:g}x at the largest, no failed run): "
+            f"{'PASS' if ok else 'FAIL'}  ({note}pool {pools}; {dask})"]
