@@ -23,7 +23,8 @@ error definition, the cases and the targets are described in ``docs/bench.md``.
 :mod:`prefriction.cli.bench_loops`. The modules of this package: ``options`` (the command
 line), ``cases`` (cases, error, reference), ``peers``, ``work_precision`` (headline rows),
 ``stiff`` (stiff and extreme cases), ``reference_rows`` (rows against independent references),
-``restarts`` (scipy DOP853 with restarts), ``costs`` (target 3, exact analytics), ``report``
+``restarts`` (scipy DOP853 with restarts), ``costs`` (target 3, exact analytics),
+``plain_c`` and ``c_reference`` (the plain-C reference, target 4), ``report``
 (tables, CSV, figure), ``verdict`` (targets), ``timing`` (shared timing helpers).
 """
 
@@ -34,6 +35,7 @@ from pathlib import Path
 from typing import Optional
 
 from prefriction.cli.bench import reference_rows
+from prefriction.cli.bench.c_reference import c_available, c_comparison, c_section, c_target
 from prefriction.cli.bench.cases import HEADLINE, LADDER, QUICK_LADDER, Case, reversal_error, stability_cases
 from prefriction.cli.bench.costs import analytics_timing, linear_cost
 from prefriction.cli.bench.models import main as _models_main
@@ -88,6 +90,8 @@ def main(argv: Optional[list[str]] = None) -> int:
 
     rows = headline(ladder, repeats, peers=not args.stability, budget=0.5 if args.quick else 4.0)
     print(headline_section(rows))
+    cmp = c_comparison(5 if args.quick else 40) if c_available() else None
+    print(c_section(cmp) if cmp else "\nPlain-C reference: not measured (no C compiler)")
     stab, stab_rows = stability(ladder, n_long, 1e-8)
     print(stiff_section(stab, ladder, n_long))
     checks = reference_rows.run(args.quick)
@@ -100,7 +104,7 @@ def main(argv: Optional[list[str]] = None) -> int:
     print(f"\nOne-time JIT compile (gcc, cached on disk): {comp:.1f} s in this run "
           f"(0 when every integrator was already in the cache)")
     print()
-    lines = targets(rows, stab, t50, tlong, n_long, ladder, checks)
+    lines = targets(rows, stab, t50, tlong, n_long, ladder, checks) + ([c_target(cmp)] if cmp else [])
     for line in lines:
         print(line)
     write_csv(out / "bench.csv", rows + stab_rows)
