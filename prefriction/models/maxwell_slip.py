@@ -209,6 +209,18 @@ class MaxwellSlip(ParallelElements):
                 zn[j], mn[j] = s * w, 1.0
         return zn, mn
 
+    def _event_at(self, is_k: list, z: Sequence[Any], m: Sequence[Any], s: Any, q: Any) -> tuple[list[Any], list[Any]]:
+        """:meth:`on_event` for the symbolic index of :meth:`on_event_at`: the element that fired,
+        and every sticking one within ``TIE`` of its limit, put on its limit."""
+        n = self.n_elements
+        zn, mn = list(z), list(m)
+        for j in range(n):
+            ind = self._indicator(j, z, None, s, q)
+            hit = ca.logic_or(is_k[j], ca.logic_and(m[j] < 0.5, ind <= TIE))
+            zn[j] = ca.if_else(hit, s * q[n + j], z[j])
+            mn[j] = ca.if_else(hit, 1.0, m[j])
+        return zn, mn
+
     def reverse(self, z: Sequence[Any], m: Sequence[Any], s_new: Any, q: Any, snap: Any) -> tuple[list[Any], list[Any]]:
         """Every element within ``snap`` of its slip force ``w_j`` (or slipping) is put on it."""
         n = self.n_elements
