@@ -40,7 +40,7 @@ from prefriction.models.element_curves import VirginCurve
 
 __all__ = ["MAX_ELEMENTS", "TIE", "ParallelElements", "nonnegative_array", "positive_array", "symbolic"]
 
-MAX_ELEMENTS = 64
+MAX_ELEMENTS = 100
 """Largest number of elements of a :class:`prefriction.MaxwellSlip` or :class:`prefriction.GMS` model."""
 
 TIE = 1e-12

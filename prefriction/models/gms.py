@@ -97,7 +97,7 @@ class GMS(StribeckCurve, ParallelElements):
     Parameters
     ----------
     k : array_like
-        Element stiffnesses ``k_i`` [N/m]: 1-D, 1 to 64 entries, each finite and > 0.
+        Element stiffnesses ``k_i`` [N/m]: 1-D, 1 to 100 entries, each finite and > 0.
     alpha : array_like
         Element fractions ``alpha_i`` of the Stribeck force [-]: as many entries as ``k``, each
         finite and > 0, summing to 1 (within 1e-9).

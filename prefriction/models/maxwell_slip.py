@@ -62,7 +62,7 @@ class MaxwellSlip(ParallelElements):
     Parameters
     ----------
     stiffness : array_like
-        Element stiffnesses ``k_i`` [N/m]: 1-D, 1 to 64 entries, each finite and > 0.
+        Element stiffnesses ``k_i`` [N/m]: 1-D, 1 to 100 entries, each finite and > 0.
     slip_force : array_like
         Element slip forces ``W_i`` [N]: 1-D, as many entries as ``stiffness``, each finite
         and > 0.
@@ -72,7 +72,7 @@ class MaxwellSlip(ParallelElements):
     TypeError
         If an argument is not an array of real numbers.
     ValueError
-        If an argument is not 1-D, has fewer than 1 or more than 64 entries, an entry that is
+        If an argument is not 1-D, has fewer than 1 or more than 100 entries, an entry that is
         not finite and > 0, or the lengths differ. The message names the argument, the value
         and the allowed range.
 
