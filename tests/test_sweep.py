@@ -63,7 +63,7 @@ def test_process_pool_gives_the_serial_results(serial: SweepResult) -> None:
 
 def test_dask_executor_gives_the_serial_results(serial: SweepResult) -> None:
     distributed = pytest.importorskip("dask.distributed")
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
                                   dashboard_address=None) as cluster, distributed.Client(cluster) as client:
         res = sweep(SYSTEMS, V0, reversals=N_REV, executor=client.get_executor(), progress=False)
     assert res.failed == []

@@ -18,7 +18,8 @@ reported separately. Peers integrate the same normalised equations
 (``docs/mathematics.md#normalised-units``), with ``rtol = tol`` and ``atol = tol / 100``. The
 error definition, the cases and the targets are described in ``docs/bench.md``.
 
-``--models``, ``--sweep`` and ``--loops`` run other benchmarks instead:
+``--models``, ``--sweep``, ``--elements`` and ``--loops`` run other benchmarks instead
+(``--elements``: :mod:`prefriction.cli.bench.elements`):
 :mod:`prefriction.cli.bench.models`, :mod:`prefriction.cli.bench.sweep` and
 :mod:`prefriction.cli.bench_loops`. The modules of this package: ``options`` (the command
 line), ``cases`` (cases, error, reference), ``peers``, ``work_precision`` (headline rows),
@@ -82,6 +83,10 @@ def main(argv: Optional[list[str]] = None) -> int:
         return sweep.main(["--out", str(args.out)] + (["--quick"] if args.quick else []))
     if args.models:
         return _models_main(args.out, args.quick)
+    if args.elements:
+        from prefriction.cli.bench import elements
+
+        return elements.main(args.quick)
     out: Path = args.out
     ladder = QUICK_LADDER if args.quick else LADDER
     repeats = args.repeats or (1 if args.quick else 5)

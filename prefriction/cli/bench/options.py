@@ -32,6 +32,7 @@ examples:
   prefriction bench --repeats 9      more warm repeats per point
   prefriction bench --models         Maxwell-slip, LuGre and GMS against scipy
   prefriction bench --sweep          parameter sweeps in cold and warm processes
+  prefriction bench --elements       Maxwell-slip and GMS compile and cost against the element count
   prefriction bench --loops          compiled PID loop against python-control"""
 
 
@@ -101,7 +102,7 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
     -------
     argparse.Namespace
         ``out`` (pathlib.Path, an existing directory; None with ``--loops``), ``quick``, ``repeats`` (int or None), and at most one of
-        ``stability``, ``models``, ``sweep``, ``loops`` set.
+        ``stability``, ``models``, ``sweep``, ``elements``, ``loops`` set.
 
     Raises
     ------
@@ -126,13 +127,16 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
     what.add_argument("--sweep", action="store_true",
                       help="instead: parameter sweeps, compiles and end-to-end time of cold and warm "
                            "processes against scipy DOP853")
+    what.add_argument("--elements", action="store_true",
+                      help="instead: Maxwell-slip and GMS with 3 to 100 elements, compile time and cost "
+                           "per reversal (target: linear in the element count)")
     what.add_argument("--loops", action="store_true",
                       help="instead: the positioning-loop benchmark (python -m prefriction.controllers.benchmark): "
                            "compiled PID loop against python-control, tuning sweep, loop lengths; "
                            "--repeats sets its warm repeats (default 3)")
     args = ap.parse_args(argv)
-    if args.repeats is not None and (args.sweep or args.models):
-        ap.error("--repeats applies to the headline and stability sections, not to --sweep or --models")
+    if args.repeats is not None and (args.sweep or args.models or args.elements):
+        ap.error("--repeats applies to the headline and stability sections, not to --sweep, --models or --elements")
     if args.loops and args.quick:
         ap.error("--quick does not apply to --loops (the loop benchmark has no quick mode; "
                  "python -m prefriction.controllers.benchmark --help lists its sizes)")
