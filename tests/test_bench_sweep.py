@@ -110,3 +110,27 @@ def test_help_and_out(tmp_path, capsys) -> None:
     with pytest.raises(SystemExit) as exc:
         main(["--out", str(tmp_path / "f")])
     assert exc.value.code == 2 and "must be a directory" in capsys.readouterr().err
+
+
+def test_scaling_targets_and_table() -> None:
+    """T3 from made-up rows: the speed-up thresholds, a failed run, no dask, --quick."""
+    from prefriction.cli.bench.sweep import ScaleRow, format_scaling, scale_systems, scaling_targets
+
+    good = [ScaleRow(1000, 0.5, 2.0, 1.2, 1.4, 0, 2e-3, 1.9e-3, 0.9e-3), ScaleRow(10_000, 0.5, 20.0, 12.0, 14.0, 0, 2e-3, 1.9e-3, 0.9e-3)]
+    assert "PASS" in scaling_targets(good, False)[0] and "PASS" in scaling_targets(good, False)[1]
+    slow_sweep = [ScaleRow(10_000, 0.5, 20.0, 12.0, 14.0, 0, 2e-3, 1.6e-3, 0.9e-3)]  # 1.25x one simulate
+    assert "FAIL" in scaling_targets(slow_sweep, False)[1] and "PASS" in scaling_targets(slow_sweep, True)[1]
+    far_from_c = [ScaleRow(10_000, 0.5, 20.0, 12.0, 14.0, 0, 2e-3, 1.9e-3, 0.7e-3)]  # 2.86x plain C
+    assert "FAIL" in scaling_targets(far_from_c, False)[1]
+    slow_pool = [good[0], ScaleRow(10_000, 0.5, 20.0, 12.6, 14.0, 0)]  # 1.59x
+    assert "FAIL" in scaling_targets(slow_pool, False)[0] and "PASS" in scaling_targets(slow_pool, True)[0]
+    slow_dask = [good[0], ScaleRow(10_000, 0.5, 20.0, 12.0, 14.4, 0)]  # 1.39x
+    assert "FAIL" in scaling_targets(slow_dask, False)[0]
+    assert "FAIL" in scaling_targets([good[0], ScaleRow(10_000, 0.5, 20.0, 12.0, 14.0, 1)], False)[0]
+    no_dask = [ScaleRow(1000, 0.5, 2.0, 1.2, math.nan, 0)]
+    assert "PASS" in scaling_targets(no_dask, False)[0] and "not installed" in scaling_targets(no_dask, False)[0]
+    table = format_scaling(good)
+    assert "10,000" in table and "1.67x" in table and "1.43x" in table and "  1.05 " in table and "  2.22" in table
+    a, b = scale_systems(3), scale_systems(3)
+    assert [s.friction.gamma for s in a] == [s.friction.gamma for s in b]
+    assert all(1.0 <= s.friction.gamma <= 3.0 and 1e3 <= s.friction.sigma <= 1e5 for s in a)

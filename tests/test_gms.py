@@ -171,7 +171,7 @@ def slips_seen(model, system, v0, n, rtol):
         (dict(alpha=[0.2, 0.3, 0.6]), ValueError, ["alpha", "sum to 1", "1.1", "[0.2, 0.3, 0.6]"]),
         (dict(alpha=[0.0, 0.5, 0.5]), ValueError, ["alpha[0]", "0.0", "0 < alpha[i] < inf"]),
         (dict(alpha=[0.5, 0.5]), ValueError, ["same length", "3 and 2"]),
-        (dict(k=[]), ValueError, ["k", "1 to 64", "got 0"]),
+        (dict(k=[]), ValueError, ["k", "1 to 100", "got 0"]),
         (dict(Fc=-1.0), ValueError, ["Fc", "-1.0", "0 < Fc < inf"]),
         (dict(Fs=0.5), ValueError, ["Fs", "0.5", "[1.0, inf)", "[N]"]),
         (dict(vs=0.0), ValueError, ["vs", "0.0", "0 < vs < inf"]),

@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import concurrent.futures as cf
+import concurrent.futures.process
 import multiprocessing
+import threading
 import warnings
 from concurrent.futures import ProcessPoolExecutor
 
@@ -60,7 +63,7 @@ def test_process_pool_gives_the_serial_results(serial: SweepResult) -> None:
 
 def test_dask_executor_gives_the_serial_results(serial: SweepResult) -> None:
     distributed = pytest.importorskip("dask.distributed")
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
                                   dashboard_address=None) as cluster, distributed.Client(cluster) as client:
         res = sweep(SYSTEMS, V0, reversals=N_REV, executor=client.get_executor(), progress=False)
     assert res.failed == []
@@ -137,3 +140,82 @@ def test_bad_input_is_refused_before_any_run() -> None:
 def test_more_than_a_million_systems_is_refused() -> None:
     with pytest.raises(ValueError, match="1,000,000"):
         sweep(iter([SYSTEMS[0]] * 1_000_001), 1.0, reversals=N_REV)
+
+
+class _CountingExecutor(cf.Executor):
+    """A thread pool that counts its tasks and the most futures in flight at once."""
+
+    def __init__(self, workers: int, fail_task: int = -1) -> None:
+        self.pool = cf.ThreadPoolExecutor(workers)
+        self._max_workers = workers
+        self.submitted = 0
+        self.in_flight = 0
+        self.most_in_flight = 0
+        self.fail_task = fail_task
+        self.lock = threading.Lock()
+
+    def submit(self, fn, *args, **kwargs):  # noqa: ANN001, ANN002, ANN003
+        with self.lock:
+            k = self.submitted
+            self.submitted += 1
+            self.in_flight += 1
+            self.most_in_flight = max(self.most_in_flight, self.in_flight)
+        if k == self.fail_task:  # the task fails as a whole (a worker that died)
+            future = cf.Future()
+            future.set_exception(cf.process.BrokenProcessPool("worker died"))
+        else:
+            future = self.pool.submit(fn, *args, **kwargs)
+        future.add_done_callback(self._done)
+        return future
+
+    def _done(self, _future: cf.Future) -> None:
+        with self.lock:
+            self.in_flight -= 1
+
+    def shutdown(self, wait: bool = True, **kwargs) -> None:  # noqa: ANN003
+        self.pool.shutdown(wait)
+
+
+def test_executor_gets_chunks_and_a_bounded_number_in_flight(serial: SweepResult) -> None:
+    # 4 x 25 = 100 systems of one structure (the first runs here), chunks of 3: 99 / 3 = 33 tasks,
+    # at most 3 chunks per worker in flight; results in input order, equal to the serial ones
+    systems, v0 = SYSTEMS * 25, V0 * 25
+    ex = _CountingExecutor(2)
+    with ex:
+        res = sweep(systems, v0, reversals=N_REV, executor=ex, progress=False, chunksize=3)
+    assert res.failed == [] and len(res) == 100
+    assert ex.submitted == 33
+    assert ex.most_in_flight <= 3 * 2
+    assert all(_same(a, serial[i % 4]) for i, a in enumerate(res))
+
+
+def test_a_chunk_that_fails_as_a_whole_leaves_its_exception_in_each_place(serial: SweepResult) -> None:
+    systems, v0 = SYSTEMS * 3, V0 * 3  # run 0 here (one structure); 1..11 in chunks of 2: task 1 = runs 3, 4
+    with _CountingExecutor(2, fail_task=1) as ex, pytest.warns(RuntimeWarning, match=r"2 of 12 runs failed \(indices 3, 4\)"):
+        res = sweep(systems, v0, reversals=N_REV, executor=ex, progress=False, chunksize=2)
+    assert res.failed == [3, 4]
+    assert all(isinstance(res[i], cf.process.BrokenProcessPool) for i in (3, 4))
+    assert all(_same(res[i], serial[i % 4]) for i in range(12) if i not in (3, 4))
+
+
+def test_dask_in_process_cluster_with_a_failing_run(serial: SweepResult) -> None:
+    distributed = pytest.importorskip("dask.distributed")
+    v0 = V0 * 3
+    v0[9] = 0.0  # F0 = 0, no input: the mass rests, run 9 raises ValueError inside its chunk
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
+                                  dashboard_address=None) as cluster, distributed.Client(cluster) as client, \
+            pytest.warns(RuntimeWarning, match=r"1 of 12 runs failed \(indices 9\)"):
+        res = sweep(SYSTEMS * 3, v0, reversals=N_REV, executor=client, progress=False, chunksize=3)
+    assert res.failed == [9] and "the mass rests" in str(res[9])
+    assert all(_same(res[i], serial[i % 4]) for i in range(12) if i != 9)
+
+
+def test_chunk_sizes() -> None:
+    from prefriction.simulation.chunks import MAX_CHUNK, chunk_size
+
+    assert chunk_size(1, 2) == 1 and chunk_size(16, 2) == 1 and chunk_size(17, 2) == 2
+    assert chunk_size(10_000, 2) == 500 == MAX_CHUNK and chunk_size(1000, 2) == 63
+    with pytest.raises(ValueError, match=r"chunksize must be an integer >= 1, got 0"):
+        sweep(SYSTEMS, 1.0, reversals=N_REV, chunksize=0)
+    with pytest.raises(TypeError, match=r"chunksize must be an integer"):
+        sweep(SYSTEMS, 1.0, reversals=N_REV, chunksize=2.5)

@@ -40,7 +40,7 @@ from prefriction.models.element_curves import VirginCurve
 
 __all__ = ["MAX_ELEMENTS", "TIE", "ParallelElements", "nonnegative_array", "positive_array", "symbolic"]
 
-MAX_ELEMENTS = 64
+MAX_ELEMENTS = 100
 """Largest number of elements of a :class:`prefriction.MaxwellSlip` or :class:`prefriction.GMS` model."""
 
 TIE = 1e-12
@@ -222,6 +222,26 @@ class ParallelElements(FrictionModel):
         for i in range(self.n_elements):
             ind = self._indicator(i, z, v, s, q)
             out.append(ca.if_else(m[i] > 0.5, 1.0, ind) if sym else (1.0 if m[i] > 0.5 else ind))
+        return out
+
+    def on_event_at(self, k: Any, z: Sequence[Any], m: Sequence[Any], s: Any, q: Any) -> tuple[list[Any], list[Any]]:
+        """:meth:`~prefriction.FrictionModel.on_event` for a symbolic event index ``k`` (a CasADi
+        SX; 0-based element index): the same expressions for ``k = 0 ... N-1`` in one piece,
+        of size proportional to ``N``, where one :meth:`on_event` per element and a selection by
+        ``k`` cost ``N^2`` (30 elements: 22,000 of the 34,000 lines of the generated plant,
+        23 s of gcc). The plant uses it when a model has it (``simulation.plant``)."""
+        return self._event_at([k == j for j in range(self.n_elements)], z, m, s, q)
+
+    def _event_at(self, is_k: list, z: Sequence[Any], m: Sequence[Any], s: Any, q: Any) -> tuple[list[Any], list[Any]]:
+        """:meth:`on_event_at` from the symbolic flags ``is_k[j]`` (element ``j`` fired)."""
+        raise NotImplementedError
+
+    @staticmethod
+    def _selected(is_k: list, values: Sequence[Any]) -> Any:
+        """``values[k]`` for the symbolic index of :meth:`on_event_at` (a sum of zeros but one)."""
+        out = 0.0
+        for flag, value in zip(is_k, values):
+            out = out + ca.if_else(flag, value, 0.0)
         return out
 
     def _put_on_limits(self, z: Sequence[Any], m: Sequence[Any], s_new: Any, q: Any, snap: Any,

@@ -98,7 +98,7 @@ class GMS(StribeckCurve, ParallelElements):
     Parameters
     ----------
     k : array_like
-        Element stiffnesses ``k_i`` [N/m]: 1-D, 1 to 64 entries, each finite and > 0.
+        Element stiffnesses ``k_i`` [N/m]: 1-D, 1 to 100 entries, each finite and > 0.
     alpha : array_like
         Element fractions ``alpha_i`` of the Stribeck force [-]: as many entries as ``k``, each
         finite and > 0, summing to 1 (within 1e-9).
@@ -267,6 +267,19 @@ class GMS(StribeckCurve, ParallelElements):
                 mn[j] = ca.if_else(ca.logic_and(m[j] < 0.5, hit), 1.0, m[j])
             elif m[j] < 0.5 and hit:
                 mn[j] = 1.0
+        return list(z), mn
+
+    def _event_at(self, is_k: list, z: Sequence[Any], m: Sequence[Any], s: Any, q: Any) -> tuple[list[Any], list[Any]]:
+        """:meth:`on_event` for the symbolic index of :meth:`on_event_at`: the element that fired
+        starts to slip, and every sticking one at its normalised force (within ``TIE``)."""
+        n = self.n_elements
+        loads = [z[j] + q[j] * z[n] for j in range(n)]
+        alpha_k = self._selected(is_k, [q[n + j] for j in range(n)])
+        gk = s * self._selected(is_k, loads) * (1.0 - TIE)
+        mn = list(m)
+        for j in range(n):
+            hit = s * loads[j] * alpha_k >= gk * q[n + j]
+            mn[j] = ca.if_else(ca.logic_or(is_k[j], ca.logic_and(m[j] < 0.5, hit)), 1.0, m[j])
         return list(z), mn
 
     def reverse(self, z: Sequence[Any], m: Sequence[Any], s_new: Any, q: Any, snap: Any) -> tuple[list[Any], list[Any]]:

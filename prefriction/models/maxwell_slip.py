@@ -63,7 +63,7 @@ class MaxwellSlip(ParallelElements):
     Parameters
     ----------
     stiffness : array_like
-        Element stiffnesses ``k_i`` [N/m]: 1-D, 1 to 64 entries, each finite and > 0.
+        Element stiffnesses ``k_i`` [N/m]: 1-D, 1 to 100 entries, each finite and > 0.
     slip_force : array_like
         Element slip forces ``W_i`` [N]: 1-D, as many entries as ``stiffness``, each finite
         and > 0.
@@ -73,7 +73,7 @@ class MaxwellSlip(ParallelElements):
     TypeError
         If an argument is not an array of real numbers.
     ValueError
-        If an argument is not 1-D, has fewer than 1 or more than 64 entries, an entry that is
+        If an argument is not 1-D, has fewer than 1 or more than 100 entries, an entry that is
         not finite and > 0, or the lengths differ. The message names the argument, the value
         and the allowed range.
 
@@ -208,6 +208,18 @@ class MaxwellSlip(ParallelElements):
                 mn[j] = ca.if_else(hit, 1.0, m[j])
             elif m[j] < 0.5 and ind <= TIE:
                 zn[j], mn[j] = s * w, 1.0
+        return zn, mn
+
+    def _event_at(self, is_k: list, z: Sequence[Any], m: Sequence[Any], s: Any, q: Any) -> tuple[list[Any], list[Any]]:
+        """:meth:`on_event` for the symbolic index of :meth:`on_event_at`: the element that fired,
+        and every sticking one within ``TIE`` of its limit, put on its limit."""
+        n = self.n_elements
+        zn, mn = list(z), list(m)
+        for j in range(n):
+            ind = self._indicator(j, z, None, s, q)
+            hit = ca.logic_or(is_k[j], ca.logic_and(m[j] < 0.5, ind <= TIE))
+            zn[j] = ca.if_else(hit, s * q[n + j], z[j])
+            mn[j] = ca.if_else(hit, 1.0, m[j])
         return zn, mn
 
     def reverse(self, z: Sequence[Any], m: Sequence[Any], s_new: Any, q: Any, snap: Any) -> tuple[list[Any], list[Any]]:

@@ -42,6 +42,7 @@ def advance_compact(self: "Run", t_target: float, n_target: float) -> bool:
     force, travel, reverse, snap = model.force, model.travel, model.reverse, self.snap
     P[:] = self.P0  # eps and the model's numbers q
     st, rev = self.st, self.rev
+    times = rev.t
     x, v, z, m, s, t = st["x"], st["v"], st["z"], st["m"], st["s"], st["t"]
     ne = st.get("ne", 0)  # model events since the last reversal
     rev_events = self.rev_events
@@ -79,7 +80,7 @@ def advance_compact(self: "Run", t_target: float, n_target: float) -> bool:
             continue
         F = float(force(z, m, v, s, q))
         if n >= 2:  # the next half-cycle about as long as the last one, with a margin
-            chunk = 2.0 * (rev[-1][0] - rev[-2][0]) * grow
+            chunk = 2.0 * (times[-1] - times[-2]) * grow
         else:  # F rises over a distance ~1 (time ~1/|v|): the first step must not skip it;
             # quadrupled while no reversal comes (a gross slide: the scales follow the speed)
             chunk = 2.0 * math.pi / max(1.0, abs(v)) * grow

@@ -223,7 +223,7 @@ def _estimate(run: "Run", buf: SampleBuffer, t_end: float, n_target: float) -> f
     rev = run.rev
     k = min(len(rev), 64)
     if k >= 2 and math.isfinite(n_target):
-        per_rev = (rev[-1][0] - rev[-k][0]) / (k - 1)
+        per_rev = (rev.t[-1] - rev.t[-k]) / (k - 1)
         t_last = rev[-1][0] + max(n_target - len(rev), 0.0) * per_rev  # of the n_target-th reversal
         est = min(est, len(buf) + max(t_last - t_now, 0.0) / DENSE_STEP + 2.0)
     return est

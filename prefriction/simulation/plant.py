@@ -372,8 +372,8 @@ def build_integrator(spec: PlantSpec) -> ca.Function:
         ch.update({f"m{i}": mn[i] for i in range(L.nm)})
         return ch
 
-    def event_changes(k: int) -> dict:
-        zn, mn = model.on_event(k, z, m, s, q)
+    def event_changes(k: Any) -> dict:
+        zn, mn = model_event(model, k, z, m, s, q)
         ch = model_changes(zn, mn)
         ch["ne"] = st["ne"] + event_count(m, mn)
         if L.potential:  # v^2 / 2 + potential - W conserved up to the event
@@ -409,8 +409,7 @@ def build_integrator(spec: PlantSpec) -> ca.Function:
                             ca.if_else(sa > eps, X, with_({"rest": 1.0, "vh": 0.0})))]
     else:
         posts = [reversal(-s, {})]
-    for k in range(model.n_events):
-        posts.append(with_(event_changes(k)))
+    model_posts = [with_(event_changes(k)) for k in _event_indices(model, idx - 1.0)]
     if spec.forced:
         new_dir = ca.if_else(acc > 0, 1.0, -1.0)
         posts.append(ca.if_else(new_dir != s, reversal(new_dir, {"rest": 0.0}), with_({"rest": 0.0})))
@@ -419,9 +418,7 @@ def build_integrator(spec: PlantSpec) -> ca.Function:
     if spec.fb == "continuous":  # enter or leave the upper, then the lower limit
         posts.append(with_({"sat": ca.if_else(ca.fabs(st["sat"]) < 0.5, 1.0, 0.0)}))
         posts.append(with_({"sat": ca.if_else(ca.fabs(st["sat"]) < 0.5, -1.0, 0.0)}))
-    post = posts[-1]
-    for k in range(len(posts) - 2, -1, -1):
-        post = ca.if_else(idx == k, posts[k], post)
+    post = _select(idx, posts[:1], model_posts, model.n_events, posts[1:])
     trans = ca.Function(
         "transition", [idx, tau, X, ca.SX(0, 1), P, U], [post, ca.SX(0, 1)],
         ca.event_in(), ca.event_out(),
@@ -468,8 +465,9 @@ def _build_compact(spec: PlantSpec) -> ca.Function:
     idx = ca.SX.sym("index")
     post = ca.SX(X)
     post[L.state["vh"]] = -s * (1.0 + tau) / p["eps"]
-    for k in range(model.n_events):
-        zn, mn = model.on_event(k, z, m, s, q)
+    model_posts = []
+    for k in _event_indices(model, idx - 1.0):
+        zn, mn = model_event(model, k, z, m, s, q)
         after = ca.SX(X)
         for i in range(L.nz):
             after[L.state[f"z{i}"]] = zn[i] / p["AF"]
@@ -478,7 +476,8 @@ def _build_compact(spec: PlantSpec) -> ca.Function:
         if L.potential:  # v^2 / 2 + potential conserved up to the event
             kinetic = p["Eb"] - model.branch_potential(zn, m, s, q)
             after[L.state["vh"]] = s * ca.sqrt(ca.fmax(2.0 * kinetic, 0.0)) / p["Av"]
-        post = ca.if_else(idx == k + 1, after, post)
+        model_posts.append(after)
+    post = _select(idx, [post], model_posts, model.n_events, [])
     trans = ca.Function(
         "transition", [idx, tau, X, ca.SX(0, 1), P, U], [post, ca.SX(0, 1)],
         ca.event_in(), ca.event_out(),
@@ -486,6 +485,44 @@ def _build_compact(spec: PlantSpec) -> ca.Function:
     opts = _options(spec, trans)
     with _without_event_notice():
         return ca.integrator(f"{_name(spec)}_stop", spec.method, dae, 0.0, [1.0], opts)
+
+
+def _event_indices(model: FrictionModel, k: Any) -> list:
+    """The model events' indices for the transition: ``0 ... n_events - 1``, one expression
+    each; or, if the model has ``on_event_at`` (a symbolic event index, e.g. Maxwell-slip and
+    GMS), the one symbolic index ``k``, so that the transition is one piece of size
+    proportional to the number of events, not to its square."""
+    if not model.n_events:
+        return []
+    return [k] if callable(getattr(model, "on_event_at", None)) else list(range(model.n_events))
+
+
+def model_event(model: FrictionModel, k: Any, z: list, m: list, s: Any, q: Any) -> tuple[list, list]:
+    """The model's state after its event ``k``: ``on_event`` for an integer ``k``, ``on_event_at``
+    for a symbolic one (:func:`_event_indices`)."""
+    return model.on_event(k, z, m, s, q) if isinstance(k, int) else model.on_event_at(k, z, m, s, q)
+
+
+def _select(idx: Any, before: list, model_posts: list, n_events: int, after: list) -> Any:
+    """The state after the event ``idx`` of the transition: ``before[i]`` for ``idx = i``, then the
+    model's ``n_events`` events (one post each, or one post for all of them, see
+    :func:`_event_indices`), then ``after``; the last candidate for any larger ``idx``."""
+    b = len(before)
+    if len(model_posts) == n_events:  # one post per event (or no model events)
+        posts = before + model_posts + after
+        post = posts[-1]
+        for k in range(len(posts) - 2, -1, -1):
+            post = ca.if_else(idx == k, posts[k], post)
+        return post
+    post = model_posts[0]  # one post for every model event
+    if after:
+        tail = after[-1]
+        for k in range(len(after) - 2, -1, -1):
+            tail = ca.if_else(idx == b + n_events + k, after[k], tail)
+        post = ca.if_else(idx < b + n_events, post, tail)
+    for k in range(b - 1, -1, -1):
+        post = ca.if_else(idx == k, before[k], post)
+    return post
 
 
 def _options(spec: PlantSpec, trans: ca.Function) -> dict:

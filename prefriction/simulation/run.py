@@ -17,6 +17,7 @@ from prefriction.simulation.integrator import INTEGRATOR_FAILED, BufferedIntegra
 from prefriction.simulation.feedback import LinearFeedback
 from prefriction.simulation.plant import Layout, PlantSpec
 from prefriction.simulation.rest import Rest
+from prefriction.simulation.reversal_log import ReversalLog
 from prefriction.simulation.state_io import StateIO
 from prefriction.errors import SolverError
 from prefriction.models import Oscillator
@@ -49,7 +50,7 @@ class Run(StateIO, Rest):
         self.f1, self.setup_time, self.mode = integrator(spec, jit)
         self.calls = 0
         self.steps: Optional[int] = 0
-        self.rev: list[tuple] = []  # (t~, x~, F~, W~)
+        self.rev = ReversalLog()  # (t~, x~, F~, W~) per reversal
         self.rev_events: list[int] = []  # model events of the half-cycle ending at each reversal
         self.st: dict = {}  # current state, normalised (set by simulate)
         self.snap = 0.0  # reversal-event coincidence tolerance (e.g. Dahl saturation)
@@ -152,9 +153,9 @@ class Run(StateIO, Rest):
             # call length: K half-cycles as long as the last one, with a margin. A call that
             # stops at its K-th reversal integrates a zero right-hand side to its end, which is
             # cheap but not free; one that ends early is followed by another.
-            rev = self.rev
-            if len(rev) >= 2:
-                chunk = (self.spec.K + 0.6) * (rev[-1][0] - rev[-2][0]) * 1.25
+            times = self.rev.t
+            if len(times) >= 2:
+                chunk = (self.spec.K + 0.6) * (times[-1] - times[-2]) * 1.25
             else:  # about one small cycle (shorter at high speed: F rises over a distance ~1),
                 # doubled while no reversal comes (gross sliding)
                 chunk = 2.0 * math.pi / max(1.0, abs(self.st["v"]))

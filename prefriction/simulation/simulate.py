@@ -235,13 +235,13 @@ def simulate(
         samples = []
         run.advance(t_end_n, n_target)
     if len(run.rev) >= n_target:
-        status, message = 1, f"reached {int(n_target)} reversals at t = {run.rev[int(n_target) - 1][0] * sc.t:.9g} s"
+        status, message = 1, f"reached {int(n_target)} reversals at t = {run.rev.t[int(n_target) - 1] * sc.t:.9g} s"
     else:
         status, message = 0, f"reached t_end = {t_end_si:.9g} s"
     wall = time.perf_counter() - start
 
     n_rev = int(min(len(run.rev), n_target))
-    table, W_r = _reversal_table(run.rev[:n_rev], system, s0, v0, F0)
+    table, W_r = _reversal_table(run.rev.columns(n_rev, writable=True), system, s0, v0, F0, run.sc)
     events = np.array(run.rev_events[:n_rev], dtype=int)
     # after the last reversal: the events up to t_end (a run stopped at its reversal has none)
     total = int(events.sum()) + (int(run.st.get("ne", 0)) if len(run.rev) <= n_rev else 0)
@@ -342,24 +342,43 @@ def _sampled_loop(run: Run, xc0: np.ndarray, t_end: float, n_target: float) -> t
     return samples, u_hist
 
 
-def _reversal_table(rev: list, system: Oscillator, s0: float, v0: float, F0: float) -> tuple[ReversalTable, np.ndarray]:
-    """The reversals ``(t~, x~, F~, W~)`` as a :class:`ReversalTable` in SI, and the input's work
-    over each half-cycle [J]; ``E_p`` is the branch potential (3.9), ``E_d`` the balance (2.10)."""
-    sc = Scales.of(system)
+_ENERGY_BLOCK = 4096  # reversals per branch_energy_of_force call: temporaries of ~2 MB (Dahl: 57 doubles each)
+
+
+def _reversal_table(rev: Union[list, tuple], system: Oscillator, s0: float, v0: float, F0: float,
+                    sc: Optional[Scales] = None) -> tuple[ReversalTable, np.ndarray]:
+    """The reversals as a :class:`ReversalTable` in SI, and the input's work over each
+    half-cycle [J]; ``E_p`` is the branch potential (3.9), ``E_d`` the balance (2.10).
+
+    ``rev``: a list of ``(t~, x~, F~, W~)`` tuples, or the four columns
+    (:meth:`~prefriction.simulation.reversal_log.ReversalLog.columns`; writable columns are
+    converted to SI in place, so that a long run holds them once); ``sc``: the system's scales,
+    if known."""
+    sc = Scales.of(system) if sc is None else sc
     model = system.friction
-    R = np.array(rev, dtype=float).reshape(-1, 4)
-    t_r, x_r, F_r, W_r = R[:, 0] * sc.t, R[:, 1] * sc.x, R[:, 2] * sc.F, R[:, 3] * sc.E
-    s_after = s0 * (-1.0) ** (np.arange(1, len(R) + 1))
+    if isinstance(rev, list):
+        R = np.array(rev, dtype=float).reshape(-1, 4)
+        rev = (R[:, 0], R[:, 1], R[:, 2], R[:, 3])
+    n = len(rev[0])
     if not model.rate_independent:  # no stored branch energy: E_p is not defined (NaN), E_0 kinetic
-        E_p = np.full(len(R), np.nan)
+        E_p = np.full(n, np.nan)
         E0 = 0.5 * system.mass * v0 * v0
-    else:
-        E_p = model.branch_energy_of_force(R[:, 2], s_after) * sc.E if len(R) else np.zeros(0)
-        E0 = 0.5 * system.mass * v0 * v0 + float(model.branch_energy_of_force(np.array([F0 / sc.F]), s0)[0]) * sc.E
-    E_d = np.empty(len(R))
-    if len(R):
+    else:  # the start and every reversal, in blocks (each call costs ~50 us whatever its size)
+        E = np.empty(n + 1)  # the start (F0, s0), then reversal k on the branch s0 (-1)^k
+        for a in range(0, n + 1, _ENERGY_BLOCK):
+            b = min(n + 1, a + _ENERGY_BLOCK)
+            F = rev[2][max(a - 1, 0):b - 1]
+            if a == 0:
+                F = np.concatenate(([F0 / sc.F], F))
+            E[a:b] = model.branch_energy_of_force(F, np.where(np.arange(a, b) % 2 == 0, s0, -s0)) * sc.E
+        E0, E_p = 0.5 * system.mass * v0 * v0 + float(E[0]), E[1:]
+    t_r, x_r, F_r, W_r = (np.multiply(col, unit, out=col if col.flags.writeable else None)
+                          for col, unit in zip(rev, (sc.t, sc.x, sc.F, sc.E)))
+    E_d = np.empty(n)
+    if n:
         E_d[0] = E0 - E_p[0] + W_r[0]
-        E_d[1:] = E_p[:-1] + W_r[1:] - E_p[1:]
+        np.add(E_p[:-1], W_r[1:], out=E_d[1:])
+        E_d[1:] -= E_p[1:]
     return ReversalTable(t=t_r, x=x_r, F=F_r, E_p=E_p, E_d=E_d, E_0=E0), W_r
 
 

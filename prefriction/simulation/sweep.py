@@ -19,7 +19,6 @@ import inspect
 import itertools
 import math
 import sys
-import threading
 import time
 import warnings
 from numbers import Real
@@ -29,6 +28,7 @@ import numpy as np
 
 from prefriction._validation import check_bool, check_choice, check_count, check_finite, check_positive
 from prefriction.models import Oscillator
+from prefriction.simulation.chunks import run_caught, run_chunks
 from prefriction.simulation.feedback import LinearFeedback
 from prefriction.simulation.simulate import METHODS, simulate
 
@@ -40,12 +40,6 @@ MAX_SYSTEMS = 1_000_000
 _PROGRESS_AFTER = 1.0  # automatic progress: show only once the sweep has run this long [s]
 _PROGRESS_EVERY = 0.5  # least interval between two progress lines [s]
 _MAX_LISTED = 10  # failed indices listed in the warning and in summary()
-
-# Runs of the same structure share one compiled integrator and its argument buffers per process
-# (prefriction.simulation.integrator), so two runs must never overlap in one process: threads of
-# a ThreadPoolExecutor or of a multi-threaded dask worker take turns on this lock.
-_RUN_LOCK = threading.Lock()
-
 
 class SweepResult(list):
     """Results of :func:`sweep`: a list with one entry per system, in input order.
@@ -118,6 +112,7 @@ def sweep(
     *,
     executor: Optional[cf.Executor] = None,
     progress: Optional[bool] = None,
+    chunksize: Optional[int] = None,
     **simulate_kwargs: Any,
 ) -> SweepResult:
     """Simulate many oscillators with the same settings, serially or on an executor.
@@ -134,7 +129,9 @@ def sweep(
         :class:`concurrent.futures.Executor` works: ``ProcessPoolExecutor``,
         ``ThreadPoolExecutor`` (correct but no faster than serial: runs in one process take
         turns, since they share compiled integrators), or dask.distributed's
-        ``client.get_executor()`` (a ``Client`` itself is accepted and converted). The first
+        ``client.get_executor()`` (a ``Client`` itself is accepted and converted). The systems
+        go to the executor in chunks (one task per chunk, a few chunks per worker in flight;
+        see ``chunksize``), so the bookkeeping is linear in the number of systems. The first
         system of each structure group runs in the calling process first, so that the compiled
         code is in the disk cache before the workers start (workers on other machines need the
         cache directory ``$PREFRICTION_CACHE`` on a shared file system, or compile once each).
@@ -144,6 +141,11 @@ def sweep(
         ``None`` (default): print a progress line such as ``sweep: 12/40 runs, 3.1 s`` to
         stderr, updated in place every 0.5 s, once the sweep has run for 1 s (short sweeps print
         nothing). ``True``: always print it; ``False``: never.
+    chunksize : int, optional
+        Systems per task on an executor (ignored without one). ``None`` (default): about 8
+        chunks per worker, at most 500 systems each
+        (:func:`prefriction.simulation.chunks.chunk_size`). A larger chunk costs less per
+        system to ship; a smaller one balances the load and updates the progress more often.
     **simulate_kwargs
         Keyword arguments of :func:`prefriction.simulate` for every run, passed unchanged
         (``reversals``, ``t_end``, ``rtol``, ``x0``, ``F0``, ``dense``, ``feedback``, ...).
@@ -165,7 +167,8 @@ def sweep(
         ``method``, ``jit``, ``feedback``).
     ValueError
         Before any run: for no systems, more than :data:`MAX_SYSTEMS`, a ``v0`` sequence whose
-        length differs from the number of systems or that holds a non-finite value, or one of
+        length differs from the number of systems or that holds a non-finite value, a
+        ``chunksize`` below 1, or one of
         those keywords out of its range (``reversals >= 1``; ``t_end``, ``rtol``, ``atol`` > 0;
         ``x0``, ``F0`` finite; ``method`` in :data:`prefriction.simulation.simulate.METHODS`).
 
@@ -220,6 +223,8 @@ def sweep(
     if progress is not None and not isinstance(progress, (bool, np.bool_)):
         raise TypeError(f"progress must be None, True or False, got {_short_repr(progress)} of type "
                         f"{type(progress).__name__}")
+    if chunksize is not None:
+        chunksize = check_count("chunksize", chunksize, 1)
     systems = _check_systems(systems)
     v0s = _check_v0(v0, len(systems))
 
@@ -228,30 +233,16 @@ def sweep(
     bar = _Progress(n, progress, start)
     if executor is None:
         for i in range(n):
-            results[i] = _run_caught(systems[i], v0s[i], kwargs)
+            results[i] = run_caught(systems[i], v0s[i], kwargs)
             bar.update(i + 1)
     else:
-        _run_on(executor, systems, v0s, kwargs, results, bar)
+        _run_on(executor, systems, v0s, kwargs, results, bar, chunksize)
     bar.close(n)
 
     out = SweepResult(results, time.perf_counter() - start)
     if out.failed:
         warnings.warn(_failure_message(out), RuntimeWarning, stacklevel=2)
     return out
-
-
-def _run_one(system: Oscillator, v0: float, kwargs: dict) -> Any:
-    """One :func:`prefriction.simulate` run (module level, so that executors can pickle it)."""
-    with _RUN_LOCK:
-        return simulate(system, v0, **kwargs)
-
-
-def _run_caught(system: Oscillator, v0: float, kwargs: dict) -> Any:
-    """:func:`_run_one`, returning the exception instead of raising it (``Exception`` only)."""
-    try:
-        return _run_one(system, v0, kwargs)
-    except Exception as exc:  # noqa: BLE001 - a failed run is a result of the sweep
-        return exc
 
 
 def _group_key(system: Oscillator, kwargs: dict) -> Hashable:
@@ -288,53 +279,20 @@ def _hashable(value: Any) -> Hashable:
     return value
 
 
-def _run_on(executor: cf.Executor, systems: list, v0s: list, kwargs: dict, results: list, bar: "_Progress") -> None:
-    """Fill ``results`` from ``executor``: the first run of each group here, the others submitted."""
+def _run_on(executor: cf.Executor, systems: list, v0s: list, kwargs: dict, results: list, bar: "_Progress",
+            chunksize: Optional[int]) -> None:
+    """Fill ``results`` from ``executor``: the first run of each group here, the others in chunks."""
     first: dict = {}
     for i, system in enumerate(systems):
         first.setdefault(_group_key(system, kwargs), i)
     warm = sorted(first.values())
-    done = 0
-    for i in warm:  # compile once, in this process, into the disk cache the workers load from
-        results[i] = _run_caught(systems[i], v0s[i], kwargs)
-        done += 1
-        bar.update(done)
+    for k, i in enumerate(warm):  # compile once, in this process, into the disk cache the workers load from
+        results[i] = run_caught(systems[i], v0s[i], kwargs)
+        bar.update(k + 1)
     warm_set = set(warm)
-    futures: dict = {}
-    try:
-        for i in range(len(systems)):
-            if i not in warm_set:
-                futures[executor.submit(_run_one, systems[i], v0s[i], kwargs)] = i
-                bar.update(done)
-        pending = set(futures)
-        if all(isinstance(f, cf.Future) for f in pending):
-            while pending:
-                finished, pending = cf.wait(pending, timeout=_PROGRESS_EVERY, return_when=cf.FIRST_COMPLETED)
-                for f in finished:
-                    results[futures[f]] = _outcome(f)
-                done += len(finished)
-                bar.update(done)
-        else:  # futures of another kind: collect in order
-            for f, i in futures.items():
-                try:
-                    results[i] = f.result()
-                except Exception as exc:  # noqa: BLE001
-                    results[i] = exc
-                done += 1
-                bar.update(done)
-    except BaseException:
-        for f in futures:
-            f.cancel()
-        raise
-
-
-def _outcome(future: cf.Future) -> Any:
-    """Result of a finished future, or its exception (a cancelled run gives ``CancelledError``)."""
-    try:
-        exc = future.exception(timeout=0)
-    except cf.CancelledError as cancelled:
-        return cancelled
-    return exc if exc is not None else future.result(timeout=0)
+    rest = [i for i in range(len(systems)) if i not in warm_set]
+    if rest:
+        run_chunks(executor, rest, systems, v0s, kwargs, results, chunksize, lambda k: bar.update(len(warm) + k))
 
 
 class _Progress:
@@ -415,8 +373,8 @@ def _check_executor(executor: Any) -> Optional[cf.Executor]:
     if executor is None or isinstance(executor, cf.Executor):
         return executor
     get_executor = getattr(executor, "get_executor", None)
-    if callable(get_executor):  # dask.distributed.Client
-        return get_executor()
+    if callable(get_executor):  # dask.distributed.Client: chunks are never the same task twice
+        return get_executor(pure=False)
     if callable(getattr(executor, "submit", None)):
         return executor
     raise TypeError(

@@ -18,12 +18,14 @@ reported separately. Peers integrate the same normalised equations
 (``docs/mathematics.md#normalised-units``), with ``rtol = tol`` and ``atol = tol / 100``. The
 error definition, the cases and the targets are described in ``docs/bench.md``.
 
-``--models``, ``--sweep``, ``--loops`` and ``--compensation`` run other benchmarks instead:
-:mod:`prefriction.cli.bench.models`, :mod:`prefriction.cli.bench.sweep`,
-:mod:`prefriction.cli.bench_loops` and :mod:`prefriction.controllers.compensation_bench`. The modules of this package: ``options`` (the command
+``--models``, ``--sweep``, ``--elements``, ``--loops`` and ``--compensation`` run other benchmarks
+instead: :mod:`prefriction.cli.bench.models`, :mod:`prefriction.cli.bench.sweep`,
+:mod:`prefriction.cli.bench.elements`, :mod:`prefriction.cli.bench_loops` and
+:mod:`prefriction.controllers.compensation_bench`. The modules of this package: ``options`` (the command
 line), ``cases`` (cases, error, reference), ``peers``, ``work_precision`` (headline rows),
 ``stiff`` (stiff and extreme cases), ``reference_rows`` (rows against independent references),
-``restarts`` (scipy DOP853 with restarts), ``costs`` (target 3, exact analytics), ``report``
+``restarts`` (scipy DOP853 with restarts), ``costs`` (target 3, exact analytics),
+``plain_c`` and ``c_reference`` (the plain-C reference, target 4), ``report``
 (tables, CSV, figure), ``verdict`` (targets), ``timing`` (shared timing helpers).
 """
 
@@ -34,6 +36,7 @@ from pathlib import Path
 from typing import Optional
 
 from prefriction.cli.bench import reference_rows
+from prefriction.cli.bench.c_reference import c_available, c_comparison, c_section, c_target
 from prefriction.cli.bench.cases import HEADLINE, LADDER, QUICK_LADDER, Case, reversal_error, stability_cases
 from prefriction.cli.bench.costs import analytics_timing, linear_cost
 from prefriction.cli.bench.models import main as _models_main
@@ -94,6 +97,10 @@ def main(argv: Optional[list[str]] = None) -> int:
         from prefriction.controllers.compensation_bench import main as compensation_main
 
         return compensation_main(["--out", str(args.out)])
+    if args.elements:
+        from prefriction.cli.bench import elements
+
+        return elements.main(args.quick)
     out: Path = args.out
     ladder = QUICK_LADDER if args.quick else LADDER
     repeats = args.repeats or (1 if args.quick else 5)
@@ -102,6 +109,8 @@ def main(argv: Optional[list[str]] = None) -> int:
 
     rows = headline(ladder, repeats, peers=not args.stability, budget=0.5 if args.quick else 4.0)
     print(headline_section(rows))
+    cmp = c_comparison(5 if args.quick else 40) if c_available() else None
+    print(c_section(cmp) if cmp else "\nPlain-C reference: not measured (no C compiler)")
     stab, stab_rows = stability(ladder, n_long, 1e-8)
     print(stiff_section(stab, ladder, n_long))
     checks = reference_rows.run(args.quick)
@@ -114,7 +123,7 @@ def main(argv: Optional[list[str]] = None) -> int:
     print(f"\nOne-time JIT compile (gcc, cached on disk): {comp:.1f} s in this run "
           f"(0 when every integrator was already in the cache)")
     print()
-    lines = targets(rows, stab, t50, tlong, n_long, ladder, checks)
+    lines = targets(rows, stab, t50, tlong, n_long, ladder, checks) + ([c_target(cmp)] if cmp else [])
     for line in lines:
         print(line)
     write_csv(out / "bench.csv", rows + stab_rows)

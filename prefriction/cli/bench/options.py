@@ -33,6 +33,7 @@ examples:
   prefriction bench --repeats 9      more warm repeats per point
   prefriction bench --models         Maxwell-slip, LuGre and GMS against scipy
   prefriction bench --sweep          parameter sweeps in cold and warm processes
+  prefriction bench --elements       Maxwell-slip and GMS compile and cost against the element count
   prefriction bench --loops          compiled PID loop against python-control
   prefriction bench --compensation   PID alone against PID with each friction compensator
                                      (writes compensation_*.png to --out)
@@ -105,7 +106,7 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
     -------
     argparse.Namespace
         ``out`` (pathlib.Path, an existing directory; None with ``--loops``), ``quick``, ``repeats`` (int or None), and at most one of
-        ``stability``, ``models``, ``sweep``, ``loops``, ``compensation`` set.
+        ``stability``, ``models``, ``sweep``, ``elements``, ``loops``, ``compensation`` set.
 
     Raises
     ------
@@ -133,6 +134,9 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
     what.add_argument("--sweep", action="store_true",
                       help="instead: parameter sweeps, compiles and end-to-end time of cold and warm "
                            "processes against scipy DOP853")
+    what.add_argument("--elements", action="store_true",
+                      help="instead: Maxwell-slip and GMS with 3 to 100 elements, compile time and cost "
+                           "per reversal (target: linear in the element count)")
     what.add_argument("--loops", action="store_true",
                       help="instead: the positioning-loop benchmark (python -m prefriction.controllers.benchmark): "
                            "compiled PID loop against python-control, tuning sweep, loop lengths; "
@@ -149,8 +153,8 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
         ap.error("--quick and --repeats do not apply to --compensation")
     if args.export and (args.quick or args.out is not None):
         ap.error("--quick and --out do not apply to --export (it writes no files; its table goes to stdout)")
-    if args.repeats is not None and (args.sweep or args.models):
-        ap.error("--repeats applies to the headline and stability sections, not to --sweep or --models")
+    if args.repeats is not None and (args.sweep or args.models or args.elements):
+        ap.error("--repeats applies to the headline and stability sections, not to --sweep, --models or --elements")
     if args.loops and args.quick:
         ap.error("--quick does not apply to --loops (the loop benchmark has no quick mode; "
                  "python -m prefriction.controllers.benchmark --help lists its sizes)")

@@ -24,8 +24,12 @@ reversal (and at saturation for gamma < 1), at *matched error*: the loosest ``rt
 ``max(1e-8, simulator error)``; the whole sweep is then timed at that ``rtol`` in the parent
 process. Ratios are scipy time over simulator time, both from the same run.
 
+A second section sweeps 1,000 and 10,000 systems serially, on ``ProcessPoolExecutor(2)`` and on
+a dask ``LocalCluster(2 x 1)`` (:mod:`prefriction.cli.bench.sweep.scaling`, target T3).
+
 Modules: ``cases`` (the sweeps, the error), ``child`` (the child process), ``peer`` (the scipy
-peer), ``measure`` (one sweep, cold and warm), ``report`` (table, CSV, targets); the
+peer), ``measure`` (one sweep, cold and warm), ``report`` (table, CSV, targets), ``scaling``
+(the executors' section); the
 Dahl-with-restarts integrator is :mod:`prefriction.cli.bench.restarts`.
 """
 
@@ -45,10 +49,13 @@ from prefriction.cli.bench.sweep.child import ChildRun, run_child, worker
 from prefriction.cli.bench.sweep.measure import SweepRow, measure_case
 from prefriction.cli.bench.sweep.peer import ScipyResult, matched_rtol, scipy_peer
 from prefriction.cli.bench.sweep.report import format_table, match_notes, targets, write_csv
+from prefriction.cli.bench.sweep.scaling import (QUICK_SIZES, SIZES, ScaleRow, format_scaling, measure_scaling,
+                                                 scale_systems, scaling_targets)
 
-__all__ = ["ChildRun", "ScipyResult", "SweepCase", "SweepRow", "exact_tables", "format_table", "main", "match_notes",
-           "matched_rtol", "measure_case", "reversal_error", "run_child", "scipy_peer", "scipy_reversals",
-           "sweep_cases", "targets", "worker", "write_csv"]
+__all__ = ["ChildRun", "ScaleRow", "ScipyResult", "SweepCase", "SweepRow", "exact_tables", "format_scaling",
+           "format_table", "main", "match_notes", "matched_rtol", "measure_case", "measure_scaling", "reversal_error",
+           "run_child", "scale_systems", "scaling_targets", "scipy_peer", "scipy_reversals", "sweep_cases", "targets",
+           "worker", "write_csv"]
 
 
 def main(argv: Optional[list[str]] = None) -> int:
@@ -97,7 +104,11 @@ def main(argv: Optional[list[str]] = None) -> int:
     for note in match_notes(rows):
         print(note)
     print()
-    lines = targets(rows, cases, args.quick)
+    scale = measure_scaling(QUICK_SIZES if args.quick else SIZES)
+    print()
+    print(format_scaling(scale))
+    print()
+    lines = targets(rows, cases, args.quick) + scaling_targets(scale, args.quick)
     for line in lines:
         print(line)
     write_csv(out / "sweep.csv", rows)

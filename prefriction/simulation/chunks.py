@@ -1,0 +1,140 @@
+"""Chunked execution of a sweep on an executor: bookkeeping linear in the number of systems.
+
+:func:`run_chunks` cuts the runs of a :func:`prefriction.sweep` into chunks of consecutive
+systems, submits one task per chunk and keeps at most a few chunks per worker in flight: a
+finished chunk's results are written into place and its future dropped before the next chunk
+is submitted. Waiting on the in-flight futures costs time proportional to their number, which
+is bounded, so a sweep of 10,000 systems costs no more bookkeeping per system than one of 100
+(one future per system cost ``wait(FIRST_COMPLETED)`` 3.3 ms per call at 10,000 pending ones:
+quadratic in the systems, 2.2x slower than serial on two processes).
+
+A run that raises leaves its exception in its place; a chunk whose task fails as a whole (a
+worker that died, a result that cannot be pickled) leaves that exception in each of its places.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import math
+import threading
+from typing import Any, Callable, Optional
+
+from prefriction.models import Oscillator
+from prefriction.simulation.simulate import simulate
+
+__all__ = ["MAX_CHUNK", "chunk_size", "run_chunk", "run_chunks", "worker_count"]
+
+MAX_CHUNK = 500
+"""Most systems per chunk of the automatic chunk size (progress and memory per task stay small)."""
+_CHUNKS_PER_WORKER = 8  # automatic chunk size: about this many chunks per worker (load balance)
+_IN_FLIGHT_PER_WORKER = 3  # chunks submitted ahead per worker: none waits for the parent
+_WAIT = 0.5  # longest wait for a chunk before the progress line is refreshed [s]
+
+# Runs of the same structure share one compiled integrator and its argument buffers per process
+# (prefriction.simulation.integrator), so two runs must never overlap in one process: threads of
+# a ThreadPoolExecutor or of a multi-threaded dask worker take turns on this lock.
+RUN_LOCK = threading.Lock()
+
+
+def run_one(system: Oscillator, v0: float, kwargs: dict) -> Any:
+    """One :func:`prefriction.simulate` run, holding :data:`RUN_LOCK`."""
+    with RUN_LOCK:
+        return simulate(system, v0, **kwargs)
+
+
+def run_caught(system: Oscillator, v0: float, kwargs: dict) -> Any:
+    """:func:`run_one`, returning the exception instead of raising it (``Exception`` only)."""
+    try:
+        return run_one(system, v0, kwargs)
+    except Exception as exc:  # noqa: BLE001 - a failed run is a result of the sweep
+        return exc
+
+
+def run_chunk(systems: list, v0s: list, kwargs: dict) -> list:
+    """The runs of one chunk, in order: each a result or the exception it raised (module level,
+    so that executors can pickle it)."""
+    return [run_caught(system, v0, kwargs) for system, v0 in zip(systems, v0s)]
+
+
+def worker_count(executor: cf.Executor) -> int:
+    """Number of parallel workers of ``executor`` if it tells (process and thread pools: their
+    ``max_workers``; dask's ``ClientExecutor``: the threads of its cluster), else 8."""
+    n = getattr(executor, "_max_workers", None)
+    if isinstance(n, int) and n > 0:
+        return n
+    client = getattr(executor, "_client", None)
+    if client is not None:
+        try:
+            return max(1, sum(client.nthreads().values()))
+        except Exception:  # noqa: BLE001 - only sizes the chunks
+            pass
+    return 8
+
+
+def chunk_size(n: int, workers: int) -> int:
+    """Automatic chunk size: about :data:`_CHUNKS_PER_WORKER` chunks per worker, at most
+    :data:`MAX_CHUNK` systems each, at least 1."""
+    return max(1, min(MAX_CHUNK, math.ceil(n / (workers * _CHUNKS_PER_WORKER))))
+
+
+def run_chunks(executor: cf.Executor, items: list, systems: list, v0s: list, kwargs: dict, results: list,
+               size: Optional[int], update: Callable[[int], None]) -> None:
+    """Run the systems ``items`` (indices into ``systems``) on ``executor`` in chunks of ``size``
+    (None: :func:`chunk_size`) and write each result (or exception) into ``results[i]``.
+
+    At most :data:`_IN_FLIGHT_PER_WORKER` chunks per worker are in flight; ``update(k)`` is
+    called with the number of runs finished so far after each chunk, and at least every 0.5 s.
+    On an exception in the parent (e.g. ``KeyboardInterrupt``) the futures in flight are
+    cancelled and it propagates.
+    """
+    workers = worker_count(executor)
+    size = size or chunk_size(len(items), workers)
+    chunks = [items[k:k + size] for k in range(0, len(items), size)]
+    window = max(2, _IN_FLIGHT_PER_WORKER * workers)
+    pending: dict = {}
+    done = 0
+    next_chunk = 0
+    try:
+        while next_chunk < len(chunks) or pending:
+            while next_chunk < len(chunks) and len(pending) < window:
+                idx = chunks[next_chunk]
+                future = executor.submit(run_chunk, [systems[i] for i in idx], [v0s[i] for i in idx], kwargs)
+                pending[future] = idx
+                next_chunk += 1
+            finished = _wait_some(pending)
+            for future in finished:
+                idx = pending.pop(future)
+                for i, outcome in zip(idx, _outcome(future, len(idx))):
+                    results[i] = outcome
+                done += len(idx)
+            update(done)
+    except BaseException:
+        for future in pending:
+            future.cancel()
+        raise
+
+
+def _wait_some(pending: dict) -> list:
+    """Futures of ``pending`` that are done: those ``concurrent.futures.wait`` returns within
+    :data:`_WAIT` (possibly none); futures of another kind (no ``cf.Future``), the oldest one,
+    waited for."""
+    futures = list(pending)
+    if all(isinstance(f, cf.Future) for f in futures):
+        finished, _ = cf.wait(futures, timeout=_WAIT, return_when=cf.FIRST_COMPLETED)
+        return list(finished)
+    return futures[:1]  # its result() blocks until it is done
+
+
+def _outcome(future: Any, n: int) -> list:
+    """The ``n`` outcomes of a finished chunk: its list of results, or its task's exception ``n``
+    times (a cancelled chunk gives ``CancelledError``)."""
+    try:
+        out = future.result()
+    except BaseException as exc:  # noqa: BLE001 - a failed chunk is a result of the sweep
+        if isinstance(exc, (KeyboardInterrupt, SystemExit)):
+            raise
+        return [exc] * n
+    if not isinstance(out, list) or len(out) != n:
+        exc = RuntimeError(f"a chunk of {n} runs returned {type(out).__name__} instead of {n} results")
+        return [exc] * n
+    return out
