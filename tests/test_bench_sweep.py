@@ -7,6 +7,7 @@ from __future__ import annotations
 import csv
 import dataclasses
 import math
+import shutil
 
 import numpy as np
 import pytest
@@ -29,11 +30,13 @@ def test_worker_against_exact_reversals() -> None:
     assert rep["error"] < 1e-7 and rep["sweep_s"] > 0 and rep["sim_wall_s"] > 0
 
 
-def test_warm_child_process_compiles_nothing(monkeypatch) -> None:
+def test_warm_child_process_compiles_nothing(monkeypatch, tmp_path) -> None:
     """A new process that finds the structure in the cache: no new library, no compile line."""
     monkeypatch.delenv("PREFRICTION_NO_JIT", raising=False)
     worker(SPEC, 0.0)  # the structure is in this process's cache (compiled or loaded)
-    child = run_child(SPEC, cache_dir())
+    # the child gets a copy of the cache: another test worker may compile into the shared one meanwhile
+    private = shutil.copytree(cache_dir(), tmp_path / "cache")
+    child = run_child(SPEC, private)
     assert child.new_libraries == 0 and child.compile_lines == 0
     assert child.report["error"] < 1e-7 and child.report["failed"] == 0
     # a row of warm children: the least time, the most compiles, a failed value (None) is inf
