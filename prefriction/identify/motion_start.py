@@ -1,0 +1,94 @@
+"""Start values of a :class:`Motion` fit from a static least-squares fit of the measured force.
+
+In sliding the friction of a dynamic model is close to its static map, so the record's force
+balance ``u = m a + Fc sign(v) + b v + F_off`` (Coulomb, viscous and offset; ``a``, ``v`` from
+a Savitzky-Golay fit of the positions) is linear in ``m``, ``Fc``, ``b`` and ``F_off``: ordinary
+least squares over the samples that move faster than a tenth of the largest speed gives them
+without any start value. The dynamic fit starts from them, so it never starts where the model
+has no meaning (a negative force level, a NaN).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.signal import savgol_filter
+
+from prefriction.identify.data import Motion
+from prefriction.models.base import FrictionModel
+
+__all__ = ["StaticStart", "derivatives", "static_start", "start_model"]
+
+_WINDOW = 21
+"""Samples of the Savitzky-Golay window (cubic) of the velocity and acceleration estimates."""
+
+
+@dataclass(frozen=True)
+class StaticStart:
+    """Static least-squares estimates from a record: mass [kg] (``None`` if given), Coulomb
+    force [N], viscous coefficient [N s/m] and force offset [N]."""
+
+    mass: float | None
+    Fc: float
+    b: float
+    offset: float
+
+
+def derivatives(t: np.ndarray, x: np.ndarray, window: int = _WINDOW) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Smoothed position [m], velocity [m/s] and acceleration [m/s^2] at the samples (cubic
+    Savitzky-Golay over ``window`` samples, the mean sample interval)."""
+    w = min(window, x.size - (1 - x.size % 2))
+    h = float(np.mean(np.diff(t)))
+    return (savgol_filter(x, w, 3), savgol_filter(x, w, 3, deriv=1, delta=h),
+            savgol_filter(x, w, 3, deriv=2, delta=h))
+
+
+def static_start(data: Motion) -> StaticStart | None:
+    """Least-squares Coulomb + viscous + offset (+ mass if ``data.mass`` is None) of a forced record.
+
+    Returns
+    -------
+    StaticStart or None
+        ``None`` for a free decay (``u = 0``: the force balance has no scale) or when too few
+        samples slide.
+    """
+    if data.free_decay:
+        return None
+    _x, v, a = derivatives(data.t, data.x)
+    moving = np.abs(v) > 0.1 * float(np.max(np.abs(v)))
+    if np.count_nonzero(moving) < 8:
+        return None
+    cols = [np.sign(v), v, np.ones_like(v)]
+    rhs = data.u.copy()
+    if data.mass is None:
+        cols.insert(0, a)
+    else:
+        rhs = rhs - data.mass * a
+    M = np.column_stack(cols)[moving]
+    coef, *_ = np.linalg.lstsq(M, rhs[moving], rcond=None)
+    if data.mass is None:
+        mass, coef = float(coef[0]), coef[1:]
+    else:
+        mass = None
+    return StaticStart(mass, float(coef[0]), float(coef[1]), float(coef[2]))
+
+
+def start_model(model: FrictionModel, fit: StaticStart | None, keep: set[str]) -> FrictionModel:
+    """``model`` with its force level (``Fc``, and ``Fs`` in proportion) and viscous coefficient
+    (``sigma2``) replaced by the static estimates where positive, except the names in ``keep``."""
+    if fit is None:
+        return model
+    names = {p.name for p in type(model).parameters}
+    new: dict[str, float] = {}
+    if "Fc" in names and "Fc" not in keep and fit.Fc > 0.0:
+        new["Fc"] = fit.Fc
+        if "Fs" in names and "Fs" not in keep:
+            new["Fs"] = getattr(model, "Fs") * fit.Fc / model.Fc
+    if "sigma2" in names and "sigma2" not in keep and fit.b > 0.0:
+        new["sigma2"] = fit.b
+    try:
+        return dataclasses.replace(model, **new) if new else model
+    except ValueError:  # e.g. Fs below the new Fc when Fs is kept: start from the user's model
+        return model
