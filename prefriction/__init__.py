@@ -3,7 +3,8 @@
 Public API, re-exported from private modules:
 
 - models (:mod:`prefriction.models`): :class:`FrictionModel` (the protocol), :class:`Dahl`,
-  :class:`MaxwellSlip`, :class:`GMS`, :class:`LuGre`, :class:`Oscillator`, :class:`Parameter`
+  :class:`MaxwellSlip`, :class:`GMS`, :class:`LuGre`, :class:`Viscous`, :class:`Parallel` (``a + b``),
+  :class:`Oscillator`, :class:`Parameter`
 - input signals: :mod:`prefriction.signals` (``Constant``, ``Step``, ``Ramp``, ``Sine``,
   ``Chirp``, ``Samples`` and sums; compiled once per kind)
 - analytics: :mod:`prefriction.dahl` (exact and approximate reversal maps, energies; Dahl only)
@@ -21,7 +22,7 @@ Public API, re-exported from private modules:
 from __future__ import annotations
 
 from prefriction.errors import PrefrictionError, SolverError
-from prefriction.models import GMS, Dahl, FrictionModel, LuGre, MaxwellSlip, Oscillator, Parameter
+from prefriction.models import GMS, Dahl, FrictionModel, LuGre, MaxwellSlip, Oscillator, Parallel, Parameter, Viscous
 from prefriction.reversals import ReversalTable
 from prefriction.units import Scales
 from prefriction.simulation.simulate import SimulationResult, simulate
@@ -40,6 +41,7 @@ __all__ = [
     "LuGre",
     "MaxwellSlip",
     "Oscillator",
+    "Parallel",
     "Parameter",
     "PrefrictionError",
     "ReversalTable",
@@ -47,6 +49,7 @@ __all__ = [
     "SimulationResult",
     "SolverError",
     "SweepResult",
+    "Viscous",
     "controllers",
     "dahl",
     "energy",

@@ -5,7 +5,10 @@
   known force, a free decay included), with Gauss-Newton standard errors and 95 % intervals.
 - :class:`FitResult`: the fitted model, estimates, intervals, correlation, residuals,
   ``report()`` and ``plot()``.
-- :class:`IdentifiabilityWarning`: names a parameter the data cannot identify.
+- :class:`IdentifiabilityWarning`: names a parameter the data cannot identify;
+  :class:`BoundWarning`: an estimate on a bound; :class:`ConvergenceWarning`: a fit that
+  stopped without converging.
+- :class:`Validation`: prediction errors on held-out data (``FitResult.validate``).
 """
 
 from __future__ import annotations
@@ -13,6 +16,8 @@ from __future__ import annotations
 from prefriction.identify.data import ForceDisplacement, Motion
 from prefriction.identify.fit import fit
 from prefriction.identify.result import FitResult
-from prefriction.identify.statistics import IdentifiabilityWarning
+from prefriction.identify.statistics import BoundWarning, ConvergenceWarning, IdentifiabilityWarning
+from prefriction.identify.validation import Validation
 
-__all__ = ["FitResult", "ForceDisplacement", "IdentifiabilityWarning", "Motion", "fit"]
+__all__ = ["BoundWarning", "ConvergenceWarning", "FitResult", "ForceDisplacement", "IdentifiabilityWarning", "Motion",
+           "Validation", "fit"]

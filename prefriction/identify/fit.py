@@ -7,20 +7,28 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from prefriction._validation import check_count, check_positive
+from prefriction._validation import check_bool, check_count, check_positive
 from prefriction.identify.data import ForceDisplacement, Motion
 from prefriction.identify.parameters import ParameterSpace
 from prefriction.identify.result import FitResult
-from prefriction.identify.statistics import IdentifiabilityWarning, gauss_newton
+from prefriction.identify.statistics import (BoundWarning, ConvergenceWarning, IdentifiabilityWarning, at_bounds,
+                                             gauss_newton)
 from prefriction.models.base import FrictionModel
 
 __all__ = ["fit"]
 
+TOL_RANGE = (1e-14, 1e-6)
+"""Allowed solver tolerances: a looser one stops the solver before the estimates settle within a
+fraction of their standard errors (``fit(tol=10)`` stopped at gamma 1.21 for a truth of 1.5)."""
+MAX_ITER = 100_000
+"""Most solver iterations ``max_iter`` may ask for."""
+
 
 def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequence[str] | None = None,
         fixed: Sequence[str] | None = None, bounds: dict[str, tuple[float, float]] | None = None,
-        mass0: float | None = None, reversals: Sequence[float] | None = None, substeps: int | None = None,
-        max_iter: int = 200, tol: float = 1e-10, identifiability_limit: float = 0.5) -> FitResult:
+        offset: bool = False, structures: str = "both", mass0: float | None = None,
+        reversals: Sequence[float] | None = None, substeps: int | None = None, max_iter: int = 200,
+        tol: float = 1e-10, identifiability_limit: float = 0.5) -> FitResult:
     """Fit a friction model's parameters to measured data.
 
     Parameters
@@ -42,8 +50,17 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
         Parameters held at the model's values.
     bounds : dict, optional
         ``{name: (low, high)}`` in the parameter's unit, inside the declared range; the start
-        value must lie inside. Default: the declared range, narrowed to keep the model's
-        structure (Dahl ``gamma``).
+        value must lie inside (a list or tuple is refused: it cannot name the parameters).
+        Default: the declared range, narrowed to keep the model's structure (Dahl ``gamma``).
+    offset : bool, default False
+        Also fit a constant force offset ``"offset"`` [N] (a sensor bias), added to the model's
+        force (:class:`ForceDisplacement`); estimated, with its interval, like any parameter.
+    structures : {"both", "given"}, default "both"
+        For :class:`prefriction.Dahl` with ``gamma`` free and not bounded by ``bounds``:
+        ``"both"`` fits the start model's structure and the other one (``gamma < 1`` started at
+        0.5, or ``gamma >= 1`` started at 1.5; the two use different states), keeps the one with
+        the smaller residual, and says in ``FitResult.notes`` what it compared; ``"given"`` fits
+        the start model's structure only.
     mass0 : float, optional
         Start value of the mass [kg] when ``data.mass`` is ``None`` (the mass is then fitted).
     reversals : sequence of float, optional
@@ -56,9 +73,11 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
         the start values (1 for Maxwell-slip on force-displacement data, where one step is the
         exact stop operator).
     max_iter : int, default 200
-        Most solver iterations (function evaluations for force-displacement data).
+        Most solver iterations (function evaluations for force-displacement data), 1 to 100 000.
+        A fit that stops there returns with ``success = False`` and a :class:`ConvergenceWarning`.
     tol : float, default 1e-10
-        Solver tolerance (relative).
+        Solver tolerance (relative), ``1e-14 <= tol <= 1e-6``: looser tolerances stop before the
+        estimates settle.
     identifiability_limit : float, default 0.5
         Relative standard error above which a parameter is reported as not identifiable.
 
@@ -81,6 +100,11 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
 
     Warns
     -----
+    BoundWarning
+        Naming every estimate that ends on a bound (the declared range, a user bound, or a
+        structure boundary such as Dahl's ``gamma = 1``); its interval starts at the bound.
+    ConvergenceWarning
+        If the solver stops at ``max_iter`` without converging.
     IdentifiabilityWarning
         Naming every parameter the data cannot identify: a relative standard error above
         ``identifiability_limit`` (e.g. ``Fc`` from loops that never leave pre-sliding), or a
@@ -91,7 +115,17 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
     -----
     Standard errors are Gauss-Newton: ``s^2 (J^T J)^-1`` at the optimum with the residual
     variance ``s^2 = |r|^2 / (n - p)``, nuisance variables (initial state, shooting nodes,
-    reversal times) marginalised; see ``docs/identify.md``.
+    reversal times) marginalised; intervals are cut at the allowed range; see
+    ``docs/identify.md``.
+
+    Examples
+    --------
+    >>> import prefriction as pf
+    >>> from prefriction.data import tribometer
+    >>> data = tribometer().window(12.0, 60.0, step=4)
+    >>> res = pf.identify.fit(pf.Dahl(sigma=4e4, Fc=2.4, gamma=0.5), data, offset=True)
+    >>> res.estimate("offset") > 0.0
+    True
     """
     if not isinstance(model, FrictionModel):
         raise TypeError(f"model must be a prefriction.FrictionModel (e.g. prefriction.Dahl), got {model!r} "
@@ -102,10 +136,19 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
         substeps = check_count("substeps", substeps, 1)
         if substeps > 64:
             raise ValueError(f"substeps must be an integer in [1, 64], got {substeps}")
-    max_iter = check_count("max_iter", max_iter, 1)
+    max_iter = check_count("max_iter", max_iter, 1, MAX_ITER, "solver iterations")
     tol = check_positive("tol", tol)
+    if not TOL_RANGE[0] <= tol <= TOL_RANGE[1]:
+        raise ValueError(f"tol must be in [{TOL_RANGE[0]:g}, {TOL_RANGE[1]:g}], got {tol!r}: a looser tolerance "
+                         f"stops the solver before the estimates settle, a tighter one is below rounding")
     limit = check_positive("identifiability_limit", identifiability_limit)
+    offset = check_bool("offset", offset)
+    if structures not in ("both", "given"):
+        raise ValueError(f"structures must be 'both' or 'given', got {structures!r}")
     if isinstance(data, Motion):
+        if offset:
+            raise ValueError("offset=True is for ForceDisplacement data: a Motion fit has no measured force to offset "
+                             "(allowed: offset=False)")
         return _fit_motion(model, data, free, fixed, bounds, mass0, reversals, substeps, max_iter, tol, limit)
     if reversals is not None:
         raise ValueError("reversals is for Motion data; force-displacement data have their directions from dx "
@@ -113,15 +156,34 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
     if mass0 is not None:
         raise ValueError(f"mass0 = {mass0!r} is for Motion data with a free mass; force-displacement data "
                          f"involve no mass (allowed: mass0=None)")
+    from prefriction.identify.structures import fit_structures, gamma_entry
+
+    scale = float(np.std(data.F)) if offset else None
+
+    def one(start: FrictionModel) -> FitResult:
+        return _fit_prescribed(start, data, free, fixed, bounds, scale, substeps, max_iter, tol, limit)
+
+    gamma = gamma_entry(model) if structures == "both" else None
+    if gamma is not None and not (
+            (free is None or gamma in ([free] if isinstance(free, str) else list(free)))
+            and gamma not in ([fixed] if isinstance(fixed, str) else list(fixed or []))
+            and not (isinstance(bounds, dict) and gamma in bounds)):
+        gamma = None  # gamma held, or bounded to one side by the user
+    return fit_structures(model, one, compare=gamma)
+
+
+def _fit_prescribed(model: FrictionModel, data: ForceDisplacement, free: Any, fixed: Any, bounds: Any,
+                    offset: float | None, substeps: int | None, max_iter: int, tol: float, limit: float) -> FitResult:
     from prefriction.identify.prescribed import fit_prescribed
 
-    space = ParameterSpace(model, free, fixed, bounds)
+    space = ParameterSpace(model, free, fixed, bounds, offset=offset)
     sol = fit_prescribed(model, data, space, n_sub=substeps, max_iter=max_iter, tol=tol)
     values = space.values(sol.w[:-1])
     est = np.array([values[n] for n in space.free])
     stats = gauss_newton(sol.jacobian, sol.residuals, space.free, est, space.scale, limit=limit)
     nuisance = {"initial force F0 [N]": float(sol.prediction[0])}
-    return _finish(space, values, est, stats, -sol.residuals, sol.prediction, data, None, nuisance, sol.message)
+    return _finish(space, values, est, stats, -sol.residuals, sol.prediction, data, None, nuisance, sol.message,
+                   sol.success, level=6)
 
 
 def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bounds: Any, mass0: Any, reversals: Any,
@@ -143,16 +205,29 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
     stats = gauss_newton(sol.jacobian, sol.residuals, space.free, est, space.scale,
                          constraints=sol.constraints, limit=limit)
     mass = values["mass"] if data.mass is None else data.mass
-    return _finish(space, values, est, stats, -sol.residuals, sol.prediction, data, mass, sol.nuisance, sol.message)
+    return _finish(space, values, est, stats, -sol.residuals, sol.prediction, data, mass, sol.nuisance, sol.message,
+                   getattr(sol, "success", True))
 
 
 def _finish(space: ParameterSpace, values: dict, est: np.ndarray, stats: Any, residuals: np.ndarray,
-            fitted: np.ndarray, data: Any, mass: float | None, nuisance: dict, message: str) -> FitResult:
+            fitted: np.ndarray, data: Any, mass: float | None, nuisance: dict, message: str,
+            success: bool = True, level: int = 4) -> FitResult:
     fitted_model = space.build(values)
     for name, why in stats.unidentifiable:
         warnings.warn(f"the data cannot identify {name}: {why}; its interval is meaningless. Fix it (fixed=[{name!r}]) "
                       f"or record data that excite it (docs/identify.md#identifiability)",
-                      IdentifiabilityWarning, stacklevel=3)
+                      IdentifiabilityWarning, stacklevel=level)
+    low, high, flags = at_bounds(space.free, est, stats.low, stats.high, space.scale, space.low, space.high,
+                                 space.why_low, space.why_high)
+    for name, value, flag in zip(space.free, est, flags):
+        if flag.startswith("on its"):
+            what = "the bound" if "structure" not in flag else "the bound: fit the other structure"
+            warnings.warn(f"{name} = {value:.6g} ends {flag}: the data may want a value beyond it; widen {what} "
+                          f"(docs/identify.md#bounds)", BoundWarning, stacklevel=level)
+    if not success:
+        warnings.warn(f"the fit of {type(fitted_model).__name__} did not converge: {message}; the estimates are where "
+                      f"the solver stopped (raise max_iter, or give better start values)", ConvergenceWarning,
+                      stacklevel=level)
     return FitResult(fitted_model, mass, tuple(space.free), tuple(space.units[n] for n in space.free), est,
-                     stats.stderr, stats.low, stats.high, stats.correlation, residuals, fitted, data, stats,
-                     nuisance, message)
+                     stats.stderr, low, high, stats.correlation, residuals, fitted, data, stats,
+                     nuisance, message, success=success, flags=flags)

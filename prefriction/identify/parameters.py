@@ -12,11 +12,12 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
-from typing import Any, Sequence
+from typing import Any, Mapping, Sequence
 
 import casadi as ca
 import numpy as np
 
+from prefriction._validation import check_positive
 from prefriction.models.base import FrictionModel, Parameter
 
 __all__ = ["ParameterSpace", "symbolic_units"]
@@ -34,9 +35,17 @@ class _Entry:
     value: float
     low: float
     high: float
+    part: int | None = None
+    local: str = ""
 
 
 def _entries(model: FrictionModel) -> list[_Entry]:
+    from prefriction.models.parallel import Parallel, qualified_names
+
+    if isinstance(model, Parallel):  # a sum: each model's entries under its names in the sum
+        names = qualified_names(model.models)
+        return [dataclasses.replace(e, name=names[i][j], part=i, local=e.name)
+                for i, m in enumerate(model.models) for j, e in enumerate(_entries(m))]
     out = []
     for par in type(model).parameters:
         val = getattr(model, par.name)
@@ -63,6 +72,16 @@ def _structure_range(model: FrictionModel, par: Parameter, value: float) -> tupl
     return low, high
 
 
+def _structure_bound(model: FrictionModel, name: str, value: float) -> tuple[str, str]:
+    """What each end of ``name``'s range is: the declared range or a structure boundary."""
+    from prefriction.models.dahl import Dahl
+
+    if isinstance(model, Dahl) and name == "gamma":
+        side = "the Dahl structure boundary gamma = 1 (gamma >= 1 and gamma < 1 use different states)"
+        return (side, "the declared range") if value >= 1.0 else ("the declared range", side)
+    return "the declared range", "the declared range"
+
+
 class ParameterSpace:
     """Which of a model's parameters (and the mass) a fit moves, their start values and bounds.
 
@@ -79,6 +98,9 @@ class ParameterSpace:
     mass : float or None
         Start value [kg] of a fitted mass (``"mass"`` becomes a free entry); ``None`` if the mass
         is known or not involved.
+    offset : float or None
+        Scale [N] of a fitted force offset (``"offset"`` becomes a free entry, started at 0 and
+        moved as ``offset / scale``); ``None`` for no offset.
 
     Raises
     ------
@@ -88,11 +110,13 @@ class ParameterSpace:
     """
 
     def __init__(self, model: FrictionModel, free: Sequence[str] | None, fixed: Sequence[str] | None,
-                 bounds: dict | None, mass: float | None = None) -> None:
+                 bounds: dict | None, mass: float | None = None, offset: float | None = None) -> None:
         self.model = model
         entries = _entries(model)
         if mass is not None:
             entries.append(_Entry("mass", "mass", None, "kg", float(mass), _OPEN * float(mass), math.inf))
+        if offset is not None:
+            entries.append(_Entry("offset", "offset", None, "N", 0.0, -math.inf, math.inf))
         self.entries = entries
         names = [e.name for e in entries]
         free_l = _names("free", free, names, model)
@@ -102,8 +126,9 @@ class ParameterSpace:
             raise ValueError(f"free and fixed both name {both}: a parameter is either fitted or held")
         if free_l is None:
             free_l = [n for n in names if n not in set(fixed_l or [])]
-        if mass is not None and "mass" not in free_l and "mass" not in (fixed_l or []):
-            free_l.append("mass")
+        for extra in ("mass", "offset"):
+            if extra in names and extra not in free_l and extra not in (fixed_l or []):
+                free_l.append(extra)
         if not free_l:
             raise ValueError(f"no parameter left to fit: free = {free!r}, fixed = {fixed!r} (allowed names: {names})")
         self.free = [n for n in names if n in set(free_l)]
@@ -112,10 +137,18 @@ class ParameterSpace:
         self.high = {e.name: e.high for e in entries}
         self.start = {e.name: e.value for e in entries}
         self.units = {e.name: e.unit for e in entries}
-        for name, lim in (bounds or {}).items():
+        self._scale = {e.name: e.value for e in entries}
+        if offset is not None:
+            self._scale["offset"] = check_positive("offset scale", offset)
+        self.why_low, self.why_high = {}, {}
+        parts = getattr(model, "models", ())
+        for e in entries:
+            owner = parts[e.part] if e.part is not None else model
+            self.why_low[e.name], self.why_high[e.name] = _structure_bound(owner, e.local or e.name, e.value)
+        for name, lim in _bound_items(bounds):
             self._set_bound(name, lim, names)
         for name in self.free:
-            if self.start[name] == 0.0:
+            if self._scale[name] == 0.0:
                 raise ValueError(f"the start value of {name} is 0: a fitted parameter needs a non-zero start "
                                  f"value (its scale); give the model a small positive {name}")
 
@@ -132,7 +165,10 @@ class ParameterSpace:
                              f"[{self.units[name]}] (the declared range)")
         if not lo <= self.start[name] <= hi:
             raise ValueError(f"bounds[{name!r}] = {lim!r} must contain the start value {self.start[name]!r}")
-        self.low[name], self.high[name] = lo, hi
+        if lo > e_lo:
+            self.low[name], self.why_low[name] = lo, "the user bound"
+        if hi < e_hi:
+            self.high[name], self.why_high[name] = hi, "the user bound"
 
     # ------------------------------------------------------------------ vectors
     @property
@@ -141,11 +177,17 @@ class ParameterSpace:
 
     @property
     def scale(self) -> np.ndarray:
-        """Start values of the free entries: the fit moves ``theta = p / p_start``."""
-        return np.array([self.start[n] for n in self.free])
+        """Scales of the free entries (their start values; the offset's force scale): the fit
+        moves ``theta = p / scale``."""
+        return np.array([self._scale[n] for n in self.free])
+
+    @property
+    def theta0(self) -> np.ndarray:
+        """The scaled start values ``p_start / scale`` (1, or 0 for the offset)."""
+        return np.array([self.start[n] for n in self.free]) / self.scale
 
     def theta_bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        """Bounds of the scaled free entries ``p / p_start``."""
+        """Bounds of the scaled free entries ``p / scale``."""
         sc = self.scale
         lo = np.array([self.low[n] for n in self.free]) / sc
         hi = np.array([self.high[n] for n in self.free]) / sc
@@ -158,7 +200,7 @@ class ParameterSpace:
         """Physical values by name from the scaled free entries and the fixed values (symbols)."""
         out = {}
         for i, n in enumerate(self.free):
-            out[n] = theta[i] * self.start[n]
+            out[n] = theta[i] * self._scale[n]
         for i, n in enumerate(self.fixed):
             out[n] = fixed[i]
         return out
@@ -167,7 +209,7 @@ class ParameterSpace:
         """Physical values by name of the scaled free entries ``theta`` (fixed ones at start)."""
         out = dict(self.start)
         for i, n in enumerate(self.free):
-            out[n] = float(theta[i]) * self.start[n]
+            out[n] = float(theta[i]) * self._scale[n]
         return out
 
     def build(self, values: dict[str, float]) -> FrictionModel:
@@ -178,20 +220,41 @@ class ParameterSpace:
         ValueError
             If the model rejects the values (e.g. LuGre with ``Fs < Fc``); the message says so.
         """
-        kwargs: dict[str, Any] = {}
-        for e in self.entries:
-            if e.field == "mass":
-                continue
-            if e.index is None:
-                kwargs[e.field] = values[e.name]
-            else:
-                kwargs.setdefault(e.field, np.array(getattr(self.model, e.field), dtype=float).copy())
-                kwargs[e.field][e.index] = values[e.name]
         try:
-            return dataclasses.replace(self.model, **kwargs)
+            return _build(self.model, [e for e in self.entries if e.field not in ("mass", "offset")], values)
         except ValueError as exc:
             raise ValueError(f"the fitted values do not make a valid {type(self.model).__name__}: {exc}; "
                              f"bound the parameters (bounds=...) or fix some (fixed=...)") from exc
+
+
+def _bound_items(bounds: Any) -> list[tuple[str, Any]]:
+    """The ``(name, (low, high))`` pairs of ``bounds``, which must be a mapping."""
+    if bounds is None:
+        return []
+    if not isinstance(bounds, Mapping):
+        raise TypeError(f"bounds must be a dict {{name: (low, high)}} in the parameters' units, e.g. "
+                        f"bounds={{'sigma': (1e3, 1e6)}}, got {bounds!r} of type {type(bounds).__name__} "
+                        f"(a list cannot say which parameter each pair bounds)")
+    return list(bounds.items())
+
+
+def _build(model: FrictionModel, entries: list[_Entry], values: dict[str, float]) -> FrictionModel:
+    """A model of ``model``'s class (a sum: of each term's class) with the entries' ``values``."""
+    from prefriction.models.parallel import Parallel
+
+    if isinstance(model, Parallel):
+        return Parallel(tuple(
+            _build(m, [dataclasses.replace(e, name=e.local, part=None) for e in entries if e.part == i],
+                   {e.local: values[e.name] for e in entries if e.part == i})
+            for i, m in enumerate(model.models)))
+    kwargs: dict[str, Any] = {}
+    for e in entries:
+        if e.index is None:
+            kwargs[e.field] = values[e.name]
+        else:
+            kwargs.setdefault(e.field, np.array(getattr(model, e.field), dtype=float).copy())
+            kwargs[e.field][e.index] = values[e.name]
+    return dataclasses.replace(model, **kwargs)
 
 
 def _names(arg: str, value: Any, names: list[str], model: FrictionModel) -> list[str] | None:
@@ -242,7 +305,14 @@ def symbolic_units(model: FrictionModel, values: dict[str, Any], mass: Any) -> t
         symbols (it uses ``math`` functions on its numbers).
     """
     from prefriction.models.maxwell_slip import MaxwellSlip
+    from prefriction.models.parallel import Parallel
 
+    if isinstance(model, Parallel):  # each term in its own units, composed (Parallel.compose)
+        entries = _entries(model)
+        units = [symbolic_units(m, {e.local: values[e.name] for e in entries if e.part == i}, mass)
+                 for i, m in enumerate(model.models)]
+        sigma, Fc, q = model.compose(units)
+        return sigma, Fc, ca.vertcat(*q)
     fields: dict[str, Any] = {}
     for par in type(model).parameters:
         val = getattr(model, par.name)

@@ -112,7 +112,7 @@ class PrescribedProblem:
         s_prev = ca.horzcat(s_v, rows[2, : n - 2]) if n > 2 else s_v
         run = step.mapaccum("run", n - 1)
         _X, F_rest = run(X, rows[0, :] / V, rows[1, :] / T, s_prev, rows[2, :], rows[4, :] / V, q)
-        F_model = Fc * ca.vertcat(F0, F_rest.T)
+        F_model = Fc * ca.vertcat(F0, F_rest.T) + values.get("offset", 0.0)  # force offset [N], if fitted
         r = F_model - F_data
         args = [w, scale, fixed, rows, v_end0, v_ref, F_data]
         self.residual = ca.Function("residual", args, [r])
@@ -139,7 +139,7 @@ def _start_d0(problem: PrescribedProblem, space: ParameterSpace, series: _Series
     args = _inputs(space, series, data)
 
     def f0(d: float) -> float:
-        w = np.append(np.ones(space.n_free), d)
+        w = np.append(space.theta0, d)
         return float(problem.force(w, *args)[0]) - float(data.F[0])
 
     lo, hi = -30.0, 30.0
@@ -160,17 +160,20 @@ class PrescribedSolution:
     prediction: np.ndarray
     nfev: int
     message: str
+    success: bool
 
 
 def fit_prescribed(model: FrictionModel, data: ForceDisplacement, space: ParameterSpace, *,
                    n_sub: int | None, max_iter: int, tol: float) -> PrescribedSolution:
     """Least-squares fit of ``space``'s free parameters to ``data`` (trust-region reflective).
 
+    A run that reaches ``max_iter`` evaluations returns with ``success = False``.
+
     Raises
     ------
     prefriction.SolverError
-        If the model's force is not finite at the start values, or the solver stops without
-        converging; the message names the parameters reached and what to try.
+        If the model's force is not finite at the start values or at the end; the message
+        names the parameters reached and what to try.
     """
     from prefriction.errors import SolverError
 
@@ -179,7 +182,7 @@ def fit_prescribed(model: FrictionModel, data: ForceDisplacement, space: Paramet
     series = _Series.of(data)
     args = _inputs(space, series, data)
     d0 = _start_d0(problem, space, series, data)
-    w0 = np.append(np.ones(space.n_free), d0)
+    w0 = np.append(space.theta0, d0)
     lo, hi = space.theta_bounds()
     lo, hi = np.append(lo, -50.0), np.append(hi, 50.0)
 
@@ -196,10 +199,12 @@ def fit_prescribed(model: FrictionModel, data: ForceDisplacement, space: Paramet
                           f"x = {data.x[i]!r} m); give start values closer to the data or more substeps")
     sol = least_squares(fun, w0, jac=jac, bounds=(lo, hi), method="trf", x_scale="jac",
                         xtol=tol, ftol=tol, gtol=tol, max_nfev=max_iter)
-    if sol.status <= 0 or not np.all(np.isfinite(sol.fun)):
+    if sol.status < 0 or not np.all(np.isfinite(sol.fun)):
         vals = space.values(sol.x[:-1])
-        raise SolverError(f"the least-squares fit did not converge ({sol.message}) after {sol.nfev} evaluations, "
+        raise SolverError(f"the least-squares fit failed ({sol.message}) after {sol.nfev} evaluations, "
                           f"at {', '.join(f'{n} = {vals[n]:.6g}' for n in space.free)}; try other start values, "
-                          f"bounds, fixing a parameter or max_iter > {max_iter}")
+                          f"bounds, fixing a parameter or more substeps")
     pred = np.asarray(problem.force(sol.x, *args)).ravel()
-    return PrescribedSolution(sol.x, sol.fun.copy(), jac(sol.x), pred, int(sol.nfev), str(sol.message))
+    message = str(sol.message) if sol.status > 0 else (
+        f"stopped without converging after {sol.nfev} evaluations (max_iter = {max_iter}): {sol.message}")
+    return PrescribedSolution(sol.x, sol.fun.copy(), jac(sol.x), pred, int(sol.nfev), message, sol.status > 0)

@@ -4,12 +4,17 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from prefriction.identify.data import ForceDisplacement, Motion
 from prefriction.identify.statistics import Statistics
+from prefriction.identify.validation import model_name
 from prefriction.models.base import FrictionModel
+
+if TYPE_CHECKING:
+    from prefriction.identify.validation import Validation
 
 __all__ = ["FitResult"]
 
@@ -29,7 +34,8 @@ class FitResult:
     units : tuple of str
         Their units.
     estimates, stderr, low, high : numpy.ndarray
-        Estimates, standard errors and 95 % confidence intervals (t quantile), physical units.
+        Estimates, standard errors and 95 % confidence intervals (t quantile), physical units;
+        an interval is cut where it would leave the allowed range (see :attr:`flags`).
     correlation : numpy.ndarray
         Correlation matrix of the estimates.
     residuals : numpy.ndarray
@@ -44,6 +50,13 @@ class FitResult:
         Other fitted quantities (initial state, reversal times), by name.
     message : str
         The solver's message.
+    success : bool
+        False if the solver stopped without converging (a :class:`ConvergenceWarning` said so).
+    flags : tuple of str
+        Per parameter: ``""``, or which bound it ends on (interval one-sided) or where its
+        interval was cut.
+    notes : tuple of str
+        What the fit compared (both Dahl structures) and other remarks.
     """
 
     model: FrictionModel
@@ -61,6 +74,9 @@ class FitResult:
     statistics: Statistics
     nuisance: dict = field(default_factory=dict)
     message: str = ""
+    success: bool = True
+    flags: tuple[str, ...] = ()
+    notes: tuple[str, ...] = ()
 
     @property
     def unidentifiable(self) -> tuple[str, ...]:
@@ -98,21 +114,69 @@ class FitResult:
         """Root mean square of the residuals."""
         return float(np.sqrt(np.mean(self.residuals**2)))
 
+    def predict(self, data: ForceDisplacement | Motion, **kwargs: Any) -> np.ndarray:
+        """The fitted model's output on another record of the data's kind (validation).
+
+        Parameters
+        ----------
+        data : ForceDisplacement or Motion
+            The record: force [N] along its ``x`` for :class:`ForceDisplacement` (the fitted
+            offset added), position [m] for :class:`Motion`.
+        **kwargs
+            ``F0`` [N] for :class:`ForceDisplacement`: the force at the first sample that sets
+            the initial state (default: the first measured force); see
+            :func:`prefriction.identify.validation.predict`.
+
+        Returns
+        -------
+        numpy.ndarray
+            The prediction at the record's samples.
+        """
+        from prefriction.identify.validation import predict
+
+        return predict(self, data, **kwargs)
+
+    def validate(self, data: ForceDisplacement | Motion, **kwargs: Any) -> "Validation":
+        """Prediction errors on another record: rms, NRMSE and fit % (``docs/identify.md#validate``).
+
+        Parameters
+        ----------
+        data : ForceDisplacement or Motion
+            A held-out record of the kind fitted.
+        **kwargs
+            ``F0`` and ``skip`` [s] (the first seconds not scored);
+            see :func:`prefriction.identify.validation.validate`.
+
+        Returns
+        -------
+        Validation
+            ``rms``, ``nrmse``, ``fit_percent``, ``summary()``, ``plot(path)``.
+        """
+        from prefriction.identify.validation import validate
+
+        return validate(self, data, **kwargs)
+
     def __repr__(self) -> str:
         est = ", ".join(f"{n}={v:.4g}+-{s:.2g}" for n, v, s in zip(self.names, self.estimates, self.stderr))
-        return f"FitResult({type(self.model).__name__}: {est}; rms {self.rms:.3g}, {len(self.residuals)} samples)"
+        tail = "" if self.success else ", NOT CONVERGED"
+        return f"FitResult({model_name(self.model)}: {est}; rms {self.rms:.3g}, {len(self.residuals)} samples{tail})"
 
     def summary(self) -> str:
         """A few lines: the fitted model, the residual level and any unidentifiable parameter."""
         st = self.statistics
         unit = "N" if isinstance(self.data, ForceDisplacement) else "m"
-        lines = [f"{type(self.model).__name__} fitted to {len(self.residuals)} samples of "
+        lines = [f"{model_name(self.model)} fitted to {len(self.residuals)} samples of "
                  f"{type(self.data).__name__}: residual sd {st.sigma_hat:.4g} {unit}, {st.dof} dof"]
-        for n, u, v, lo, hi in zip(self.names, self.units, self.estimates, self.low, self.high):
-            lines.append(f"  {n:<14} {v:< 12.6g} [{lo:.6g}, {hi:.6g}] {u}")
+        for i, (n, u, v, lo, hi) in enumerate(zip(self.names, self.units, self.estimates, self.low, self.high)):
+            lines.append(f"  {n:<14} {v:< 12.6g} [{lo:.6g}, {hi:.6g}] {u}" + self._flag(i, "  "))
         for n, why in st.unidentifiable:
             lines.append(f"  not identifiable: {n} ({why})")
+        if not self.success:
+            lines.append(f"  NOT CONVERGED: {self.message}")
         return "\n".join(lines)
+
+    def _flag(self, i: int, sep: str) -> str:
+        return f"{sep}({self.flags[i]})" if i < len(self.flags) and self.flags[i] else ""
 
     def report(self) -> str:
         """A table of estimates, standard errors, 95 % intervals and relative errors, the
@@ -122,7 +186,8 @@ class FitResult:
         rows = [head, "-" * len(head)]
         for n, u, v, s, lo, hi in zip(self.names, self.units, self.estimates, self.stderr, self.low, self.high):
             rel = s / abs(v) if v else np.inf
-            rows.append(f"{n:<14} {u:<6} {v:>13.6g} {s:>11.3g} {100 * rel:>7.3g}%   [{lo:.6g}, {hi:.6g}]")
+            rows.append(f"{n:<14} {u:<6} {v:>13.6g} {s:>11.3g} {100 * rel:>7.3g}%   [{lo:.6g}, {hi:.6g}]"
+                        + self._flag(len(rows) - 2, "  "))
         rows.append("")
         rows.append("correlation:")
         width = max(len(n) for n in self.names)
@@ -142,7 +207,8 @@ class FitResult:
                 rows.append(f"NOT IDENTIFIABLE from these data: {n} ({why})")
         else:
             rows.append("every fitted parameter is identifiable from these data")
-        rows.append(f"solver: {self.message}")
+        rows.extend(self.notes)
+        rows.append(f"solver: {self.message}" if self.success else f"NOT CONVERGED: {self.message}")
         return "\n".join(rows)
 
     def plot(self, path: str | Path = "fit.png", *, show: bool = False) -> Path:
@@ -164,7 +230,7 @@ class FitResult:
 
         d = self.data
         fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7.0, 6.5), height_ratios=[2.2, 1.0], layout="constrained")
-        name = type(self.model).__name__
+        name = model_name(self.model)
         if isinstance(d, ForceDisplacement):
             ax1.plot(d.x * 1e6, d.F, ".", ms=3, color="0.55", label="data")
             ax1.plot(d.x * 1e6, self.fitted, "-", lw=1.2, color="C0", label=f"fitted {name}")

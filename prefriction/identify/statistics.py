@@ -17,7 +17,7 @@ import numpy as np
 from scipy.linalg import null_space
 from scipy.stats import t as student_t
 
-__all__ = ["IdentifiabilityWarning", "Statistics", "gauss_newton"]
+__all__ = ["BoundWarning", "ConvergenceWarning", "IdentifiabilityWarning", "Statistics", "at_bounds", "gauss_newton"]
 
 SINGULAR = 1e-12
 """Eigenvalue of the Jacobi-scaled ``N^T J^T J N`` (relative to the largest) below which a
@@ -135,3 +135,53 @@ def gauss_newton(J: np.ndarray, r: np.ndarray, names: list[str], estimates: np.n
     cond = float(top / lam[0]) if lam[0] > 0 else np.inf
     return Statistics(se, estimates - tq * se, estimates + tq * se, corr, float(np.sqrt(s2)), dof, cond,
                       tuple((n_, reasons[n_]) for n_ in names if n_ in reasons))
+
+
+class BoundWarning(UserWarning):
+    """A fitted parameter ended on a bound of its allowed range (declared, user or structure
+    bound): the optimum may lie beyond it, and its interval is cut at the bound."""
+
+
+class ConvergenceWarning(UserWarning):
+    """The fit stopped without converging (``FitResult.success`` is False)."""
+
+
+def at_bounds(names: list[str], estimates: np.ndarray, low: np.ndarray, high: np.ndarray, scale: np.ndarray,
+              lower: dict[str, float], upper: dict[str, float], why_low: dict[str, str],
+              why_high: dict[str, str]) -> tuple[np.ndarray, np.ndarray, tuple[str, ...]]:
+    """Intervals cut to the allowed range and a note per parameter on a bound or cut.
+
+    An estimate within ``1e-6`` of its scale (or of the bound) of a bound is on it. Its interval is
+    one-sided: it starts at the bound. An interval that reaches past a bound is cut there.
+
+    Parameters
+    ----------
+    names : list of str
+        Parameter names.
+    estimates, low, high, scale : numpy.ndarray
+        Estimates, 95 % interval ends and scales (physical units).
+    lower, upper : dict
+        The allowed range of each name.
+    why_low, why_high : dict
+        What each end of the range is (``"the declared range"``, ``"the user bound"``, a structure
+        boundary).
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray, tuple of str)
+        Cut interval ends and a note per parameter (``""`` when neither on a bound nor cut).
+    """
+    lo_out, hi_out, notes = low.copy(), high.copy(), []
+    for i, n in enumerate(names):
+        a, b = lower[n], upper[n]
+        note = ""
+        for side, bound, why in (("lower", a, why_low[n]), ("upper", b, why_high[n])):
+            if np.isfinite(bound) and abs(estimates[i] - bound) <= 1e-6 * max(abs(scale[i]), abs(bound)):
+                note = f"on its {side} bound {bound:.6g} ({why}); interval one-sided"
+        if not note and (low[i] < a or high[i] > b):
+            cut = a if low[i] < a else b
+            which = why_low[n] if low[i] < a else why_high[n]
+            note = f"interval cut at {cut:.6g} ({which})"
+        lo_out[i], hi_out[i] = max(low[i], a), min(high[i], b)
+        notes.append(note)
+    return lo_out, hi_out, tuple(notes)

@@ -186,6 +186,28 @@ class FrictionModel(ABC):
         ``snap`` of zero at the reversal may be taken as coinciding with it.
         """
 
+    def advance(self, z: Sequence[Any], m: Sequence[Any], v: Any, dt: Any, s: Any,
+                q: Any) -> Optional[tuple[list[Any], list[Any]]]:
+        """Exact state after ``dt`` time units at the constant velocity ``v`` on a branch of
+        direction ``s`` (floats and CasADi ``SX`` alike), in-branch events included.
+
+        The optional hook of :func:`prefriction.friction_along` and the force-displacement fit
+        (:func:`prefriction.identify.stepping.interval_function`): a closed form over one
+        sample interval of a prescribed piecewise-linear motion. Every event that falls inside
+        the interval is applied where it occurs (``docs/along.md#exact-steps``). ``None`` (the
+        default): the interval is integrated with Runge-Kutta sub-steps instead.
+        """
+        return None
+
+    def __add__(self, other: "FrictionModel") -> "FrictionModel":
+        """``a + b``: the models in parallel (forces summed, each with its own state),
+        :class:`prefriction.Parallel`."""
+        from prefriction.models.parallel import Parallel
+
+        if not isinstance(other, FrictionModel):
+            return NotImplemented
+        return Parallel.of(self, other)
+
     def free_branch(self, z: Sequence[float], m: Sequence[float], v: float, s: float, q: Any,
                     horizon: float) -> Optional[tuple[float, float, list[float], list[float], float, int]]:
         """Closed-form unforced motion on the current branch, if the model has one (floats).
