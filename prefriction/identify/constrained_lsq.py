@@ -16,11 +16,12 @@ the number of samples.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable
+import warnings
+from typing import Any, Callable
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.linalg import spsolve
+from scipy.sparse.linalg import splu
 
 __all__ = ["LsqOutcome", "solve"]
 
@@ -50,70 +51,89 @@ def solve(full: Callable, plain: Callable, w0: np.ndarray, lo: np.ndarray, hi: n
     full : callable
         ``w -> (r, J, g, A)``: residuals, their sparse Jacobian, constraints and their sparse Jacobian.
     plain : callable
-        ``w -> (r, g)`` (the line search).
+        ``w -> (r, g)`` (trial points).
     w0 : numpy.ndarray
         Start point; its first ``len(lo)`` entries are bounded by ``lo``, ``hi``.
     lo, hi : numpy.ndarray
         Bounds of the leading entries.
     max_iter : int
-        Most iterations.
+        Most iterations (Jacobian evaluations).
     tol : float
-        Convergence: the relative decrease of ``|r|^2`` in a full step and the step (relative to
-        ``1 + |w|``) below ``tol``, with ``|g| <= gtol``.
+        Convergence: the step (relative to ``1 + |w|``) below ``tol``, or a full step that
+        decreases ``|r|^2`` by less than ``tol`` relative and moves less than ``1000 tol``,
+        with ``|g| <= gtol``.
     gtol : float, default 1e-9
         Largest constraint violation at convergence (in the scaled units of ``g``).
     progress : callable, optional
         Called with one line per iteration.
+
+    Notes
+    -----
+    A trial step is accepted when the merit decreases by at least a tenth of the decrease the
+    linear model predicts; a rejected full step first gets a second-order correction (the
+    constraints' curvature, the Maratos effect), then a larger damping ``mu``.
     """
     w = np.array(w0, dtype=float)
     nb = lo.size
     mu, rho = 1e-2, 0.0
+    r, J, g, A = full(w)
     for it in range(1, max_iter + 1):
-        r, J, g, A = full(w)
         f0 = 0.5 * float(r @ r)
         JtJ = (J.T @ J).tocsc()
         grad = J.T @ r
         diag = np.maximum(JtJ.diagonal(), 1e-12 * max(float(JtJ.diagonal().max()), 1e-300))
-        step = lam = None
-        while mu < 1e12:
-            H = JtJ + sp.diags(mu * diag)
-            K = sp.bmat([[H, A.T], [A, None]], format="csc")
-            with np.errstate(all="ignore"):
-                sol = spsolve(K, -np.concatenate([grad, g]))
-            if np.all(np.isfinite(sol)):
-                step, lam = sol[: w.size], sol[w.size:]
-                break
-            mu *= 10.0
-        if step is None:
-            return LsqOutcome(w, False, it, "the Gauss-Newton system is singular at every damping")
-        rho = max(rho, 1.1 * float(np.abs(lam).max(initial=0.0)))
-        alpha = _to_bounds(w[:nb], step[:nb], lo, hi)
-        phi0 = _merit(r, g, rho)
-        slope = float(grad @ step) - rho * float(np.abs(g).sum())
         accepted = False
-        while alpha > 1e-10:
-            wt = w + alpha * step
-            rt, gt = plain(wt)
-            if np.all(np.isfinite(rt)) and np.all(np.isfinite(gt)) and \
-                    _merit(rt, gt, rho) <= phi0 + 1e-4 * alpha * min(slope, 0.0):
-                accepted = True
-                break
-            alpha *= 0.5
-        if not accepted:
-            if mu < 1e10:
-                mu *= 100.0
+        while not accepted and mu < 1e12:
+            lu = _factor(JtJ, diag, mu, A)
+            if lu is None:
+                mu *= 10.0
                 continue
-            return LsqOutcome(w, False, it, "the line search found no decrease of the merit function")
-        mu = max(mu / 10.0, 1e-12) if alpha == 1.0 else min(mu * 10.0, 1e10)
-        moved = float(np.max(np.abs(alpha * step) / (1.0 + np.abs(w))))
+            sol = lu.solve(-np.concatenate([grad, g]))
+            d, lam = sol[: w.size], sol[w.size:]
+            rho = max(rho, 1.1 * float(np.abs(lam).max(initial=0.0)))
+            phi0 = _merit(r, g, rho)
+            Jd = J @ d
+            pred = -(float(grad @ d) + 0.5 * float(Jd @ Jd)) + rho * float(np.abs(g).sum())
+            alpha = _to_bounds(w[:nb], d[:nb], lo, hi)
+            wt = w + alpha * d
+            rt, gt = plain(wt)
+            phi = _merit(rt, gt, rho)
+            if not phi0 - phi >= 0.1 * alpha * pred and np.isfinite(phi):
+                corr = lu.solve(np.concatenate([np.zeros(w.size), -gt]))[: w.size]
+                beta = _to_bounds(wt[:nb], corr[:nb], lo, hi)
+                ws = wt + beta * corr
+                rs, gs = plain(ws)
+                if _merit(rs, gs, rho) < phi:
+                    wt, rt, gt, phi = ws, rs, gs, _merit(rs, gs, rho)
+            ratio = (phi0 - phi) / max(alpha * pred, 1e-300)
+            if ratio >= 0.1:
+                accepted = True
+                mu = max(mu / 3.0, 1e-12) if ratio > 0.5 else mu
+            else:
+                mu *= 10.0
+        if not accepted:
+            return LsqOutcome(w, False, it, "no decrease of the merit function at any damping")
+        moved = float(np.max(np.abs(wt - w) / (1.0 + np.abs(w))))
         w = wt
-        f1 = 0.5 * float(rt @ rt)
-        gmax = float(np.abs(gt).max(initial=0.0))
+        r, J, g, A = full(w)
+        f1 = 0.5 * float(r @ r)
+        gmax = float(np.abs(g).max(initial=0.0))
         if progress is not None:
-            progress(f"iteration {it}: 0.5 |r|^2 = {f1:.6g}, |g| = {gmax:.2e}, step {moved:.2e}, alpha {alpha:.3g}")
+            progress(f"iteration {it}: 0.5 |r|^2 = {f1:.6g}, |g| = {gmax:.2e}, step {moved:.2e}, damping {mu:.2g}")
         if gmax <= gtol and (moved <= tol or (alpha == 1.0 and f0 - f1 <= tol * f0 and moved <= 1e3 * tol)):
             return LsqOutcome(w, True, it, f"converged after {it} Gauss-Newton iterations")
     return LsqOutcome(w, False, max_iter, f"no convergence after max_iter = {max_iter} Gauss-Newton iterations")
+
+
+def _factor(JtJ: sp.csc_matrix, diag: np.ndarray, mu: float, A: sp.csr_matrix) -> Any:
+    """Sparse LU of the damped KKT matrix, or None if it is singular."""
+    K = sp.bmat([[JtJ + sp.diags(mu * diag), A.T], [A, None]], format="csc")
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            return splu(K)
+    except RuntimeError:
+        return None
 
 
 def _to_bounds(x: np.ndarray, d: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> float:

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from scipy.signal import savgol_filter
@@ -19,7 +20,7 @@ from scipy.signal import savgol_filter
 from prefriction.identify.data import Motion
 from prefriction.models.base import FrictionModel
 
-__all__ = ["StaticStart", "derivatives", "static_start", "start_model"]
+__all__ = ["StaticStart", "derivatives", "start_model", "start_values", "static_start"]
 
 _WINDOW = 21
 """Samples of the Savitzky-Golay window (cubic) of the velocity and acceleration estimates."""
@@ -75,19 +76,55 @@ def static_start(data: Motion) -> StaticStart | None:
     return StaticStart(mass, float(coef[0]), float(coef[1]), float(coef[2]))
 
 
+def start_values(model: FrictionModel, data: Motion, mass0: float | None, free: Any, fixed: Any,
+                 bounds: Any) -> tuple[FrictionModel, float | None, float, float]:
+    """Start model, start mass [kg], start offset [N] and offset scale [N] of a Motion fit.
+
+    The static estimates (:func:`static_start`) replace the start model's ``Fc`` (``Fs`` in
+    proportion), its viscous coefficient (``sigma2`` of LuGre, ``b`` of a
+    :class:`prefriction.Viscous` term) and ``mass0`` where they are positive and the name is
+    fitted, not fixed and not bounded by the user.
+    """
+    fit = static_start(data)
+    keep = set(_list(fixed)) | set(bounds or {})
+    if free is not None:
+        keep |= {p.name for p in type(model).parameters} - set(_list(free))
+    model = start_model(model, fit, keep)
+    if fit is not None and mass0 is not None and fit.mass is not None and fit.mass > 0.0 and "mass" not in keep:
+        mass0 = fit.mass
+    offset0 = fit.offset if fit is not None else 0.0
+    return model, mass0, offset0, float(model.Fc)
+
+
+def _list(names: Any) -> list[str]:
+    if names is None:
+        return []
+    return [names] if isinstance(names, str) else list(names)
+
+
 def start_model(model: FrictionModel, fit: StaticStart | None, keep: set[str]) -> FrictionModel:
     """``model`` with its force level (``Fc``, and ``Fs`` in proportion) and viscous coefficient
-    (``sigma2``) replaced by the static estimates where positive, except the names in ``keep``."""
+    (``sigma2``, or ``b`` of a :class:`prefriction.Viscous` term of a sum) replaced by the static
+    estimates where positive, except the names in ``keep``."""
+    from prefriction.models.parallel import Parallel
+
     if fit is None:
         return model
+    if isinstance(model, Parallel):
+        levels = [m for m in model.models if "Fc" in {p.name for p in type(m).parameters}]
+        share = StaticStart(fit.mass, fit.Fc / max(len(levels), 1), fit.b, fit.offset)
+        terms = [start_model(m, share, keep if "b" in {p.name for p in type(m).parameters} else set(keep) | {"b"})
+                 for m in model.models]
+        return Parallel(tuple(terms))
     names = {p.name for p in type(model).parameters}
     new: dict[str, float] = {}
     if "Fc" in names and "Fc" not in keep and fit.Fc > 0.0:
         new["Fc"] = fit.Fc
         if "Fs" in names and "Fs" not in keep:
             new["Fs"] = getattr(model, "Fs") * fit.Fc / model.Fc
-    if "sigma2" in names and "sigma2" not in keep and fit.b > 0.0:
-        new["sigma2"] = fit.b
+    for visc in ("sigma2", "b"):
+        if visc in names and visc not in keep and fit.b > 0.0:
+            new[visc] = fit.b
     try:
         return dataclasses.replace(model, **new) if new else model
     except ValueError:  # e.g. Fs below the new Fc when Fs is kept: start from the user's model
