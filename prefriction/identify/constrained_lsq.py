@@ -25,6 +25,9 @@ from scipy.sparse.linalg import splu
 
 __all__ = ["LsqOutcome", "solve"]
 
+_MU_DONE = 1e-4
+"""Largest damping at which a short step counts as convergence (a damped step is short anyway)."""
+
 
 @dataclass(frozen=True)
 class LsqOutcome:
@@ -69,8 +72,8 @@ def solve(full: Callable, plain: Callable, w0: np.ndarray, lo: np.ndarray, hi: n
 
     Notes
     -----
-    A trial step is accepted when the merit decreases by at least a tenth of the decrease the
-    linear model predicts; a rejected full step first gets a second-order correction (the
+    A trial step is accepted when the merit decreases (by at least ``1e-4`` of the decrease the
+    linear model predicts); convergence is declared only at a damping ``mu <= 1e-4``; a rejected full step first gets a second-order correction (the
     constraints' curvature, the Maratos effect), then a larger damping ``mu``.
     """
     w = np.array(w0, dtype=float)
@@ -106,7 +109,7 @@ def solve(full: Callable, plain: Callable, w0: np.ndarray, lo: np.ndarray, hi: n
                 if _merit(rs, gs, rho) < phi:
                     wt, rt, gt, phi = ws, rs, gs, _merit(rs, gs, rho)
             ratio = (phi0 - phi) / max(alpha * pred, 1e-300)
-            if ratio >= 0.1:
+            if ratio >= 1e-4:
                 accepted = True
                 mu = max(mu / 3.0, 1e-12) if ratio > 0.5 else mu
             else:
@@ -121,7 +124,9 @@ def solve(full: Callable, plain: Callable, w0: np.ndarray, lo: np.ndarray, hi: n
         if progress is not None:
             progress(f"iteration {it}: 0.5 |r|^2 = {f1:.6g}, |g| = {gmax:.2e}, step {moved:.2e}, damping {mu:.2g}")
         if gmax <= gtol and (moved <= tol or (alpha == 1.0 and f0 - f1 <= tol * f0 and moved <= 1e3 * tol)):
-            return LsqOutcome(w, True, it, f"converged after {it} Gauss-Newton iterations")
+            if mu <= _MU_DONE:
+                return LsqOutcome(w, True, it, f"converged after {it} Gauss-Newton iterations")
+            mu = 1e-2 * _MU_DONE  # a short step of a heavily damped system is no optimum: try Gauss-Newton
     return LsqOutcome(w, False, max_iter, f"no convergence after max_iter = {max_iter} Gauss-Newton iterations")
 
 

@@ -4,7 +4,8 @@ In sliding the friction of a dynamic model is close to its static map, so the re
 balance ``u = m a + Fc sign(v) + b v + F_off`` (Coulomb, viscous and offset; ``a``, ``v`` from
 a Savitzky-Golay fit of the positions) is linear in ``m``, ``Fc``, ``b`` and ``F_off``: ordinary
 least squares over the samples that move faster than a tenth of the largest speed gives them
-without any start value. The dynamic fit starts from them, so it never starts where the model
+without any start value. A record that slides in one direction only cannot tell the offset
+from ``Fc``: its offset starts at 0. The dynamic fit starts from them, so it never starts where the model
 has no meaning (a negative force level, a NaN).
 """
 
@@ -61,14 +62,16 @@ def static_start(data: Motion) -> StaticStart | None:
     moving = np.abs(v) > 0.1 * float(np.max(np.abs(v)))
     if np.count_nonzero(moving) < 8:
         return None
-    cols = [np.sign(v), v, np.ones_like(v)]
+    sv = np.sign(v[moving])
+    both = min(np.count_nonzero(sv > 0), np.count_nonzero(sv < 0)) >= 0.1 * sv.size
+    cols = [np.sign(v), v, np.ones_like(v) if both else np.zeros_like(v)]
     rhs = data.u.copy()
     if data.mass is None:
         cols.insert(0, a)
     else:
         rhs = rhs - data.mass * a
     M = np.column_stack(cols)[moving]
-    coef, *_ = np.linalg.lstsq(M, rhs[moving], rcond=None)
+    coef, *_ = np.linalg.lstsq(M, rhs[moving], rcond=None)  # no offset column in one direction: 0
     if data.mass is None:
         mass, coef = float(coef[0]), coef[1:]
     else:

@@ -10,7 +10,8 @@ sample to the next by ``n_sub`` classical Runge-Kutta sub-steps, in SI units for
 The direction ``s`` is carried along with the state. A sub-step whose Euler-predicted end
 velocity has the other sign is cut at the predicted zero of the velocity: Runge-Kutta on the
 old branch up to it, the model's ``reverse`` (a change of coordinates for models without events,
-e.g. Dahl's log-gap), Runge-Kutta on the new branch for the rest. No step straddles a reversal
+e.g. Dahl's log-gap), the velocity set to its located zero, Runge-Kutta on the new branch for
+the rest. No step straddles a reversal
 by more than the error of that prediction, where the velocity and so the rates are small.
 
 Forward sensitivities ride along: the carried matrix ``S = dy/dw`` of a segment is propagated
@@ -32,6 +33,10 @@ from prefriction.models.base import FrictionModel
 __all__ = ["segment_functions", "step_function"]
 
 _CACHE: dict[Any, tuple[ca.Function, ca.Function]] = {}
+STATE_CAP = 50.0
+"""Bound of a state just after a reversal: Dahl's log-gap reversed twice at a saturated force
+is infinite (``exp(-50)`` of ``Fc`` away from it is the same force); the protocol's states are
+otherwise of the size of the normalised force."""
 
 
 def _rk4(f: Any, y: list[Any], tau: Any, h: Any) -> list[Any]:
@@ -80,23 +85,28 @@ def step_function(model: FrictionModel, n_sub: int) -> ca.Function:
         ya = _rk4(rhs(s), yl, tau, frac * h)
         s_new = ca.if_else(turn, -s, s)
         zr, _ = model.reverse(ya[2:], [], s_new, q, 1e-12)
-        ya = ya[:2] + [ca.if_else(turn, a, b) for a, b in zip(zr, ya[2:])]
+        zr = [ca.fmin(ca.fmax(a, -STATE_CAP), STATE_CAP) for a in zr]
+        v_rev = ca.if_else(ca.logic_and(turn, s * v0 > 0.0), 0.0, ya[1])  # at the located zero
+        ya = [ya[0], v_rev] + [ca.if_else(turn, a, b) for a, b in zip(zr, ya[2:])]
         yl = _rk4(rhs(s_new), ya, tau + frac * h, (1.0 - frac) * h)
         s = s_new
     return ca.Function("motion_step", [y, u0, u1, dt, pp], [ca.vertcat(*yl, s)])
 
 
 def _units_function(model: FrictionModel, space: ParameterSpace, mass_free: bool) -> ca.Function:
-    """``(theta, fixed, mass) -> pp``: the step's numbers from the scaled free parameters (SX)."""
+    """``(theta, scale, fixed, mass) -> pp``: the step's numbers from the free parameters
+    ``theta * scale`` (SX; the scales are inputs, so one function serves every start point)."""
     theta = ca.SX.sym("theta", space.n_free)
+    scale = ca.SX.sym("scale", space.n_free)
     fixed = ca.SX.sym("fixed", len(space.fixed))
     mass_in = ca.SX.sym("mass")
-    values = space.symbols(theta, fixed)
+    values = {n: theta[i] * scale[i] for i, n in enumerate(space.free)}
+    values.update({n: fixed[i] for i, n in enumerate(space.fixed)})
     mass = values["mass"] if mass_free else mass_in
     sigma, Fc, q = symbolic_units(model, values, mass)
     off = values.get("offset", 0.0)
     pp = ca.vertcat(mass, sigma, Fc, off, q)
-    return ca.Function("units", [theta, fixed, mass_in], [pp])
+    return ca.Function("units", [theta, scale, fixed, mass_in], [pp])
 
 
 def segment_functions(model: FrictionModel, space: ParameterSpace, K: int, n_sub: int,
@@ -104,7 +114,8 @@ def segment_functions(model: FrictionModel, space: ParameterSpace, K: int, n_sub
     """The shooting segment of ``K`` samples, with and without forward sensitivities (cached).
 
     Inputs of both: ``node`` (the scaled start state ``[x / Xs, v / Vs, z]``), ``s0`` (its
-    direction), ``s_to`` (the direction of the next node), ``theta``, ``fixed``, ``mass``,
+    direction), ``s_to`` (the direction of the next node), ``theta`` and ``scale`` (the free
+    parameters are ``theta * scale``), ``fixed``, ``mass``,
     ``U0``, ``U1``, ``DT`` (rows of ``K`` samples) and ``scl = [Xs, Vs]``. Outputs: ``X``
     (``2 x (K + 1)``: position [m] and velocity [m/s] at the node and after each sample) and
     ``Ye`` (the scaled end state in the coordinates of ``s_to``); the sensitive one adds ``dX``
@@ -154,14 +165,15 @@ def segment_functions(model: FrictionModel, space: ParameterSpace, K: int, n_sub
     node = ca.MX.sym("node", ny)
     s0, s_next = ca.MX.sym("s0"), ca.MX.sym("s_to")
     th = ca.MX.sym("theta", nth)
+    scale = ca.MX.sym("scale", nth)
     fx = ca.MX.sym("fixed", len(space.fixed))
     mass = ca.MX.sym("mass")
     U0, U1, DT = ca.MX.sym("U0", 1, K), ca.MX.sym("U1", 1, K), ca.MX.sym("DT", 1, K)
     sc = ca.MX.sym("scl", 2)
-    p_mx = units(th, fx, mass)
+    p_mx = units(th, scale, fx, mass)
     y0 = ca.vertcat(node[0] * sc[0], node[1] * sc[1], node[2:], s0)
-    inputs = [node, s0, s_next, th, fx, mass, U0, U1, DT, sc]
-    names = ["node", "s0", "s_to", "theta", "fixed", "mass", "U0", "U1", "DT", "scl"]
+    inputs = [node, s0, s_next, th, scale, fx, mass, U0, U1, DT, sc]
+    names = ["node", "s0", "s_to", "theta", "scale", "fixed", "mass", "U0", "U1", "DT", "scl"]
 
     C, O = plain_acc(y0, U0, U1, DT, ca.repmat(p_mx, 1, K))
     X = ca.horzcat(y0[:2], O)

@@ -31,7 +31,7 @@ from prefriction.errors import SolverError
 from prefriction.identify.constrained_lsq import solve
 from prefriction.identify.data import Motion
 from prefriction.identify.motion_start import derivatives
-from prefriction.identify.motion_step import segment_functions
+from prefriction.identify.motion_step import STATE_CAP, segment_functions
 from prefriction.identify.parameters import ParameterSpace
 from prefriction.identify.reversals import locate_reversals
 from prefriction.models.base import FrictionModel
@@ -122,7 +122,7 @@ class _Problem:
         self.x = data.x[self.samples[self.rows]]
         self.gw = np.ones((lay.J - 1) * self.ny)
         s = lay.s
-        self.args = dict(s0=s, s_to=np.r_[s[1:], s[-1]], fixed=self.fixed, mass=mass,
+        self.args = dict(s0=s, s_to=np.r_[s[1:], s[-1]], scale=space.scale, fixed=self.fixed, mass=mass,
                          U0=lay.U0[None, :], U1=lay.U1[None, :], DT=lay.DT[None, :], scl=lay.scl)
 
     def carry_states(self, w: np.ndarray, single: ca.Function) -> np.ndarray:
@@ -133,12 +133,12 @@ class _Problem:
         a, K = self.args, self.lay.K
         for j in range(self.lay.J - 1):
             cols = slice(j * K, (j + 1) * K)
-            out = single(node=nodes[:, j], theta=th, s0=a["s0"][j], s_to=a["s_to"][j], fixed=a["fixed"],
+            out = single(node=nodes[:, j], theta=th, s0=a["s0"][j], s_to=a["s_to"][j], scale=a["scale"], fixed=a["fixed"],
                          mass=a["mass"], U0=a["U0"][:, cols], U1=a["U1"][:, cols], DT=a["DT"][:, cols],
                          scl=a["scl"])
             ye = np.asarray(out["Ye"]).ravel()
             if np.all(np.isfinite(ye)):
-                nodes[2:, j + 1] = ye[2:]
+                nodes[2:, j + 1] = np.clip(ye[2:], -STATE_CAP, STATE_CAP)
         w[self.nth:] = nodes.T.ravel()
         return w
 
@@ -286,11 +286,14 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
     lay = _layout(data, min(SEGMENT, len(data) - 1), directions, np.array([X, V]))
     xs = max(float(np.ptp(data.x)) * 1e-3, 1e-300)
     prob = _Problem(model, space, data, lay, n_sub, mass_free, mass, xs)
-    w0 = prob.carry_states(_start(model, data, space, lay, xsm, v, a, mass, offset0),
-                           segment_functions(model, space, lay.K, n_sub, mass_free)[0])
-    prob.weigh(w0)
-    r0, g0 = prob.plain_eval(w0)
-    if not (np.all(np.isfinite(r0)) and np.all(np.isfinite(g0))):
+    single = segment_functions(model, space, lay.K, n_sub, mass_free)[0]
+    for level in (0.5, 0.0):  # node states of the force balance, else of zero force (see _start)
+        w0 = prob.carry_states(_start(model, data, space, lay, xsm, v, a, mass, offset0, level), single)
+        prob.weigh(w0)
+        r0, g0 = prob.plain_eval(w0)
+        if np.all(np.isfinite(r0)) and np.all(np.isfinite(g0)):
+            break
+    else:
         raise SolverError(f"the model's motion is not finite at the start values ({_at(space, w0)}); give start "
                           f"values closer to the data or bounds")
     lo, hi = space.theta_bounds()
@@ -329,14 +332,16 @@ def _directions(t: np.ndarray, x: np.ndarray, v: np.ndarray, given: Any) -> np.n
 
 
 def _start(model: FrictionModel, data: Motion, space: ParameterSpace, lay: _Layout, xsm: np.ndarray,
-           v: np.ndarray, a: np.ndarray, mass: float, offset0: float) -> np.ndarray:
-    """Start vector: scaled parameters, then each node's ``[x / X, v / V, z]`` from the smoothed data."""
+           v: np.ndarray, a: np.ndarray, mass: float, offset0: float, level: float) -> np.ndarray:
+    """Start vector: scaled parameters, then each node's ``[x / X, v / V, z]`` from the smoothed
+    data, ``z`` the state of the force balance's friction ``u - m a - F_off`` clipped to
+    ``+-level Fc``."""
     theta = np.array([offset0 / space.scale[i] if n == "offset" else space.start[n] / space.scale[i]
                       for i, n in enumerate(space.free)])
     X, V = lay.scl
     nodes = []
     for k, s in zip(lay.nodes, lay.s):
-        f = float(np.clip((data.u[k] - mass * a[k] - offset0) / model.Fc, -0.5, 0.5))
+        f = float(np.clip((data.u[k] - mass * a[k] - offset0) / model.Fc, -level, level))
         nodes += [xsm[k] / X, v[k] / V, *model.initial_state(f, s)[0]]
     return np.concatenate([theta, nodes])
 

@@ -25,7 +25,7 @@ from prefriction.models.base import FrictionModel
 from prefriction.models.dahl import Dahl
 from prefriction.models.lugre import LuGre
 
-__all__ = ["ClosedLoop", "closed_loop_record", "reference_moves"]
+__all__ = ["ClosedLoop", "closed_loop_record", "reference_moves", "replay"]
 
 
 @dataclass(frozen=True)
@@ -48,6 +48,9 @@ class ClosedLoop:
         Encoder step [m].
     dt : float
         Sample interval [s].
+    noise : float
+        Standard deviation [m] of Gaussian noise added to the position before the encoder
+        rounds it (0: rounding only).
     """
 
     friction: FrictionModel
@@ -58,6 +61,7 @@ class ClosedLoop:
     Kd: float = 2.0e3
     quantum: float = 5e-8
     dt: float = 1e-3
+    noise: float = 0.0
 
 
 def reference_moves(n: int, dt: float, rng: np.random.Generator, stroke: float = 0.2) -> np.ndarray:
@@ -107,7 +111,7 @@ def closed_loop_record(loop: ClosedLoop, n: int, rng: np.random.Generator, *, rt
     n : int
         Number of samples (``t = k dt``).
     rng : numpy.random.Generator
-        Source of the reference moves.
+        Source of the reference moves and the position noise.
     rtol : float, default 1e-10
         Relative tolerance of LSODA (absolute ``1e-14`` m, m/s and the state's unit).
 
@@ -123,8 +127,9 @@ def closed_loop_record(loop: ClosedLoop, n: int, rng: np.random.Generator, *, rt
     u = np.empty(n)
     y = np.array([r[0], 0.0, 0.0])
     xq_prev = np.round(r[0] / loop.quantum) * loop.quantum
+    e = loop.noise * rng.standard_normal(n)
     for k in range(n):
-        xq = np.round(y[0] / loop.quantum) * loop.quantum
+        xq = np.round((y[0] + e[k]) / loop.quantum) * loop.quantum
         x[k] = xq
         u[k] = loop.Kp * (r[k] - xq) - loop.Kd * (xq - xq_prev) / dt
         xq_prev = xq
@@ -153,3 +158,34 @@ def _interval(rhs, y: np.ndarray, t0: float, t1: float, u: float, rtol: float) -
         if t0 >= t1:
             return y
     raise SolverError(f"more than 100 velocity reversals between t = {t0!r} s and {t1!r} s (a chattering loop)")
+
+
+def replay(loop: ClosedLoop, t: np.ndarray, u: np.ndarray, x0: float, v0: float, F0: float,
+           rtol: float = 1e-10) -> np.ndarray:
+    """Positions [m] of the stage of ``loop`` driven by the held force ``u`` (open loop).
+
+    The same equations and integration as :func:`closed_loop_record` (LSODA per sample
+    interval, restarted at reversals), from position ``x0`` [m], velocity ``v0`` [m/s] and
+    friction state ``F0``: the bristle deflection ``z = F0 / sigma0`` [m] for LuGre, the force
+    [N] for Dahl.
+
+    Parameters
+    ----------
+    loop : ClosedLoop
+        Stage and friction (the gains are not used).
+    t, u : numpy.ndarray
+        Sample times [s] and the force [N] held from each sample to the next.
+    x0, v0, F0 : float
+        Initial position [m], velocity [m/s] and friction state.
+    rtol : float, default 1e-10
+        Relative tolerance of LSODA.
+    """
+    rhs = _rhs(loop)
+    z0 = F0 / loop.friction.sigma0 if isinstance(loop.friction, LuGre) else F0
+    y = np.array([x0, v0, z0], dtype=float)
+    x = np.empty(len(t))
+    x[0] = x0
+    for k in range(len(t) - 1):
+        y = _interval(rhs, y, float(t[k]), float(t[k + 1]), float(u[k]), rtol)
+        x[k + 1] = y[0]
+    return x
