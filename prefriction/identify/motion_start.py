@@ -53,8 +53,9 @@ def static_start(data: Motion) -> StaticStart | None:
     Returns
     -------
     StaticStart or None
-        ``None`` for a free decay (``u = 0``: the force balance has no scale) or when too few
-        samples slide.
+        ``None`` for a free decay (``u = 0``: the force balance has no scale), when too few
+        samples slide, or when the estimates are not physical (a mass or ``Fc`` not positive, a
+        negative viscous coefficient: the record does not excite the balance enough).
     """
     if data.free_decay:
         return None
@@ -76,6 +77,8 @@ def static_start(data: Motion) -> StaticStart | None:
         mass, coef = float(coef[0]), coef[1:]
     else:
         mass = None
+    if (mass is not None and not mass > 0.0) or not coef[0] > 0.0 or not coef[1] >= 0.0:
+        return None  # a record that does not excite the balance (e.g. one short move): no physical fit
     return StaticStart(mass, float(coef[0]), float(coef[1]), float(coef[2]))
 
 

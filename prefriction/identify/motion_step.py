@@ -10,8 +10,8 @@ sample to the next by ``n_sub`` classical Runge-Kutta sub-steps, in SI units for
 The direction ``s`` is carried along with the state. A sub-step whose Euler-predicted end
 velocity has the other sign is cut at the predicted zero of the velocity: Runge-Kutta on the
 old branch up to it, the model's ``reverse`` (a change of coordinates for models without events,
-e.g. Dahl's log-gap), the velocity set to its located zero, Runge-Kutta on the new branch for
-the rest. No step straddles a reversal
+e.g. Dahl's log-gap), Runge-Kutta on the new branch for the rest. A velocity left a little
+on the old side of zero by the cut does not turn the branch back. No step straddles a reversal
 by more than the error of that prediction, where the velocity and so the rates are small.
 
 Forward sensitivities ride along: the carried matrix ``S = dy/dw`` of a segment is propagated
@@ -80,14 +80,13 @@ def step_function(model: FrictionModel, n_sub: int) -> ca.Function:
         tau = k * h
         a0 = rhs(s)(yl, tau)[1]
         v0, v1 = yl[1], yl[1] + h * a0
-        turn = ca.logic_or(s * v0 < 0.0, s * v1 < 0.0)
+        turn = s * v1 < 0.0  # a velocity a little past zero at the start (the last cut) is not a turn
         frac = ca.if_else(turn, ca.if_else(s * v0 > 0.0, v0 / (v0 - v1), 0.0), 1.0)
         ya = _rk4(rhs(s), yl, tau, frac * h)
         s_new = ca.if_else(turn, -s, s)
         zr, _ = model.reverse(ya[2:], [], s_new, q, 1e-12)
         zr = [ca.fmin(ca.fmax(a, -STATE_CAP), STATE_CAP) for a in zr]
-        v_rev = ca.if_else(ca.logic_and(turn, s * v0 > 0.0), 0.0, ya[1])  # at the located zero
-        ya = [ya[0], v_rev] + [ca.if_else(turn, a, b) for a, b in zip(zr, ya[2:])]
+        ya = ya[:2] + [ca.if_else(turn, a, b) for a, b in zip(zr, ya[2:])]
         yl = _rk4(rhs(s_new), ya, tau + frac * h, (1.0 - frac) * h)
         s = s_new
     return ca.Function("motion_step", [y, u0, u1, dt, pp], [ca.vertcat(*yl, s)])
