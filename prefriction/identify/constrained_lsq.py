@@ -111,7 +111,7 @@ def solve(full: Callable, plain: Callable, w0: np.ndarray, lo: np.ndarray, hi: n
             ratio = (phi0 - phi) / max(alpha * pred, 1e-300)
             if ratio >= 1e-4:
                 accepted = True
-                mu = max(mu / 3.0, 1e-12) if ratio > 0.5 else mu
+                mu = max(mu / 3.0, 1e-12) if ratio > 0.25 else mu
             else:
                 mu *= 10.0
         if not accepted:

@@ -80,7 +80,7 @@ def step_function(model: FrictionModel, n_sub: int) -> ca.Function:
         tau = k * h
         a0 = rhs(s)(yl, tau)[1]
         v0, v1 = yl[1], yl[1] + h * a0
-        turn = s * v1 < 0.0  # a velocity a little past zero at the start (the last cut) is not a turn
+        turn = ca.logic_or(s * v0 < 0.0, s * v1 < 0.0)
         frac = ca.if_else(turn, ca.if_else(s * v0 > 0.0, v0 / (v0 - v1), 0.0), 1.0)
         ya = _rk4(rhs(s), yl, tau, frac * h)
         s_new = ca.if_else(turn, -s, s)
