@@ -8,7 +8,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from prefriction._validation import check_bool, check_count, check_positive
-from prefriction.identify.data import ForceDisplacement, Motion
+from prefriction.identify.data import ForceDisplacement, ForceVelocity, Motion
 from prefriction.identify.parameters import ParameterSpace
 from prefriction.identify.result import FitResult
 from prefriction.identify.statistics import (BoundWarning, ConvergenceWarning, IdentifiabilityWarning, at_bounds,
@@ -37,7 +37,10 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
         The model to fit (:class:`prefriction.Dahl`, :class:`prefriction.MaxwellSlip`,
         :class:`prefriction.LuGre`, ...); its parameter values are the starting values, and fix
         its structure (Dahl: ``gamma >= 1`` or ``gamma < 1``; Maxwell-slip: the number of elements).
-    data : ForceDisplacement or Motion
+    data : ForceDisplacement, Motion or ForceVelocity
+        :class:`ForceVelocity` (steady-sliding force against velocity): fits a
+        :class:`prefriction.identify.StaticFriction` map (Coulomb + viscous + Stribeck,
+        optionally direction-dependent) by least squares (``docs/identify_motion.md#static-maps``).
         :class:`ForceDisplacement`: friction force along a prescribed displacement; the model's
         force along the measured ``x`` is fitted to ``F`` by least squares (trust-region
         reflective, Jacobian by CasADi). :class:`Motion`: positions of a mass under a known
@@ -134,11 +137,17 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
     >>> res.estimate("offset") > 0.0
     True
     """
-    if not isinstance(model, FrictionModel):
+    from prefriction.identify.static_map import StaticFriction
+
+    if isinstance(model, StaticFriction) != isinstance(data, ForceVelocity):
+        raise TypeError(f"a StaticFriction map is fitted to ForceVelocity data and only it, got {type(model).__name__} "
+                        f"and {type(data).__name__}")
+    if not isinstance(model, (FrictionModel, StaticFriction)):
         raise TypeError(f"model must be a prefriction.FrictionModel (e.g. prefriction.Dahl), got {model!r} "
                         f"of type {type(model).__name__}")
-    if not isinstance(data, (ForceDisplacement, Motion)):
-        raise TypeError(f"data must be prefriction.identify.ForceDisplacement or Motion, got {type(data).__name__}")
+    if not isinstance(data, (ForceDisplacement, Motion, ForceVelocity)):
+        raise TypeError(f"data must be prefriction.identify.ForceDisplacement, Motion or ForceVelocity, got "
+                        f"{type(data).__name__}")
     if substeps is not None:
         substeps = check_count("substeps", substeps, 1)
         if substeps > 64:
@@ -152,6 +161,11 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
     offset = check_bool("offset", offset)
     if structures not in ("both", "given"):
         raise ValueError(f"structures must be 'both' or 'given', got {structures!r}")
+    if isinstance(data, ForceVelocity):
+        from prefriction.identify.static_fit import fit_static
+
+        return fit_static(model, data, free=free, fixed=fixed, bounds=bounds, offset=offset, max_iter=max_iter,
+                          tol=tol, limit=limit)
     if isinstance(data, Motion):
         return _fit_motion(model, data, free, fixed, bounds, mass0, reversals, substeps, max_iter, tol, limit, offset)
     if reversals is not None:

@@ -164,7 +164,7 @@ class FitResult:
     def summary(self) -> str:
         """A few lines: the fitted model, the residual level and any unidentifiable parameter."""
         st = self.statistics
-        unit = "N" if isinstance(self.data, ForceDisplacement) else "m"
+        unit = "m" if isinstance(self.data, Motion) else "N"
         lines = [f"{model_name(self.model)} fitted to {len(self.residuals)} samples of "
                  f"{type(self.data).__name__}: residual sd {st.sigma_hat:.4g} {unit}, {st.dof} dof"]
         for i, (n, u, v, lo, hi) in enumerate(zip(self.names, self.units, self.estimates, self.low, self.high)):
@@ -194,7 +194,7 @@ class FitResult:
         for n, row in zip(self.names, self.correlation):
             rows.append(f"  {n:<{width}} " + " ".join(f"{c:>6.3f}" for c in row))
         rows.append("")
-        unit = "N" if isinstance(self.data, ForceDisplacement) else "m"
+        unit = "m" if isinstance(self.data, Motion) else "N"
         rows.append(f"residual sd {st.sigma_hat:.4g} {unit} ({st.dof} degrees of freedom), "
                     f"condition number {st.condition:.3g} (Jacobi-scaled)")
         for key, val in self.nuisance.items():

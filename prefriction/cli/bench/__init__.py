@@ -18,9 +18,9 @@ reported separately. Peers integrate the same normalised equations
 (``docs/mathematics.md#normalised-units``), with ``rtol = tol`` and ``atol = tol / 100``. The
 error definition, the cases and the targets are described in ``docs/bench.md``.
 
-``--models``, ``--sweep`` and ``--loops`` run other benchmarks instead:
-:mod:`prefriction.cli.bench.models`, :mod:`prefriction.cli.bench.sweep` and
-:mod:`prefriction.cli.bench_loops`. The modules of this package: ``options`` (the command
+``--models``, ``--sweep``, ``--loops`` and ``--identify`` run other benchmarks instead:
+:mod:`prefriction.cli.bench.models`, :mod:`prefriction.cli.bench.sweep`,
+:mod:`prefriction.cli.bench_loops` and :mod:`prefriction.cli.bench.identify`. The modules of this package: ``options`` (the command
 line), ``cases`` (cases, error, reference), ``peers``, ``work_precision`` (headline rows),
 ``stiff`` (stiff and extreme cases), ``reference_rows`` (rows against independent references),
 ``restarts`` (scipy DOP853 with restarts), ``costs`` (target 3, exact analytics), ``report``
@@ -74,6 +74,10 @@ def main(argv: Optional[list[str]] = None) -> int:
     args = parse(argv)
     if args.loops:
         return _loops(args.repeats)
+    if args.identify:
+        from prefriction.cli.bench import identify
+
+        return identify.main(args.quick)
     if args.sweep:
         from prefriction.cli.bench import sweep
 

@@ -32,7 +32,8 @@ examples:
   prefriction bench --repeats 9      more warm repeats per point
   prefriction bench --models         Maxwell-slip, LuGre and GMS against scipy
   prefriction bench --sweep          parameter sweeps in cold and warm processes
-  prefriction bench --loops          compiled PID loop against python-control"""
+  prefriction bench --loops          compiled PID loop against python-control
+  prefriction bench --identify       Motion fit time and memory against the record length"""
 
 
 def repeats(text: str) -> int:
@@ -101,7 +102,7 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
     -------
     argparse.Namespace
         ``out`` (pathlib.Path, an existing directory; None with ``--loops``), ``quick``, ``repeats`` (int or None), and at most one of
-        ``stability``, ``models``, ``sweep``, ``loops`` set.
+        ``stability``, ``models``, ``sweep``, ``loops``, ``identify`` set.
 
     Raises
     ------
@@ -130,6 +131,9 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
                       help="instead: the positioning-loop benchmark (python -m prefriction.controllers.benchmark): "
                            "compiled PID loop against python-control, tuning sweep, loop lengths; "
                            "--repeats sets its warm repeats (default 3)")
+    what.add_argument("--identify", action="store_true",
+                      help="instead: time and peak memory of a closed-loop Motion fit against the number of "
+                           "samples (1e3, 5e3, 2.5e4; --quick: 500, 1000, 2000), each in a fresh process")
     args = ap.parse_args(argv)
     if args.repeats is not None and (args.sweep or args.models):
         ap.error("--repeats applies to the headline and stability sections, not to --sweep or --models")
