@@ -36,10 +36,12 @@ from prefriction.identify.parameters import ParameterSpace
 from prefriction.identify.reversals import locate_reversals
 from prefriction.models.base import FrictionModel
 
-__all__ = ["SEGMENT", "MotionSolution", "fit_motion"]
+__all__ = ["LONG", "SEGMENT", "MotionSolution", "fit_motion"]
 
 SEGMENT = 50
 """Samples per shooting segment."""
+LONG = 5_000
+"""Records of at least this many samples report each iteration on stderr (long work)."""
 _NODE_WINDOW = 7
 """Samples of the Savitzky-Golay window of the node start values (short: coarse records)."""
 _MAPPED: dict[Any, tuple[ca.Function, ca.Function]] = {}
@@ -262,7 +264,8 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
     offset0 : float, default 0.0
         Start value of a fitted force offset [N] (if ``"offset"`` is a free entry of ``space``).
     verbose : bool, default False
-        One line per Gauss-Newton iteration on stderr.
+        One line per Gauss-Newton iteration on stderr (always for records of :data:`LONG`
+        samples or more).
 
     Raises
     ------
@@ -298,7 +301,7 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
                           f"values closer to the data or bounds")
     lo, hi = space.theta_bounds()
     out = solve(prob.full_eval, prob.plain_eval, w0, lo, hi, max_iter=max_iter, tol=tol,
-                progress=_progress if verbose else None)
+                progress=_progress if verbose or len(data) >= LONG else None)
     if not out.success:
         raise SolverError(f"the Motion fit did not converge ({out.message}), at {_at(space, out.w)}; try start "
                           f"values closer to the data, bounds, fixing a parameter, more max_iter or a looser tol")
