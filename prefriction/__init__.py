@@ -9,9 +9,12 @@ Public API, re-exported from private modules:
   ``Chirp``, ``Samples`` and sums; compiled once per kind)
 - analytics: :mod:`prefriction.dahl` (exact and approximate reversal maps, energies; Dahl only)
 - exact reference: :func:`exact_reversals` (Dahl only)
+- the force along a prescribed or measured motion: :func:`friction_along` (:class:`AlongResult`),
+  sample by sample :class:`FrictionStream` (:mod:`prefriction.along`)
 - simulation: :func:`simulate` (closed linear loops: :class:`LinearFeedback`), :func:`sweep`
 - energy analysis: :mod:`prefriction.energy`
 - model checks for new models: :mod:`prefriction.testing`
+- measured records: :mod:`prefriction.data` (``tribometer()``, a reciprocating tribometer record)
 - identification: :mod:`prefriction.identify` (``fit``, ``ForceDisplacement``, ``Motion``,
   ``FitResult``, ``IdentifiabilityWarning``)
 - derivatives through the simulator and the exact map: :func:`sensitivities`
@@ -22,6 +25,7 @@ Public API, re-exported from private modules:
 from __future__ import annotations
 
 from prefriction.errors import PrefrictionError, SolverError
+from prefriction.along import AlongResult, FrictionStream, friction_along
 from prefriction.models import GMS, Dahl, FrictionModel, LuGre, MaxwellSlip, Oscillator, Parallel, Parameter, Viscous
 from prefriction.reversals import ReversalTable
 from prefriction.units import Scales
@@ -34,8 +38,10 @@ from prefriction.sensitivity import sensitivities
 from prefriction.analysis.exact import exact_reversals
 
 __all__ = [
+    "AlongResult",
     "Dahl",
     "FrictionModel",
+    "FrictionStream",
     "GMS",
     "LinearFeedback",
     "LuGre",
@@ -54,8 +60,10 @@ __all__ = [
     "dahl",
     "energy",
     "exact_reversals",
+    "friction_along",
     "describing",
     "identify",
+    "data",
     "sensitivities",
     "sensitivity",
     "signals",
@@ -66,7 +74,7 @@ __version__ = "0.2.0"
 del annotations  # bound by the __future__ import; not part of the API
 
 
-_LAZY = ("controllers", "describing", "identify")  # python-control (1.6 s) and scipy.stats (0.6 s) on first use
+_LAZY = ("controllers", "data", "describing", "identify")  # python-control (1.6 s) and scipy.stats (0.6 s) on first use
 
 
 def __getattr__(name: str):

@@ -43,8 +43,8 @@ def test_bad_terms_are_refused():
         pf.Parallel(())
     with pytest.raises(ValueError, match="b must"):
         pf.Viscous(-1.0)
-    with pytest.raises(ValueError, match="F0"):
-        pf.Viscous(1.0).initial_state(0.5, 1.0)
+    with pytest.raises(ValueError, match=r"F0 must lie in \[-0.0, 0.0\] N"):
+        pf.friction_along(pf.Viscous(1.0), np.linspace(0.0, 1.0, 5), np.zeros(5), F0=0.5)
 
 
 @pytest.fixture(scope="module")

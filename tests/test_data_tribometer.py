@@ -64,3 +64,11 @@ def test_window_and_its_checks():
 def test_wheel_declares_the_data_files():
     text = (ROOT / "pyproject.toml").read_text()
     assert '"prefriction.data" = ["tribometer/*"]' in text
+
+
+def test_docstring_example_runs():
+    import doctest
+
+    import prefriction.data
+
+    assert doctest.testmod(prefriction.data).failed == 0

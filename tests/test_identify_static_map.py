@@ -92,3 +92,13 @@ def test_bad_input_names_the_argument():
         warnings.simplefilter("ignore")
         with pytest.raises(ValueError, match="no parameter left"):
             identify.fit(StaticFriction(Fc=1.0), ForceVelocity(V, TRUE.force(V)), fixed=["Fc", "b"])
+
+
+def test_predict_plot_and_report_of_a_static_fit(tmp_path):
+    F = TRUE.force(V) + 0.3 * np.random.default_rng(5).standard_normal(V.size)
+    res = identify.fit(StaticFriction(Fc=15.0, b=100.0, Fs=20.0, vs=1e-3, Fc_neg=15.0, Fs_neg=20.0), ForceVelocity(V, F))
+    np.testing.assert_allclose(res.predict(ForceVelocity(V, F)), F - res.residuals, rtol=1e-12, atol=1e-12)
+    assert "residual sd" in res.report() and " N " in res.report()
+    assert res.plot(tmp_path / "map.png").stat().st_size > 0
+    with pytest.raises(TypeError, match="ForceVelocity data have none"):
+        res.validate(ForceVelocity(V, F))

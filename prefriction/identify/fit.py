@@ -11,6 +11,7 @@ from prefriction._validation import check_bool, check_count, check_positive
 from prefriction.identify.data import ForceDisplacement, ForceVelocity, Motion
 from prefriction.identify.parameters import ParameterSpace
 from prefriction.identify.result import FitResult
+from prefriction.identify.validation import model_name
 from prefriction.identify.statistics import (BoundWarning, ConvergenceWarning, IdentifiabilityWarning, at_bounds,
                                              gauss_newton)
 from prefriction.models.base import FrictionModel
@@ -245,11 +246,11 @@ def _finish(space: ParameterSpace, values: dict, est: np.ndarray, stats: Any, re
                                  space.why_low, space.why_high)
     for name, value, flag in zip(space.free, est, flags):
         if flag.startswith("on its"):
-            what = "the bound" if "structure" not in flag else "the bound: fit the other structure"
-            warnings.warn(f"{name} = {value:.6g} ends {flag}: the data may want a value beyond it; widen {what} "
+            todo = "fit the other structure (structures='both')" if "structure" in flag else "widen the bound"
+            warnings.warn(f"{name} = {value:.6g} ends {flag}: the data may want a value beyond it; {todo} "
                           f"(docs/identify.md#bounds)", BoundWarning, stacklevel=level)
     if not success:
-        warnings.warn(f"the fit of {type(fitted_model).__name__} did not converge: {message}; the estimates are where "
+        warnings.warn(f"the fit of {model_name(fitted_model)} did not converge: {message}; the estimates are where "
                       f"the solver stopped (raise max_iter, or give better start values)", ConvergenceWarning,
                       stacklevel=level)
     return FitResult(fitted_model, mass, tuple(space.free), tuple(space.units[n] for n in space.free), est,

@@ -77,7 +77,7 @@ def _structure_bound(model: FrictionModel, name: str, value: float) -> tuple[str
     from prefriction.models.dahl import Dahl
 
     if isinstance(model, Dahl) and name == "gamma":
-        side = "the Dahl structure boundary gamma = 1 (gamma >= 1 and gamma < 1 use different states)"
+        side = "the Dahl structure boundary gamma = 1"
         return (side, "the declared range") if value >= 1.0 else ("the declared range", side)
     return "the declared range", "the declared range"
 
@@ -304,6 +304,7 @@ def symbolic_units(model: FrictionModel, values: dict[str, Any], mass: Any) -> t
         If the model's ``sigma``, ``Fc`` or ``runtime_params_for`` cannot be evaluated on CasADi
         symbols (it uses ``math`` functions on its numbers).
     """
+    from prefriction.models.gms import GMS
     from prefriction.models.maxwell_slip import MaxwellSlip
     from prefriction.models.parallel import Parallel
 
@@ -324,6 +325,13 @@ def symbolic_units(model: FrictionModel, values: dict[str, Any], mass: Any) -> t
         k, W = fields["stiffness"], fields["slip_force"]
         sigma, Fc = ca.sum1(k), ca.sum1(W)
         return sigma, Fc, ca.vertcat(k / sigma, W / Fc)
+    if isinstance(model, GMS):  # GMS.runtime_params_for, written for CasADi columns
+        f = fields
+        sigma, Fc = ca.sum1(f["k"]), f["Fc"]
+        V = Fc / ca.sqrt(mass * sigma)
+        kappa = f["k"] / sigma
+        tail = ca.vertcat(f["Fs"] / Fc - 1.0, V / f["vs"], 0.5 * f["delta"], f["C"] / (sigma * V), f["sigma2"] * V / Fc)
+        return sigma, Fc, ca.vertcat(kappa, f["alpha"], f["damping"] * V / Fc / kappa, tail)
     sym = object.__new__(type(model))
     for f in dataclasses.fields(model):
         object.__setattr__(sym, f.name, getattr(model, f.name))

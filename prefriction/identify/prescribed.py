@@ -1,7 +1,9 @@
 """Fit a friction model to force measured along a prescribed displacement (:class:`ForceDisplacement`).
 
-The model's normalised state is carried sample by sample along the measured displacement
-(:func:`prefriction.identify.stepping.interval_function`, repeated with CasADi ``mapaccum``);
+The model's normalised state is carried sample by sample along the measured displacement by
+the interval step that :func:`prefriction.friction_along` uses
+(:func:`prefriction.identify.stepping.interval_function`: the model's exact step, else RK4
+sub-steps), repeated with CasADi ``mapaccum``;
 the force at every sample is an expression of the parameters, and the least-squares problem is
 solved by scipy's trust-region reflective method with the Jacobian from CasADi's automatic
 differentiation. The built problem depends only on the model's structure, the free parameters
@@ -25,7 +27,7 @@ from scipy.optimize import brentq, least_squares
 
 from prefriction.identify.data import ForceDisplacement
 from prefriction.identify.parameters import ParameterSpace, symbolic_units
-from prefriction.identify.stepping import interval_function
+from prefriction.identify.stepping import has_exact_step, interval_function
 from prefriction.models.base import FrictionModel
 
 __all__ = ["PrescribedProblem", "fit_prescribed", "substeps_for"]
@@ -62,15 +64,13 @@ class _Series:
 
 
 def substeps_for(model: FrictionModel, data: ForceDisplacement, requested: int | None) -> int:
-    """RK4 sub-steps per sample interval: ``requested``; 1 for Maxwell-slip, whose element rates
-    are constant up to the slip event that ``on_event`` applies exactly (one step is the stop
-    operator); otherwise enough that one sub-step moves at most 0.25 (a quarter of the force unit
+    """RK4 sub-steps per sample interval: ``requested``; 1 (unused) for a model with an exact
+    interval step (:meth:`FrictionModel.advance`: Dahl, Maxwell-slip, LuGre, GMS, Viscous and
+    their sums); otherwise enough that one sub-step moves at most 0.25 (a quarter of the force unit
     ``Fc / sigma``) at the start values, times a margin of 4 for the fit to move, between 1 and 64."""
-    from prefriction.models.maxwell_slip import MaxwellSlip
-
     if requested is not None:
         return requested
-    if isinstance(model, MaxwellSlip):
+    if has_exact_step(model):
         return 1
     step = float(np.max(np.abs(np.diff(data.x)))) * model.sigma / model.Fc
     return int(min(64, max(2, math.ceil(4.0 * step / 0.25))))

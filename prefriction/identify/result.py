@@ -123,9 +123,10 @@ class FitResult:
             The record: force [N] along its ``x`` for :class:`ForceDisplacement` (the fitted
             offset added), position [m] for :class:`Motion`.
         **kwargs
-            ``F0`` [N] for :class:`ForceDisplacement`: the force at the first sample that sets
-            the initial state (default: the first measured force); see
-            :func:`prefriction.identify.validation.predict`.
+            For :class:`ForceDisplacement`: ``F0`` [N], the force at the first sample that sets
+            the initial state (default: the first measured force), or ``warmup`` [s], the
+            initial state fitted to the first seconds instead; see
+            :func:`prefriction.identify.validation.predict_force` (``docs/identify.md#validate``).
 
         Returns
         -------
@@ -162,7 +163,8 @@ class FitResult:
         return f"FitResult({model_name(self.model)}: {est}; rms {self.rms:.3g}, {len(self.residuals)} samples{tail})"
 
     def summary(self) -> str:
-        """A few lines: the fitted model, the residual level and any unidentifiable parameter."""
+        """A few lines: the fitted model, the residual level, estimates with intervals and bound
+        flags, any unidentifiable parameter, what was compared, and non-convergence."""
         st = self.statistics
         unit = "m" if isinstance(self.data, Motion) else "N"
         lines = [f"{model_name(self.model)} fitted to {len(self.residuals)} samples of "
@@ -171,6 +173,7 @@ class FitResult:
             lines.append(f"  {n:<14} {v:< 12.6g} [{lo:.6g}, {hi:.6g}] {u}" + self._flag(i, "  "))
         for n, why in st.unidentifiable:
             lines.append(f"  not identifiable: {n} ({why})")
+        lines.extend(f"  {note}" for note in self.notes)
         if not self.success:
             lines.append(f"  NOT CONVERGED: {self.message}")
         return "\n".join(lines)
@@ -178,38 +181,13 @@ class FitResult:
     def _flag(self, i: int, sep: str) -> str:
         return f"{sep}({self.flags[i]})" if i < len(self.flags) and self.flags[i] else ""
 
+
     def report(self) -> str:
         """A table of estimates, standard errors, 95 % intervals and relative errors, the
         correlation matrix, the residual level and the identifiability diagnosis."""
-        st = self.statistics
-        head = f"{'parameter':<14} {'unit':<6} {'estimate':>13} {'std err':>11} {'rel':>8}   95 % interval"
-        rows = [head, "-" * len(head)]
-        for n, u, v, s, lo, hi in zip(self.names, self.units, self.estimates, self.stderr, self.low, self.high):
-            rel = s / abs(v) if v else np.inf
-            rows.append(f"{n:<14} {u:<6} {v:>13.6g} {s:>11.3g} {100 * rel:>7.3g}%   [{lo:.6g}, {hi:.6g}]"
-                        + self._flag(len(rows) - 2, "  "))
-        rows.append("")
-        rows.append("correlation:")
-        width = max(len(n) for n in self.names)
-        for n, row in zip(self.names, self.correlation):
-            rows.append(f"  {n:<{width}} " + " ".join(f"{c:>6.3f}" for c in row))
-        rows.append("")
-        unit = "m" if isinstance(self.data, Motion) else "N"
-        rows.append(f"residual sd {st.sigma_hat:.4g} {unit} ({st.dof} degrees of freedom), "
-                    f"condition number {st.condition:.3g} (Jacobi-scaled)")
-        for key, val in self.nuisance.items():
-            if np.ndim(val) == 0:
-                rows.append(f"{key}: {float(val):.6g}")
-            else:
-                rows.append(f"{key}: {np.size(val)} values")
-        if st.unidentifiable:
-            for n, why in st.unidentifiable:
-                rows.append(f"NOT IDENTIFIABLE from these data: {n} ({why})")
-        else:
-            rows.append("every fitted parameter is identifiable from these data")
-        rows.extend(self.notes)
-        rows.append(f"solver: {self.message}" if self.success else f"NOT CONVERGED: {self.message}")
-        return "\n".join(rows)
+        from prefriction.identify.report import report_text
+
+        return report_text(self)
 
     def plot(self, path: str | Path = "fit.png", *, show: bool = False) -> Path:
         """Data against fit and the residuals, saved to ``path``.
@@ -226,35 +204,6 @@ class FitResult:
         Path
             The file written.
         """
-        import matplotlib.pyplot as plt
+        from prefriction.identify.report import plot_fit
 
-        d = self.data
-        fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7.0, 6.5), height_ratios=[2.2, 1.0], layout="constrained")
-        name = model_name(self.model)
-        if isinstance(d, ForceDisplacement):
-            ax1.plot(d.x * 1e6, d.F, ".", ms=3, color="0.55", label="data")
-            ax1.plot(d.x * 1e6, self.fitted, "-", lw=1.2, color="C0", label=f"fitted {name}")
-            ax1.set_xlabel("displacement x [um]")
-            ax1.set_ylabel("friction force F [N]")
-            ax2.set_ylabel("residual F - fit [N]")
-            ax2.plot(d.t, self.residuals, ".", ms=3, color="C3")
-        else:
-            ax1.plot(d.t, d.x * 1e6, ".", ms=3, color="0.55", label="data")
-            ax1.plot(d.t, self.fitted * 1e6, "-", lw=1.2, color="C0", label=f"fitted {name}")
-            ax1.set_xlabel("time t [s]")
-            ax1.set_ylabel("position x [um]")
-            ax2.set_ylabel("residual x - fit [um]")
-            ax2.plot(d.t, self.residuals * 1e6, ".", ms=3, color="C3")
-        ax1.legend(loc="best", frameon=True)
-        ax1.grid(alpha=0.3)
-        ax2.axhline(0.0, color="0.3", lw=0.8)
-        ax2.set_xlabel("time t [s]")
-        ax2.grid(alpha=0.3)
-        est = ", ".join(f"{n} = {v:.4g}" for n, v in zip(self.names, self.estimates))
-        ax1.set_title(f"{name} fit: {est}", fontsize=9)
-        out = Path(path)
-        fig.savefig(out, dpi=120)
-        if show:
-            plt.show()
-        plt.close(fig)
-        return out
+        return plot_fit(self, path, show)

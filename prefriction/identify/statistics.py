@@ -46,7 +46,10 @@ class Statistics:
     dof : int
         Degrees of freedom ``n - p``.
     condition : float
-        Condition number of the Jacobi-scaled information matrix (columns of ``J`` normalised).
+        Condition number of the Jacobi-scaled information matrix (columns of ``J`` normalised)
+        over the variables that change the residual (a nuisance variable that changes nothing,
+        such as the initial virgin distance of a record that starts in gross sliding, is left
+        out; a parameter that changes nothing is reported as unidentifiable).
     unidentifiable : tuple of (str, str)
         Names of the parameters the data cannot identify, each with the reason.
     """
@@ -100,7 +103,8 @@ def gauss_newton(J: np.ndarray, r: np.ndarray, names: list[str], estimates: np.n
     s2 = rss / dof
     H = (J @ N).T @ (J @ N)
     d = np.sqrt(np.diag(H))
-    d[d == 0.0] = 1.0  # a column that changes nothing stays zero: a singular direction
+    moves = d > 0.0    # variables that change the residual (the condition number is theirs)
+    d[~moves] = 1.0  # a column that changes nothing stays zero: a singular direction
     lam, U = np.linalg.eigh(H / np.outer(d, d))  # Jacobi-scaled: eigenvalues measure collinearity
     top = max(float(lam[-1]), 1e-300)
     good = lam > SINGULAR * top
@@ -132,7 +136,8 @@ def gauss_newton(J: np.ndarray, r: np.ndarray, names: list[str], estimates: np.n
     for i, name in enumerate(names):
         if name not in reasons and not rse[i] <= limit:
             reasons[name] = f"relative standard error {100.0 * rse[i]:.3g} % > {100.0 * limit:.3g} %"
-    cond = float(top / lam[0]) if lam[0] > 0 else np.inf
+    lam_moving = np.linalg.eigvalsh((H / np.outer(d, d))[np.ix_(moves, moves)]) if moves.any() else lam
+    cond = float(lam_moving[-1] / lam_moving[0]) if lam_moving[0] > 0 else np.inf
     return Statistics(se, estimates - tq * se, estimates + tq * se, corr, float(np.sqrt(s2)), dof, cond,
                       tuple((n_, reasons[n_]) for n_ in names if n_ in reasons))
 

@@ -129,6 +129,6 @@ def fit_structures(model: FrictionModel, one: Callable[[FrictionModel], FitResul
     kept = "gamma >= 1" if _gamma(best[1].model) >= 1.0 else "gamma < 1"
     note = f"compared both Dahl structures: {'; '.join(lines)}; kept {kept} (smaller residual)"
     for w in best[2]:
-        warnings.warn(w.message, w.category, stacklevel=4)
+        warnings.warn(w.message, w.category, stacklevel=3)
     return dataclasses.replace(best[1], notes=best[1].notes + (note,))
 

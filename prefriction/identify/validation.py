@@ -6,13 +6,15 @@ stepped by the same compiled recursion as the fit (:mod:`prefriction.identify.pr
 the fitted offset is added.
 
 The initial state (``docs/identify.md#validate``): a held-out record usually starts mid-cycle,
-in a state the record does not give. The prediction starts on the virgin curve whose force
-equals ``F0`` minus the fitted offset (``F0`` defaults to the first measured force), reached by
-a virtual monotone displacement in the direction that gives it. For Dahl this is exact: every
-Dahl state is a force on a virgin-like branch. For models with more states (Maxwell-slip, GMS,
-LuGre) it is an assumption: the element states are those of a virgin loading to ``F0``; the
-error it leaves is wiped out at the first gross-sliding stroke (the memory of those models is
-erased by sliding), so the first stroke can be left out of the score with ``skip``.
+in a state the record does not give. The prediction starts on a virgin curve, reached by a
+virtual monotone displacement ``d0`` (either direction). By default ``d0`` makes the first force
+equal ``F0`` minus the fitted offset (``F0`` defaults to the first measured force); with
+``warmup`` (``validate``'s ``skip``) ``d0`` is the one whose prediction fits the first
+``warmup`` seconds best, and those seconds are not scored. For Dahl the first choice is exact:
+every Dahl state is a force on a virgin-like branch. For models with more states (Maxwell-slip,
+GMS, LuGre) a virgin state is an assumption; the error it leaves dies out at the first
+gross-sliding stroke for elements that slip, and never for an element that does not (it acts as
+a spring whose preload only the warm-up fit can find).
 :class:`Motion` records are predicted by ``prefriction.identify.motion_predict.predict_motion``.
 """
 
@@ -23,10 +25,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from scipy.optimize import brentq
+from scipy.optimize import brentq, minimize_scalar
 
 from prefriction._validation import check_finite
-from prefriction.identify.data import ForceDisplacement, Motion
+from prefriction.identify.data import ForceDisplacement, ForceVelocity, Motion
 
 if TYPE_CHECKING:
     from prefriction.identify.result import FitResult
@@ -49,7 +51,7 @@ _D0 = 30.0
 
 
 def predict_force(model: Any, data: ForceDisplacement, *, offset: float = 0.0, F0: float | None = None,
-                  substeps: int | None = None) -> np.ndarray:
+                  warmup: float = 0.0, substeps: int | None = None) -> np.ndarray:
     """Friction force [N] of ``model`` along ``data.x`` plus ``offset``, started at force ``F0``.
 
     Parameters
@@ -64,6 +66,9 @@ def predict_force(model: Any, data: ForceDisplacement, *, offset: float = 0.0, F
         Force [N] at the first sample (offset included) that sets the initial state; default
         ``data.F[0]``. A force the model cannot reach (beyond its sliding level) starts fully
         loaded in its direction.
+    warmup : float, default 0.0
+        If > 0 (and ``F0`` not given): choose the initial state instead so that the prediction
+        fits ``data.F`` best (least squares) over the first ``warmup`` seconds [s].
     substeps : int, optional
         Runge-Kutta sub-steps per sample interval (default as in :func:`prefriction.identify.fit`).
 
@@ -86,9 +91,26 @@ def predict_force(model: Any, data: ForceDisplacement, *, offset: float = 0.0, F
     def force(d0: float) -> np.ndarray:
         return np.asarray(problem.force(np.append(space.theta0, d0), *args)).ravel()
 
+    if warmup > 0.0 and F0 is None:
+        return force(_best_start(force, data, offset, warmup)) + offset
     lo, hi = force(-_D0)[0] - target, force(_D0)[0] - target
     d0 = -_D0 if lo > 0.0 else _D0 if hi < 0.0 else brentq(lambda d: force(d)[0] - target, -_D0, _D0, xtol=1e-12)
     return force(d0) + offset
+
+
+def _best_start(force: Any, data: ForceDisplacement, offset: float, warmup: float) -> float:
+    """The virgin distance whose prediction fits the first ``warmup`` seconds best: a grid over
+    ``[-_D0, _D0]``, then a bounded scalar search around the best grid point."""
+    keep = data.t <= data.t[0] + warmup
+    F = data.F[keep] - offset
+
+    def cost(d: float) -> float:
+        return float(np.sum((force(d)[keep] - F) ** 2))
+
+    grid = np.linspace(-_D0, _D0, 121)
+    i = int(np.argmin([cost(d) for d in grid]))
+    lo, hi = grid[max(i - 1, 0)], grid[min(i + 1, grid.size - 1)]
+    return float(minimize_scalar(cost, bounds=(lo, hi), method="bounded", options={"xatol": 1e-9}).x)
 
 
 def predict(result: "FitResult", data: ForceDisplacement | Motion, **kwargs: Any) -> np.ndarray:
@@ -101,7 +123,7 @@ def predict(result: "FitResult", data: ForceDisplacement | Motion, **kwargs: Any
     data : ForceDisplacement or Motion
         A record of the kind fitted.
     **kwargs
-        For :class:`ForceDisplacement`: ``F0`` [N] (see :func:`predict_force`). For
+        For :class:`ForceDisplacement`: ``F0`` [N] or ``warmup`` [s] (see :func:`predict_force`). For
         :class:`Motion`: passed to ``prefriction.identify.motion_predict.predict_motion``.
 
     Returns
@@ -117,10 +139,16 @@ def predict(result: "FitResult", data: ForceDisplacement | Motion, **kwargs: Any
     if type(data) is not type(result.data):
         raise TypeError(f"data must be {type(result.data).__name__} like the fitted record, got {type(data).__name__}")
     if isinstance(data, Motion):
-        from prefriction.identify.motion_predict import predict_motion
+        try:
+            from prefriction.identify.motion_predict import predict_motion
+        except ImportError as exc:  # the Motion predictor ships with the Motion fits
+            raise NotImplementedError("predicting Motion data needs prefriction.identify.motion_predict, which this "
+                                      "installation lacks; ForceDisplacement records are supported") from exc
 
         return predict_motion(result, data, **kwargs)
     offset = result.estimate("offset") if "offset" in result.names else 0.0
+    if isinstance(data, ForceVelocity):  # a static map: its force at the record's velocities
+        return result.model.force(data.v) + offset
     return predict_force(result.model, data, offset=offset, **kwargs)
 
 
@@ -221,10 +249,12 @@ def validate(result: "FitResult", data: ForceDisplacement | Motion, *, skip: flo
     data : ForceDisplacement or Motion
         A record of the kind fitted (held out from the fit).
     skip : float, default 0.0
-        Time [s] at the start of the record predicted but not scored (the transient of an
-        unknown initial state, ``0 <= skip`` and fewer than all samples).
+        Time [s] at the start of the record not scored, ``0 <= skip`` leaving at least 2
+        samples. For :class:`ForceDisplacement` without ``F0`` these seconds also set the
+        initial state (``warmup`` of :func:`predict_force`): the state whose prediction fits
+        them best, as system identification estimates initial conditions.
     **kwargs
-        Passed to :func:`predict` (``F0``).
+        Passed to :func:`predict` (``F0``: start at this force instead).
 
     Returns
     -------
@@ -246,6 +276,11 @@ def validate(result: "FitResult", data: ForceDisplacement | Motion, *, skip: flo
     True
     """
     skip = check_finite("skip", skip)
+    if isinstance(data, ForceDisplacement) and "F0" not in kwargs:
+        kwargs["warmup"] = skip
+    if isinstance(data, ForceVelocity):
+        raise TypeError("validate scores records in time; ForceVelocity data have none: compare "
+                        "result.predict(data) [N] with data.F")
     y_hat = predict(result, data, **kwargs)
     keep = data.t >= data.t[0] + skip
     if skip < 0.0 or keep.sum() < 2:

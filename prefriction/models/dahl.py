@@ -16,6 +16,7 @@ import numpy as np
 
 from prefriction.analysis.branch import branch_potential
 from prefriction.models.base import FrictionModel, Parameter
+from prefriction.models.closed_form import exp, log1p_ratio, pick
 
 __all__ = ["Dahl", "distance_of_log_gap", "force_of_p", "p_of_force"]
 
@@ -186,6 +187,25 @@ class Dahl(FrictionModel):
             F = ca.if_else(near, s_old, F) if _sym(F, near) else (s_old if near else F)
             return [p_of_force(s_new * F, q[0])], [0.0]
         return [-(math.log1p(-s_new * F) if type(F) is float else ca.log1p(-s_new * F))], []
+
+    def advance(self, z: Sequence[Any], m: Sequence[Any], v: Any, dt: Any, s: Any,
+                q: Any) -> tuple[list[Any], list[Any]]:
+        """Exact step over ``dt`` at the constant velocity ``v`` (``docs/along.md#exact-steps``).
+
+        With the travel ``xi = s v dt`` along the branch: for gamma < 1 the branch distance
+        ``p + xi``, stopped at saturation ``1 / (1 - gamma)`` (the event, located inside the
+        interval); for gamma >= 1, ``dL/dxi = exp(-k L)`` (``k = gamma - 1``) gives
+        ``L + xi e^(-k L) log(1 + y) / y`` with ``y = k xi e^(-k L)`` (``L + xi`` for gamma = 1).
+        """
+        xi = s * v * dt
+        if self.saturates:
+            e = 1.0 - q[0]
+            p1 = z[0] + xi * (1.0 - m[0])
+            hit = 1.0 - e * p1 <= 0.0
+            return [pick(hit, 1.0 / e, p1)], [pick(hit, 1.0, m[0])]
+        k = q[0] - 1.0
+        a = xi * exp(-k * z[0])
+        return [z[0] + a * log1p_ratio(k * a)], []
 
     def free_branch(self, z: Sequence[float], m: Sequence[float], v: float, s: float, q: Any,
                     horizon: float) -> Optional[tuple[float, float, list[float], list[float], float, int]]:

@@ -56,6 +56,7 @@ import casadi as ca
 import numpy as np
 
 from prefriction.models.base import Parameter
+from prefriction.models.closed_form import exp, pick
 from prefriction.models.elements import TIE, ParallelElements, nonnegative_array, symbolic
 from prefriction.models.stribeck import StribeckCurve
 
@@ -273,6 +274,32 @@ class GMS(StribeckCurve, ParallelElements):
         n = self.n_elements
         S0 = 1.0 + q[3 * n]  # S~ at v = 0: Fs / Fc
         return self._put_on_limits(z, m, s_new, q, snap, [q[n + j] * S0 for j in range(n)], sticking_only=True)
+
+    def advance(self, z: Sequence[Any], m: Sequence[Any], v: Any, dt: Any, s: Any,
+                q: Any) -> tuple[list[Any], list[Any]]:
+        """Exact step over ``dt`` at the constant velocity ``v`` (``docs/along.md#exact-steps``).
+
+        ``S~`` is constant. A sticking element moves by ``kappa_i v dt``; if it reaches its limit
+        ``a_i = alpha_i S~`` (the distance ``d_i = a_i - s z_i``, reached after ``d_i / (kappa_i
+        s v)``, or at once if ``d_i <= 0``) it slips from there; a slipping element relaxes,
+        ``z_i -> s a_i + (z_i - s a_i) exp(-C~ t / a_i)`` over the time ``t`` it slips.
+        """
+        n = self.n_elements
+        S, C = self._S(v, q, 3 * n), q[3 * n + 3]
+        sv = s * v
+        sv_safe = pick(sv > 0.0, sv, 1.0)
+        zn, mn = list(z), list(m)
+        for i in range(n):
+            kappa, a = q[i], q[n + i] * S
+            d = a - s * z[i]
+            reach = (1.0 - m[i]) * (kappa * sv * dt - d) >= -TIE * a
+            t_stick = pick(d > 0.0, d / (kappa * sv_safe), 0.0)
+            t_slip = pick(m[i] > 0.5, dt, pick(reach, dt - t_stick, 0.0))
+            z_on = pick(m[i] > 0.5, z[i], pick(d > 0.0, s * a, z[i]))
+            slipped = s * a + (z_on - s * a) * exp(-C * t_slip / a)
+            zn[i] = pick(m[i] > 0.5, slipped, pick(reach, slipped, z[i] + kappa * v * dt))
+            mn[i] = pick(reach, 1.0, m[i])
+        return zn, mn
 
 
 @dataclass(frozen=True)

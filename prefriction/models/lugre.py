@@ -16,6 +16,7 @@ import casadi as ca
 import numpy as np
 
 from prefriction.models.base import FrictionModel, Parameter
+from prefriction.models.closed_form import expm1
 
 if TYPE_CHECKING:  # units imports the models
     from prefriction.units import Scales
@@ -161,6 +162,14 @@ class LuGre(FrictionModel):
     def reverse(self, z: Sequence[Any], m: Sequence[Any], s_new: Any, q: Any, snap: Any) -> tuple[list[Any], list[Any]]:
         """The bristle deflection is continuous: ``zeta`` unchanged."""
         return [z[0]], []
+
+    def advance(self, z: Sequence[Any], m: Sequence[Any], v: Any, dt: Any, s: Any,
+                q: Any) -> tuple[list[Any], list[Any]]:
+        """Exact step over ``dt`` at the constant velocity ``v``: ``zeta' = v - (s v / g) zeta`` is
+        linear, ``zeta(dt) = zeta + (s g - zeta) (1 - exp(-s v dt / g))``
+        (``docs/along.md#exact-steps``)."""
+        g = self.stribeck(v, q)
+        return [z[0] - (s * g - z[0]) * expm1(-s * v * dt / g)], []
 
     def steady_force(self, v: Any) -> Any:
         """Steady-state friction [N] at the constant velocity ``v`` [m/s] (numpy):

@@ -41,6 +41,7 @@ import casadi as ca
 import numpy as np
 
 from prefriction.models.base import Parameter
+from prefriction.models.closed_form import pick
 from prefriction.models.element_curves import unloading_energy
 from prefriction.models.elements import MAX_ELEMENTS, TIE, ParallelElements, symbolic
 
@@ -213,6 +214,20 @@ class MaxwellSlip(ParallelElements):
         """Every element within ``snap`` of its slip force ``w_j`` (or slipping) is put on it."""
         n = self.n_elements
         return self._put_on_limits(z, m, s_new, q, snap, [q[n + j] for j in range(n)], sticking_only=False)
+
+    def advance(self, z: Sequence[Any], m: Sequence[Any], v: Any, dt: Any, s: Any,
+                q: Any) -> tuple[list[Any], list[Any]]:
+        """Exact step over ``dt`` at the constant velocity ``v``: the stop operator per element
+        (``docs/along.md#exact-steps``). A sticking element moves by ``kappa_i v dt`` up to its
+        limit ``s w_i`` (within :data:`~prefriction.models.elements.TIE`), where it slips."""
+        n = self.n_elements
+        zn, mn = list(z), list(m)
+        for i in range(n):
+            w = q[n + i]
+            z1 = z[i] + q[i] * v * dt * (1.0 - m[i])
+            hit = s * z1 >= w * (1.0 - TIE)
+            zn[i], mn[i] = pick(hit, s * w, z1), pick(hit, 1.0, m[i])
+        return zn, mn
 
     # --- energy ---------------------------------------------------------------------------
     def branch_energy_of_force(self, F: np.ndarray, s: Any) -> np.ndarray:

@@ -98,9 +98,8 @@ class Viscous(FrictionModel):
         return np.array([self.b])
 
     def initial_state(self, f0: float, s: float) -> tuple[list[float], list[float]]:
-        """No state; ``f0`` must be 0 (a damper at rest carries no force)."""
-        if f0 != 0.0:
-            raise ValueError(f"F0 = {f0!r} N: a viscous damper at rest carries no force (allowed: F0 = 0)")
+        """No state (``f0`` unused): a damper at rest carries no force, and ``simulate`` and
+        ``friction_along`` refuse ``F0 != 0`` through ``max_hysteretic_force = 0``."""
         return [], []
 
     def rate(self, z: Sequence[Any], m: Sequence[Any], v: Any, s: Any, q: Any) -> list[Any]:

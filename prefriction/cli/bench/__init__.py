@@ -72,6 +72,10 @@ def main(argv: Optional[list[str]] = None) -> int:
         0 if every target line says PASS, else 1 (argparse errors exit with status 2).
     """
     args = parse(argv)
+    if args.along:  # prefriction.along.bench (docs/along.md#speed)
+        from prefriction.along import bench as along_bench
+
+        return along_bench.main(args.repeats, args.quick)
     if args.loops:
         return _loops(args.repeats)
     if args.identify:

@@ -28,6 +28,7 @@ output (in --out): bench.csv (every measured point), work_precision.png, stabili
 
 examples:
   prefriction bench --quick          two tolerances, one repeat, 500 long reversals
+  prefriction bench --along          friction_along per 100,000 samples against scipy
   prefriction bench --stability      simulate only: stiff and extreme cases, no peers
   prefriction bench --repeats 9      more warm repeats per point
   prefriction bench --models         Maxwell-slip, LuGre and GMS against scipy
@@ -119,6 +120,9 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
                     help=f"warm repeats per point, 1..{MAX_REPEATS}; the minimum time is kept "
                          "(default: 5, 1 with --quick)")
     what = ap.add_mutually_exclusive_group()
+    what.add_argument("--along", action="store_true",
+                      help="instead: friction_along, warm time per 100,000 samples per model and error against "
+                           "scipy references restarted at every interval and event (docs/along.md#speed)")
     what.add_argument("--stability", action="store_true",
                       help="simulate only: the stiff and extreme cases, no peers (target 2 not measured)")
     what.add_argument("--models", action="store_true",
