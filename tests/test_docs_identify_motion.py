@@ -23,7 +23,7 @@ def _shown(after: str) -> list[str]:
 def test_every_python_block_runs_and_prints_what_the_page_shows():
     namespace: dict = {}
     blocks = list(re.finditer(r"```python\n(.*?)```", PAGE, flags=re.S))
-    assert len(blocks) == 4
+    assert len(blocks) == 5
     for b in blocks:
         out = io.StringIO()
         with contextlib.redirect_stdout(out), warnings.catch_warnings():
