@@ -204,3 +204,13 @@ def test_user_bound_interval_stays_inside(small):
                            bounds={"sigma": (1e4, 3.5e4)})
     lo, hi = res.interval("sigma")
     assert hi == 3.5e4 and lo < hi
+
+
+def test_plots_refuse_a_missing_directory(small, tmp_path):
+    res = identify.fit(pf.Dahl(sigma=3e4, Fc=2.0, gamma=0.5), small, offset=True, structures="given")
+    missing = tmp_path / "nowhere" / "x.png"
+    with pytest.raises(ValueError, match="path must be in an existing directory"):
+        res.plot(missing)
+    with pytest.raises(ValueError, match="path must be in an existing directory"):
+        res.validate(small).plot(missing)
+    assert "residual sd" in res.summary() and res.summary().count("\n") < 12

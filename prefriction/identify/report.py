@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from prefriction.identify.data import ForceDisplacement, ForceVelocity, Motion
-from prefriction.identify.validation import model_name
+from prefriction.identify.validation import check_directory, model_name
 
 if TYPE_CHECKING:
     from prefriction.identify.result import FitResult
@@ -85,6 +85,7 @@ def plot_fit(res: "FitResult", path: str | Path, show: bool) -> Path:
     """
     import matplotlib.pyplot as plt
 
+    check_directory(path)
     d = res.data
     fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7.0, 6.5), height_ratios=[2.2, 1.0], layout="constrained")
     name = model_name(res.model)

@@ -33,7 +33,20 @@ from prefriction.identify.data import ForceDisplacement, ForceVelocity, Motion
 if TYPE_CHECKING:
     from prefriction.identify.result import FitResult
 
-__all__ = ["Validation", "model_name", "predict", "predict_force", "validate"]
+__all__ = ["Validation", "check_directory", "model_name", "predict", "predict_force", "validate"]
+
+
+def check_directory(path: str | Path) -> None:
+    """Raise ``ValueError`` if the directory of the file ``path`` does not exist.
+
+    Parameters
+    ----------
+    path : str or Path
+        A file to write.
+    """
+    if not Path(path).parent.is_dir():
+        raise ValueError(f"path must be in an existing directory: {Path(path).parent} does not exist "
+                         f"(create it first), got path = {str(path)!r}")
 
 
 def model_name(model: Any) -> str:
@@ -207,15 +220,21 @@ class Validation:
         Parameters
         ----------
         path : str or Path, default "validation.png"
-            Image file to write (the format from the suffix).
+            Image file to write (the format from the suffix), in an existing directory.
 
         Returns
         -------
         Path
             The file written.
+
+        Raises
+        ------
+        ValueError
+            If the directory of ``path`` does not exist.
         """
         import matplotlib.pyplot as plt
 
+        check_directory(path)
         k = 1e6 if self.unit == "m" else 1.0
         unit = "µm" if self.unit == "m" else "N"
         what = "position x" if self.unit == "m" else "friction force F"
