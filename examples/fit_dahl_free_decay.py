@@ -4,9 +4,10 @@ Synthetic measurements: the unforced Dahl oscillator released with a velocity th
 into gross sliding; reversal times, positions and forces from ``prefriction.exact_reversals``,
 the samples in between from scipy DOP853 at ``rtol = 1e-12``
 (``prefriction.identify.synthetic.dahl_free_decay``), with position noise. The amplitudes decay
-like ``3 / (2 n)`` (``docs/mathematics.md#convergence``). The fit is multiple shooting between
-the reversals located in the data, with IPOPT; the figure shows the data, the fit, the
-residuals and the located reversals against the exact ones. With the mass free as well, the
+like ``3 / (2 n)`` (``docs/mathematics.md#convergence``). The fit is multiple shooting over
+segments of 50 samples with constrained Gauss-Newton (``docs/identify_motion.md``), the
+reversals located inside the sub-steps; the figure shows the data, the fit, the residuals and
+the reversals of the fitted motion against the exact ones. With the mass free as well, the
 fit warns that a free decay cannot tell ``m``, ``sigma`` and ``Fc`` apart.
 
 Run: ``python examples/fit_dahl_free_decay.py [outdir] [--quick]``.

@@ -14,7 +14,7 @@ import pytest
 
 import prefriction as pf
 from prefriction import identify
-from prefriction.identify import shooting
+from prefriction.identify import motion_step
 from prefriction.identify.synthetic import lugre_free_decay
 
 TRUE = pf.LuGre(sigma0=1.0e4, sigma1=20.0, sigma2=0.4, Fc=1.0, Fs=1.3, vs=3.0e-3)
@@ -31,7 +31,7 @@ TRUTH = np.array([TRUE.sigma0, TRUE.sigma1, TRUE.Fc])
 def test_lugre_free_decay_recovered_by_multiple_shooting():
     clean, radau = lugre_free_decay(TRUE, MASS, V0, T, 0.0, np.random.default_rng(0))
     assert radau.size == 3
-    built = len(shooting._CACHE)
+    built = len(motion_step._CACHE)
     exact = identify.fit(START, clean, free=FREE, tol=1e-9)
     tau = exact.nuisance["reversal times [s]"]
     np.testing.assert_allclose(tau, radau, atol=0.01 * (T[1] - T[0]))
@@ -43,4 +43,4 @@ def test_lugre_free_decay_recovered_by_multiple_shooting():
     assert np.all(np.abs(res.estimates - TRUTH) <= 3.0 * res.stderr), res.report()
     assert res.statistics.sigma_hat == pytest.approx(NOISE, rel=0.25)
     assert res.unidentifiable == ()
-    assert len(shooting._CACHE) <= built + 1  # one nonlinear program for both fits
+    assert len(motion_step._CACHE) <= built + 1  # one nonlinear program for both fits

@@ -9,15 +9,18 @@
   :class:`BoundWarning`: an estimate on a bound; :class:`ConvergenceWarning`: a fit that
   stopped without converging.
 - :class:`Validation`: prediction errors on held-out data (``FitResult.validate``).
+- :class:`ForceVelocity` and :class:`StaticFriction`: steady-sliding force against velocity and
+  the classic static map (Coulomb + viscous + Stribeck, direction-dependent levels) it fits.
 """
 
 from __future__ import annotations
 
-from prefriction.identify.data import ForceDisplacement, Motion
+from prefriction.identify.data import ForceDisplacement, ForceVelocity, Motion
 from prefriction.identify.fit import fit
 from prefriction.identify.result import FitResult
+from prefriction.identify.static_map import StaticFriction
 from prefriction.identify.statistics import BoundWarning, ConvergenceWarning, IdentifiabilityWarning
 from prefriction.identify.validation import Validation
 
-__all__ = ["BoundWarning", "ConvergenceWarning", "FitResult", "ForceDisplacement", "IdentifiabilityWarning", "Motion",
-           "Validation", "fit"]
+__all__ = ["BoundWarning", "ConvergenceWarning", "FitResult", "ForceDisplacement", "ForceVelocity",
+           "IdentifiabilityWarning", "Motion", "StaticFriction", "Validation", "fit"]

@@ -14,10 +14,12 @@ import numpy as np
 
 from prefriction._validation import check_positive
 
-__all__ = ["ForceDisplacement", "Motion", "MIN_SAMPLES", "MAX_SAMPLES"]
+__all__ = ["ForceDisplacement", "ForceVelocity", "HOLDS", "Motion", "MIN_SAMPLES", "MAX_SAMPLES"]
 
 MIN_SAMPLES = 8
 """Fewest samples a data set may hold."""
+HOLDS = ("zoh", "linear")
+"""How :class:`Motion` holds the applied force between samples."""
 MAX_SAMPLES = 200_000
 """Most samples a data set may hold (the fit builds one expression per sample interval)."""
 
@@ -130,12 +132,16 @@ class Motion:
     x : array_like
         Measured position [m] at the sample times.
     u : float or array_like, default 0.0
-        Applied force [N]: a constant (``0`` is a free decay) or one sample per time, linear in
-        between.
+        Applied force [N]: a constant (``0`` is a free decay) or one sample per time, held
+        between the samples as ``hold`` says.
     mass : float or None, default None
         Moving mass [kg], ``0 < mass < inf``, if known; ``None`` fits it (give ``mass0`` to
         :func:`prefriction.identify.fit`). A free decay cannot tell the mass from the force
         scale: with ``u = 0``, ``m``, ``sigma`` and ``Fc`` scaled together give the same motion.
+    hold : {"zoh", "linear"}, default "zoh"
+        How ``u`` acts between samples ``t[k]`` and ``t[k+1]``: ``"zoh"`` holds ``u[k]`` (what a
+        digital loop applies: its output changes at the samples and is held in between);
+        ``"linear"`` interpolates linearly between ``u[k]`` and ``u[k+1]``.
 
     Raises
     ------
@@ -150,8 +156,12 @@ class Motion:
     x: Any
     u: Any = 0.0
     mass: Any = None
+    hold: str = "zoh"
 
     def __post_init__(self) -> None:
+        if self.hold not in HOLDS:
+            raise ValueError(f"hold must be one of {HOLDS}, got {self.hold!r} ('zoh': u[k] held over each "
+                             f"sample interval; 'linear': u linear between the samples)")
         t = _times(self.t)
         x = _samples("x", self.x, "m")
         _same_length(t, "x", x)
@@ -181,4 +191,48 @@ class Motion:
         m = "free" if self.mass is None else f"{self.mass:.4g} kg"
         u = "u = 0 (free decay)" if self.free_decay else f"u in [{self.u.min():.4g}, {self.u.max():.4g}] N"
         return (f"Motion({len(self)} samples, t in [{self.t[0]:.4g}, {self.t[-1]:.4g}] s, "
-                f"x in [{self.x.min():.4g}, {self.x.max():.4g}] m, {u}, mass {m})")
+                f"x in [{self.x.min():.4g}, {self.x.max():.4g}] m, {u}, mass {m}, hold {self.hold!r})")
+
+
+@dataclass(frozen=True, eq=False)
+class ForceVelocity:
+    """Friction force measured in steady sliding at a set of velocities (a Stribeck curve).
+
+    The data of a static friction map (:class:`prefriction.identify.StaticFriction`): each
+    sample is one constant-velocity run, its velocity ``v`` and its friction force ``F``.
+
+    Parameters
+    ----------
+    v : array_like
+        Sliding velocities [m/s], 8 to 200 000 samples, any order, both signs allowed.
+    F : array_like
+        Measured friction force [N] at each velocity.
+
+    Raises
+    ------
+    TypeError
+        If an argument is not an array of real numbers.
+    ValueError
+        If an array is not 1-D, holds NaN or inf, the lengths differ, there are too few or too
+        many samples, or ``v`` or ``F`` is constant. The message names the argument.
+    """
+
+    v: Any
+    F: Any
+
+    def __post_init__(self) -> None:
+        v = _samples("v", self.v, "m/s")
+        F = _samples("F", self.F, "N")
+        if F.size != v.size:
+            raise ValueError(f"F must have one sample per velocity, got len(F) = {F.size} and len(v) = {v.size}")
+        _moving("v", v, "m/s")
+        _moving("F", F, "N")
+        object.__setattr__(self, "v", v)
+        object.__setattr__(self, "F", F)
+
+    def __len__(self) -> int:
+        return int(self.v.size)
+
+    def __repr__(self) -> str:
+        return (f"ForceVelocity({len(self)} samples, v in [{self.v.min():.4g}, {self.v.max():.4g}] m/s, "
+                f"F in [{self.F.min():.4g}, {self.F.max():.4g}] N)")

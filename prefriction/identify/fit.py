@@ -8,7 +8,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from prefriction._validation import check_bool, check_count, check_positive
-from prefriction.identify.data import ForceDisplacement, Motion
+from prefriction.identify.data import ForceDisplacement, ForceVelocity, Motion
 from prefriction.identify.parameters import ParameterSpace
 from prefriction.identify.result import FitResult
 from prefriction.identify.validation import model_name
@@ -38,12 +38,17 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
         The model to fit (:class:`prefriction.Dahl`, :class:`prefriction.MaxwellSlip`,
         :class:`prefriction.LuGre`, ...); its parameter values are the starting values, and fix
         its structure (Dahl: ``gamma >= 1`` or ``gamma < 1``; Maxwell-slip: the number of elements).
-    data : ForceDisplacement or Motion
+    data : ForceDisplacement, Motion or ForceVelocity
+        :class:`ForceVelocity` (steady-sliding force against velocity): fits a
+        :class:`prefriction.identify.StaticFriction` map (Coulomb + viscous + Stribeck,
+        optionally direction-dependent) by least squares (``docs/identify_motion.md#static-maps``).
         :class:`ForceDisplacement`: friction force along a prescribed displacement; the model's
         force along the measured ``x`` is fitted to ``F`` by least squares (trust-region
         reflective, Jacobian by CasADi). :class:`Motion`: positions of a mass under a known
-        force ``u`` (a free decay for ``u = 0``); fitted by multiple shooting between the
-        velocity reversals (located in the data, refined as free variables) with IPOPT.
+        force ``u`` (a free decay for ``u = 0``), held or linear between samples as
+        ``data.hold`` says; fitted by multiple shooting over segments of 50 samples with
+        constrained Gauss-Newton (``docs/identify_motion.md``: time and memory grow linearly
+        with the samples).
     free : sequence of str, optional
         Parameters to fit (names of ``type(model).parameters``; ``"stiffness[0]"`` for an
         array entry; ``"mass"``). Default: every parameter not in ``fixed``.
@@ -55,7 +60,9 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
         Default: the declared range, narrowed to keep the model's structure (Dahl ``gamma``).
     offset : bool, default False
         Also fit a constant force offset ``"offset"`` [N] (a sensor bias), added to the model's
-        force (:class:`ForceDisplacement`); estimated, with its interval, like any parameter.
+        force (:class:`ForceDisplacement`) or to the friction of a :class:`Motion`
+        (``m x'' + F + F_off = u``, a bias of the force sensor or the drive); estimated, with its
+        interval, like any parameter.
     structures : {"both", "given"}, default "both"
         For :class:`prefriction.Dahl` with ``gamma`` free and not bounded by ``bounds``:
         ``"both"`` fits the start model's structure and the other one (``gamma < 1`` started at
@@ -63,12 +70,15 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
         the smaller residual, and says in ``FitResult.notes`` what it compared; ``"given"`` fits
         the start model's structure only.
     mass0 : float, optional
-        Start value of the mass [kg] when ``data.mass`` is ``None`` (the mass is then fitted).
+        Start value of the mass [kg] when ``data.mass`` is ``None`` (the mass is then fitted). For
+        a forced record (``u`` not zero) the static least-squares fit of the force balance
+        (``docs/identify_motion.md#start-values``) gives the start values of the mass, of the
+        force level ``Fc`` (and ``Fs`` in proportion), of the viscous coefficient and of the
+        offset where they are free and come out positive; ``mass0`` is the fallback.
     reversals : sequence of float, optional
-        Approximate velocity reversal times [s] of :class:`Motion` data, each refined within a
-        sample and a half; default: located from the sign changes of a smoothed velocity. The
-        nonlinear program is built once per model structure, free set, number of samples and
-        sample interval of every reversal, so refits with the same reversal layout reuse it.
+        Approximate velocity reversal times [s] of :class:`Motion` data: the direction of
+        motion at each shooting node is taken from them; default: the sign of a smoothed
+        velocity. Reversals inside a sample are located by the fit itself.
     substeps : int, optional
         Runge-Kutta sub-steps per sample interval (1 to 64); default: chosen from the data and
         the start values (1 for Maxwell-slip on force-displacement data, where one step is the
@@ -128,11 +138,17 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
     >>> res.estimate("offset") > 0.0
     True
     """
-    if not isinstance(model, FrictionModel):
+    from prefriction.identify.static_map import StaticFriction
+
+    if isinstance(model, StaticFriction) != isinstance(data, ForceVelocity):
+        raise TypeError(f"a StaticFriction map is fitted to ForceVelocity data and only it, got {type(model).__name__} "
+                        f"and {type(data).__name__}")
+    if not isinstance(model, (FrictionModel, StaticFriction)):
         raise TypeError(f"model must be a prefriction.FrictionModel (e.g. prefriction.Dahl), got {model!r} "
                         f"of type {type(model).__name__}")
-    if not isinstance(data, (ForceDisplacement, Motion)):
-        raise TypeError(f"data must be prefriction.identify.ForceDisplacement or Motion, got {type(data).__name__}")
+    if not isinstance(data, (ForceDisplacement, Motion, ForceVelocity)):
+        raise TypeError(f"data must be prefriction.identify.ForceDisplacement, Motion or ForceVelocity, got "
+                        f"{type(data).__name__}")
     if substeps is not None:
         substeps = check_count("substeps", substeps, 1)
         if substeps > 64:
@@ -146,11 +162,13 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
     offset = check_bool("offset", offset)
     if structures not in ("both", "given"):
         raise ValueError(f"structures must be 'both' or 'given', got {structures!r}")
+    if isinstance(data, ForceVelocity):
+        from prefriction.identify.static_fit import fit_static
+
+        return fit_static(model, data, free=free, fixed=fixed, bounds=bounds, offset=offset, max_iter=max_iter,
+                          tol=tol, limit=limit)
     if isinstance(data, Motion):
-        if offset:
-            raise ValueError("offset=True is for ForceDisplacement data: a Motion fit has no measured force to offset "
-                             "(allowed: offset=False)")
-        return _fit_motion(model, data, free, fixed, bounds, mass0, reversals, substeps, max_iter, tol, limit)
+        return _fit_motion(model, data, free, fixed, bounds, mass0, reversals, substeps, max_iter, tol, limit, offset)
     if reversals is not None:
         raise ValueError("reversals is for Motion data; force-displacement data have their directions from dx "
                          "(allowed: reversals=None)")
@@ -188,7 +206,8 @@ def _fit_prescribed(model: FrictionModel, data: ForceDisplacement, free: Any, fi
 
 
 def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bounds: Any, mass0: Any, reversals: Any,
-                substeps: int | None, max_iter: int, tol: float, limit: float) -> FitResult:
+                substeps: int | None, max_iter: int, tol: float, limit: float, offset: bool) -> FitResult:
+    from prefriction.identify.motion_start import start_values
     from prefriction.identify.shooting import fit_motion
 
     if data.mass is None:
@@ -199,8 +218,13 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
     elif mass0 is not None:
         raise ValueError(f"mass0 = {mass0!r} is only for a free mass, but data.mass = {data.mass!r} is known "
                          f"(allowed: mass0=None)")
-    space = ParameterSpace(model, free, fixed, bounds, mass=mass0)
-    sol = fit_motion(model, data, space, n_sub=substeps, max_iter=max_iter, tol=tol, reversals=reversals)
+    if offset and data.free_decay:
+        raise ValueError("offset=True needs an applied force: in a free decay (u = 0) a force offset cannot be told "
+                         "from the rest position (allowed: offset=False)")
+    model, mass0, offset0, scale = start_values(model, data, mass0, free, fixed, bounds)
+    space = ParameterSpace(model, free, fixed, bounds, mass=mass0, offset=scale if offset else None)
+    sol = fit_motion(model, data, space, n_sub=substeps, max_iter=max_iter, tol=tol, reversals=reversals,
+                     offset0=offset0)
     values = space.values(sol.w[: space.n_free])
     est = np.array([values[n] for n in space.free])
     stats = gauss_newton(sol.jacobian, sol.residuals, space.free, est, space.scale,

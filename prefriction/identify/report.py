@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from prefriction.identify.data import ForceDisplacement, Motion
+from prefriction.identify.data import ForceDisplacement, ForceVelocity, Motion
 from prefriction.identify.validation import check_directory, model_name
 
 if TYPE_CHECKING:
@@ -88,7 +89,18 @@ def plot_fit(res: "FitResult", path: str | Path, show: bool) -> Path:
     d = res.data
     fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7.0, 6.5), height_ratios=[2.2, 1.0], layout="constrained")
     name = model_name(res.model)
-    if isinstance(d, ForceDisplacement):
+    if isinstance(d, ForceVelocity):
+        order = np.argsort(d.v)
+        ax1.plot(d.v, d.F, ".", ms=4, color="0.55", label="data")
+        ax1.plot(d.v[order], res.fitted[order], "-", lw=1.2, color="C0", label=f"fitted {name}")
+        ax1.set_xlabel("velocity v [m/s]")
+        ax1.set_ylabel("friction force F [N]")
+        ax2.set_ylabel("residual F - fit [N]")
+        ax2.plot(d.v, res.residuals, ".", ms=3, color="C3")
+        small = float(np.min(np.abs(d.v[d.v != 0.0]))) if np.any(d.v != 0.0) else 1.0
+        for ax in (ax1, ax2):  # the Stribeck region lives at small speeds
+            ax.set_xscale("symlog", linthresh=small)
+    elif isinstance(d, ForceDisplacement):
         ax1.plot(d.x * 1e6, d.F, ".", ms=3, color="0.55", label="data")
         ax1.plot(d.x * 1e6, res.fitted, "-", lw=1.2, color="C0", label=f"fitted {name}")
         ax1.set_xlabel("displacement x [µm]")
@@ -105,10 +117,10 @@ def plot_fit(res: "FitResult", path: str | Path, show: bool) -> Path:
     ax1.legend(loc="best", frameon=True)
     ax1.grid(alpha=0.3)
     ax2.axhline(0.0, color="0.3", lw=0.8)
-    ax2.set_xlabel("time t [s]")
+    ax2.set_xlabel("velocity v [m/s]" if isinstance(d, ForceVelocity) else "time t [s]")
     ax2.grid(alpha=0.3)
     est = ", ".join(f"{n} = {v:.4g}" for n, v in zip(res.names, res.estimates))
-    ax1.set_title(f"{name} fit: {est}", fontsize=9)
+    ax1.set_title("\n".join(textwrap.wrap(f"{name} fit: {est}", 100)), fontsize=9)  # long sums wrap
     out = Path(path)
     fig.savefig(out, dpi=120)
     if show:

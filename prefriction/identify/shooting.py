@@ -1,43 +1,50 @@
-"""Fit a friction model to the motion of a mass (:class:`Motion`) by multiple shooting with IPOPT.
+"""Fit a friction model to the motion of a mass (:class:`Motion`) by multiple shooting.
 
-The record is cut into segments at the velocity reversals located in the data
-(:func:`prefriction.identify.reversals.locate_reversals`). Each segment has a fixed direction
-``s`` and starts at its reversal time ``tau_j`` (a free variable within a sample and a half of
-its estimate) with zero velocity, a free position and a free model state; the first segment
-starts at the first sample with free position, velocity and state. Inside a segment the
-oscillator ``m x'' + F = u`` (2.1) and the model's state are integrated in the model's
-normalised units (``docs/models.md#protocol``) by RK4 sub-steps between the samples (from the
-reversal to the first sample, possibly backwards by a fraction of a sample: near a reversal
-the velocity is small and the branch direction matters only at fourth order in the time
-offset). Continuity at every reversal: position, zero velocity, and the state after
-``reverse``. The objective is the sum of squared position residuals.
+The record is cut into segments of ``K`` samples (:data:`SEGMENT`). Each segment starts at a
+node with a free position, velocity and model state and is simulated sample by sample
+(:mod:`prefriction.identify.motion_step`: ``m x'' + F + F_off = u`` (2.1), the applied force held
+or linear over each sample as the data say, reversals located inside the sub-steps); the end
+of a segment must meet the next node. The objective is the sum of squared position residuals,
+minimised by constrained Gauss-Newton on sparse matrices
+(:mod:`prefriction.identify.constrained_lsq`), with forward sensitivities propagated sample
+by sample. Nothing holds more than a few numbers per sample and sensitivity column, so the
+time and the memory of a fit grow linearly with the samples (measured:
+``docs/identify_motion.md``).
 
-The nonlinear program depends on the model structure, the free parameters, the number of
-samples and the segment layout; the data, start values and fixed values are its parameters,
-so refits of data with the same layout reuse it.
+The statistics need the residual Jacobian on the constraint manifold: chaining the segment
+sensitivities node to node gives it with respect to the parameters and the first node alone
+(the single-shooting Jacobian), ``n`` rows by a few columns.
 """
 
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass
 from typing import Any
 
 import casadi as ca
 import numpy as np
+import scipy.sparse as sp
 
 from prefriction.errors import SolverError
+from prefriction.identify.constrained_lsq import solve
 from prefriction.identify.data import Motion
-from prefriction.identify.parameters import ParameterSpace, symbolic_units
+from prefriction.identify.motion_start import derivatives
+from prefriction.identify.motion_step import STATE_CAP, segment_functions
+from prefriction.identify.parameters import ParameterSpace
 from prefriction.identify.reversals import locate_reversals
-from prefriction.identify.stepping import rk4
 from prefriction.models.base import FrictionModel
 
-__all__ = ["MotionSolution", "fit_motion"]
+__all__ = ["LONG", "SEGMENT", "MotionSolution", "fit_motion"]
 
-_SLACK = 1.5
-"""Half-width of a reversal time's bracket, in samples around its estimate."""
-_CACHE: dict[Any, "_ShootingProblem"] = {}
+SEGMENT = 50
+"""Samples per shooting segment."""
+LONG = 5_000
+"""Records of at least this many samples report each iteration on stderr (long work)."""
+_NODE_WINDOW = 7
+"""Samples of the Savitzky-Golay window of the node start values (short: coarse records)."""
+_MAPPED: dict[Any, tuple[ca.Function, ca.Function]] = {}
 
 
 @dataclass(frozen=True)
@@ -47,211 +54,316 @@ class MotionSolution:
     w: np.ndarray
     residuals: np.ndarray
     jacobian: np.ndarray
-    constraints: np.ndarray
+    constraints: np.ndarray | None
     prediction: np.ndarray
     nuisance: dict
     message: str
 
 
-class _ShootingProblem:
-    """The multiple-shooting NLP of one structure and segment layout (built once, then reused)."""
+@dataclass(frozen=True)
+class _Layout:
+    """Segments of a record: node samples, padded inputs, directions, scales."""
 
-    def __init__(self, model: FrictionModel, space: ParameterSpace, n: int, cuts: tuple[int, ...], n_sub: int,
-                 mass_free: bool, max_iter: int, tol: float) -> None:
-        nz, nf, nx = model.n_states, space.n_free, len(space.fixed)
-        nr = len(cuts)
-        P = {name: ca.SX.sym(name, size) for name, size in
-             (("t", n), ("x", n), ("u", n), ("scale", nf), ("fixed", nx), ("mass", 1), ("tau0", nr),
-              ("htau", nr), ("s0", 1), ("xs", 1))}
-        theta = ca.SX.sym("theta", nf)
-        values = {name: theta[i] * P["scale"][i] for i, name in enumerate(space.free)}
-        values.update({name: P["fixed"][i] for i, name in enumerate(space.fixed)})
-        mass = values["mass"] if mass_free else P["mass"]
-        sigma, Fc, q = symbolic_units(model, values, mass)
-        ql = [q[i] for i in range(q.shape[0])]
-        T = ca.sqrt(mass / sigma)
-        X = Fc / sigma
-        first = ca.SX.sym("first", 2 + nz)                   # x~, v~, z at t0
-        nodes = [ca.SX.sym(f"node{j}", 2 + nz) for j in range(nr)]   # dtau, x~, z at each reversal
-        t, x, u = P["t"], P["x"], P["u"]
+    K: int
+    nodes: np.ndarray
+    U0: np.ndarray
+    U1: np.ndarray
+    DT: np.ndarray
+    s: np.ndarray
+    scl: np.ndarray
+    n: int
 
-        piece = _piece_function(model, n_sub, q.shape[0])
+    @property
+    def J(self) -> int:
+        return int(self.nodes.size)
 
-        def advance(y: list[Any], s: Any, t_from: Any, t_to: Any, i: int) -> list[Any]:
-            """From ``t_from`` to ``t_to`` with u linear on the data interval ``[t[i-1], t[i]]`` (extended)."""
-            a, b = max(i - 1, 0), max(i, 1)
-            slope = (u[b] - u[a]) / (t[b] - t[a])
-            out = piece(ca.vertcat(*y), s, t_from, t_to, u[a], t[a], slope, T, Fc, q)
-            return [out[k] for k in range(2 + nz)]
-
-        pred, cons = [], []
-        starts = [0] + [k + 1 for k in cuts]
-        ends = [k + 1 for k in cuts] + [n]
-        s = P["s0"]
-        y = [first[0], first[1], *[first[2 + i] for i in range(nz)]]
-        t_prev: Any = t[0]
-        for j, (a_idx, b_idx) in enumerate(zip(starts, ends)):
-            for i in range(a_idx, b_idx):
-                if not (j == 0 and i == 0):
-                    y = advance(y, s, t_prev, t[i], i)
-                pred.append(y[0] * X)
-                t_prev = t[i]
-            if j < nr:
-                tau = P["tau0"][j] + P["htau"][j] * nodes[j][0]
-                y = advance(y, s, t_prev, tau, b_idx)
-                s = -s
-                z_new, _m = model.reverse(y[2:], [], s, ql, 1e-12)
-                node = nodes[j]
-                cons += [y[0] - node[1], y[1], *[zz - node[2 + i] for i, zz in enumerate(z_new)]]
-                y = [node[1], 0.0 * node[1], *[node[2 + i] for i in range(nz)]]
-                t_prev = tau
-        w = ca.vertcat(theta, first, *nodes)
-        r = ca.vertcat(*pred) - x
-        p = ca.vertcat(*P.values())
-        g = ca.vertcat(*cons) if cons else ca.SX(0, 1)
-        self.n_w, self.n_g, self.n_theta, self.nz = w.shape[0], g.shape[0], nf, nz
-        nlp = {"x": w, "p": p, "f": 0.5 * ca.sumsqr(r / P["xs"]), "g": g}
-        opts = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes", "ipopt.max_iter": max_iter,
-                "ipopt.tol": tol}
-        self.solver = ca.nlpsol("motion_fit", "ipopt", nlp, opts)
-        self.parts = ca.Function("parts", [w, p], [r, ca.jacobian(r, w), g, ca.jacobian(g, w),
-                                                   ca.vertcat(*pred), sigma, Fc, T])
-        self.param_names = list(P)
-
-    @classmethod
-    def get(cls, model: FrictionModel, space: ParameterSpace, n: int, cuts: tuple[int, ...], n_sub: int,
-            mass_free: bool, max_iter: int, tol: float) -> "_ShootingProblem":
-        key = (type(model), model.structure_key(), tuple(space.free), tuple(space.fixed), n, cuts, n_sub, mass_free,
-               max_iter, tol)
-        if key not in _CACHE:
-            _CACHE[key] = cls(model, space, n, cuts, n_sub, mass_free, max_iter, tol)
-        return _CACHE[key]
+    def samples(self) -> np.ndarray:
+        """Index of the data sample of every output column (``-1``: the end of a segment or padding)."""
+        idx = self.nodes[:, None] + np.arange(self.K + 1)[None, :]
+        idx[:, -1] = -1
+        idx[-1, -1] = self.nodes[-1] + self.K if self.nodes[-1] + self.K == self.n - 1 else -1
+        idx[idx >= self.n] = -1
+        return idx.ravel()
 
 
-def _piece_function(model: FrictionModel, n_sub: int, nq: int) -> ca.Function:
-    """``n_sub`` RK4 sub-steps of the normalised oscillator ``x~' = v~``, ``v~' = u~ - F~``, with
-    the model's state, from ``t_from`` to ``t_to`` [s] (SX ``Function``, inlined where called).
+def _layout(data: Motion, K: int, directions: np.ndarray, scl: np.ndarray) -> _Layout:
+    n = len(data)
+    J = max(1, math.ceil((n - 1) / K))
+    nodes = np.arange(J) * K
+    total = J * K
+    dt = np.zeros(total)
+    dt[: n - 1] = np.diff(data.t)
+    u0 = np.zeros(total)
+    u0[: n - 1] = data.u[:-1]
+    u1 = u0.copy() if data.hold == "zoh" else np.zeros(total)
+    if data.hold == "linear":
+        u1[: n - 1] = data.u[1:]
+    return _Layout(K, nodes, u0, u1, dt, directions[nodes], scl, n)
 
-    Inputs ``(y, s, t_from, t_to, u_a, t_a, slope, T, Fc, q)``: state ``[x~, v~, z]``, direction,
-    the interval, the applied force ``u = u_a + slope (t - t_a)`` [N], the time unit ``T`` [s],
-    the force unit ``Fc`` [N] and the run-time numbers ``q``.
-    """
-    nz = model.n_states
-    y = ca.SX.sym("y", 2 + nz)
-    s, t_from, t_to, u_a, t_a, slope, T, Fc = (ca.SX.sym(n) for n in ("s", "t_from", "t_to", "u_a", "t_a",
-                                                                         "slope", "T", "Fc"))
-    qs = ca.SX.sym("q", nq)
-    ql = [qs[i] for i in range(nq)]
 
-    def rhs(yy: list[Any], ut: Any) -> list[Any]:
-        z = yy[2:]
-        F = model.force(z, [], yy[1], s, ql)
-        return [yy[1], ut / Fc - F, *model.rate(z, [], yy[1], s, ql)]
+def _mapped(model: FrictionModel, space: ParameterSpace, K: int, n_sub: int, mass_free: bool,
+            J: int) -> tuple[ca.Function, ca.Function]:
+    key = (type(model), model.structure_key(), tuple(space.free), tuple(space.fixed), K, n_sub, mass_free, J)
+    if key not in _MAPPED:
+        plain, sens = segment_functions(model, space, K, n_sub, mass_free)
+        _MAPPED.clear()
+        _MAPPED[key] = (plain.map(J), sens.map(J))
+    return _MAPPED[key]
 
-    h = (t_to - t_from) / n_sub
-    yl = [y[i] for i in range(2 + nz)]
-    for k in range(n_sub):
-        ut = u_a + slope * (t_from + (k + 0.5) * h - t_a)  # u linear: RK4 uses it at the midpoint
-        yl = rk4(lambda yy, ut=ut: rhs(yy, ut), yl, h / T)
-    return ca.Function("piece", [y, s, t_from, t_to, u_a, t_a, slope, T, Fc, qs], [ca.vertcat(*yl)])
+
+class _Problem:
+    """Residuals, constraints and their sparse Jacobians of one record, layout and parameter set."""
+
+    def __init__(self, model: FrictionModel, space: ParameterSpace, data: Motion, lay: _Layout, n_sub: int,
+                 mass_free: bool, mass: float, xs: float) -> None:
+        self.lay, self.nth, self.ny = lay, space.n_free, 2 + model.n_states
+        self.plain, self.sens = _mapped(model, space, lay.K, n_sub, mass_free, lay.J)
+        self.fixed, self.mass, self.xs = space.fixed_values(), mass, xs
+        self.samples = lay.samples()
+        self.rows = np.flatnonzero(self.samples >= 0)
+        self.x = data.x[self.samples[self.rows]]
+        self.gw = np.ones((lay.J - 1) * self.ny)
+        s = lay.s
+        self.args = dict(s0=s, s_to=np.r_[s[1:], s[-1]], scale=space.scale, fixed=self.fixed, mass=mass,
+                         U0=lay.U0[None, :], U1=lay.U1[None, :], DT=lay.DT[None, :], scl=lay.scl)
+
+    def carry_states(self, w: np.ndarray, single: ca.Function) -> np.ndarray:
+        """``w`` with every node's model state after the first replaced by the end state of the
+        segment before it (simulated from the start values): states consistent with the history."""
+        w = w.copy()
+        th, nodes = self.split(w)
+        a, K = self.args, self.lay.K
+        for j in range(self.lay.J - 1):
+            cols = slice(j * K, (j + 1) * K)
+            out = single(node=nodes[:, j], theta=th, s0=a["s0"][j], s_to=a["s_to"][j], scale=a["scale"], fixed=a["fixed"],
+                         mass=a["mass"], U0=a["U0"][:, cols], U1=a["U1"][:, cols], DT=a["DT"][:, cols],
+                         scl=a["scl"])
+            ye = np.asarray(out["Ye"]).ravel()
+            if np.all(np.isfinite(ye)):
+                nodes[2:, j + 1] = np.clip(ye[2:], -STATE_CAP, STATE_CAP)
+        w[self.nth:] = nodes.T.ravel()
+        return w
+
+    def weigh(self, w: np.ndarray) -> None:
+        """Scale each state row of the continuity constraints by ``1 / max(1, |z|)`` at ``w``: a
+        state that grows without bound in sliding (Dahl's log-gap) then counts by its relative
+        mismatch in the merit function (the solution is the same: ``g = 0`` either way)."""
+        _th, nodes = self.split(w)
+        wt = 1.0 / np.maximum(1.0, np.abs(nodes[:, 1:]))
+        wt[:2] = 1.0
+        self.gw = wt.T.ravel()
+
+    def split(self, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return w[: self.nth], w[self.nth:].reshape(self.lay.J, self.ny).T
+
+    def _call(self, fn: ca.Function, w: np.ndarray) -> dict:
+        th, nodes = self.split(w)
+        out = fn(node=nodes, theta=th, **self.args)
+        return {k: np.asarray(v) for k, v in out.items()}
+
+    def residuals(self, w: np.ndarray) -> tuple[np.ndarray, np.ndarray, dict]:
+        out = self._call(self.plain, w)
+        X = out["X"][0, self.rows]
+        _th, nodes = self.split(w)
+        g = (out["Ye"][:, :-1] - nodes[:, 1:]).T.ravel() * self.gw
+        return (X - self.x) / self.xs, g, out
+
+    def plain_eval(self, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        r, g, _ = self.residuals(w)
+        return r, g
+
+    def full_eval(self, w: np.ndarray) -> tuple[np.ndarray, sp.csr_matrix, np.ndarray, sp.csr_matrix]:
+        out = self._call(self.sens, w)
+        lay, nth, ny = self.lay, self.nth, self.ny
+        ncol = nth + ny
+        _th, nodes = self.split(w)
+        X = out["X"][0, self.rows]
+        dX = out["dX"][:, self.rows].T / self.xs                      # rows: residuals, cols: [theta, node]
+        seg = self.rows // (lay.K + 1)
+        colmap = np.concatenate([np.broadcast_to(np.arange(nth), (seg.size, nth)),
+                                 nth + ny * seg[:, None] + np.arange(ny)[None, :]], axis=1)
+        nw = nth + ny * lay.J
+        Jr = sp.csr_matrix((dX.ravel(), (np.repeat(np.arange(seg.size), ncol), colmap.ravel())),
+                           shape=(seg.size, nw))
+        g = (out["Ye"][:, :-1] - nodes[:, 1:]).T.ravel()
+        dYe = out["dYe"].reshape(ny, lay.J, ncol)[:, :-1, :].transpose(1, 0, 2)   # (J-1, ny, ncol)
+        rows_g = np.arange((lay.J - 1) * ny)
+        jj = rows_g // ny
+        cols_g = np.concatenate([np.broadcast_to(np.arange(nth), (rows_g.size, nth)),
+                                 nth + ny * jj[:, None] + np.arange(ny)[None, :]], axis=1)
+        A = sp.csr_matrix((dYe.reshape(-1, ncol).ravel(), (np.repeat(rows_g, ncol), cols_g.ravel())),
+                          shape=(rows_g.size, nw))
+        A = A - sp.csr_matrix((np.ones(rows_g.size), (rows_g, nth + ny * (jj + 1) + rows_g % ny)),
+                              shape=(rows_g.size, nw))
+        return (X - self.x) / self.xs, Jr, g * self.gw, (sp.diags(self.gw) @ A).tocsr()
+
+    def reduced_jacobian(self, w: np.ndarray) -> np.ndarray:
+        """``dr/d(theta, node_0)`` along the constraints (single-shooting Jacobian), dense ``n x ncol``."""
+        out = self._call(self.sens, w)
+        lay, nth, ny = self.lay, self.nth, self.ny
+        ncol = nth + ny
+        dX = out["dX"].reshape(ncol, lay.J, lay.K + 1)
+        dYe = out["dYe"].reshape(ny, lay.J, ncol)
+        M = np.zeros((ny, ncol))
+        M[:, nth:] = np.eye(ny)                                       # d node_0 / d(theta, node_0)
+        full = np.zeros((lay.J * (lay.K + 1), ncol))
+        for j in range(lay.J):
+            chain = np.zeros((ncol, ncol))
+            chain[:nth, :nth] = np.eye(nth)
+            chain[nth:, :] = M
+            full[j * (lay.K + 1):(j + 1) * (lay.K + 1)] = dX[:, j, :].T @ chain
+            M = dYe[:, j, :] @ chain
+        return full[self.rows] / self.xs
 
 
 def _substeps(model: FrictionModel, data: Motion, mass: float, v_max: float, requested: int | None) -> int:
-    """RK4 sub-steps per sample: a normalised sub-step of at most 0.1 (and 0.2 / |v~| for a
-    rate-dependent model, whose state relaxes at a rate ~ |v~|), at the start values, 1 to 64."""
+    """RK4 sub-steps per sample: a normalised sub-step of at most 0.1 (the stuck mass swings with
+    period ``2 pi``) and of at most ``0.5 / lambda``, ``lambda`` the largest rate of the model's
+    state and force at the largest speed of the data (LuGre's bristle relaxes at ``~ |v~|``,
+    Dahl's log-gap not at all), at the start values; 1 to 64."""
     if requested is not None:
         return requested
     T = math.sqrt(mass / model.sigma)
     h = float(np.max(np.diff(data.t))) / T
-    v = v_max / (model.Fc / math.sqrt(mass * model.sigma))
-    limit = 0.1 if model.rate_independent else min(0.1, 0.2 / max(v, 1e-300))
-    return int(min(64, max(1, math.ceil(h / limit))))
+    lam = _stiffness(model, v_max / (model.Fc / math.sqrt(mass * model.sigma)), mass)
+    return int(min(64, max(1, math.ceil(h / min(0.1, 0.5 / max(lam, 1e-300))))))
 
 
-def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_sub: int | None,
-               max_iter: int, tol: float, reversals: Any = None) -> MotionSolution:
-    """Multiple-shooting least-squares fit of ``space``'s free parameters to ``data`` (IPOPT).
+def _stiffness(model: FrictionModel, v: float, mass: float) -> float:
+    """Largest ``|d rate / d z|`` and ``|d F~ / d v~|`` of the start model at speeds up to ``v`` (normalised)."""
+    from prefriction.units import Scales
+
+    sc = Scales(x=model.Fc / model.sigma, F=model.Fc, t=math.sqrt(mass / model.sigma),
+                v=model.Fc / math.sqrt(mass * model.sigma), E=model.Fc**2 / model.sigma)
+    q = [float(c) for c in model.runtime_params_for(sc)]
+    lam = 0.0
+    for vv in (v, 0.1 * v, 0.01 * v):
+        for f in (-0.5, 0.0, 0.5):
+            z = [float(c) for c in model.initial_state(f, 1.0)[0]]
+            r0 = model.rate(z, [], vv, 1.0, q)
+            for i in range(len(z)):
+                dz = 1e-6 * max(1.0, abs(z[i]))
+                zp = list(z)
+                zp[i] += dz
+                lam = max(lam, max(abs(float(a) - float(b)) / dz for a, b in zip(model.rate(zp, [], vv, 1.0, q), r0)))
+            dv = 1e-6 * max(1.0, vv)
+            lam = max(lam, abs(float(model.force(z, [], vv + dv, 1.0, q)) - float(model.force(z, [], vv, 1.0, q))) / dv)
+    return lam
+
+
+def _progress(line: str) -> None:
+    print(f"motion fit: {line}", file=sys.stderr, flush=True)
+
+
+def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_sub: int | None, max_iter: int,
+               tol: float, reversals: Any = None, offset0: float = 0.0, verbose: bool = False) -> MotionSolution:
+    """Multiple-shooting least-squares fit of ``space``'s free parameters to ``data``.
+
+    Parameters
+    ----------
+    offset0 : float, default 0.0
+        Start value of a fitted force offset [N] (if ``"offset"`` is a free entry of ``space``).
+    verbose : bool, default False
+        One line per Gauss-Newton iteration on stderr (always for records of :data:`LONG`
+        samples or more).
 
     Raises
     ------
     ValueError
-        If the model has in-branch events (not supported for motion data) or the data's
-        reversals cannot be located.
+        If the model has in-branch events (not supported for motion data) or given reversal
+        times are invalid.
     prefriction.SolverError
-        If IPOPT fails; the message gives its status and the parameters reached.
+        If the residuals are not finite at the start or Gauss-Newton does not converge; the
+        message says where and what to try.
     """
     if model.n_events or model.n_flags:
         raise ValueError(f"Motion fits support models without in-branch events or flags (Dahl with gamma >= 1, "
                          f"LuGre); {type(model).__name__} has {model.n_events} events: fit it to "
                          f"ForceDisplacement data")
-    mass_free = "mass" in space.start
-    mass = space.start["mass"] if mass_free else float(data.mass)
-    rev = locate_reversals(data.t, data.x, reversals)
-    n_sub = _substeps(model, data, mass, float(np.max(np.abs(rev.v))), n_sub)
-    cuts = tuple(int(k) for k in rev.index)
-    prob = _ShootingProblem.get(model, space, len(data), cuts, n_sub, mass_free, max_iter, tol)
-    h = np.diff(data.t)
-    htau = _SLACK * h[rev.index] if cuts else np.zeros(0)
+    mass_free = "mass" in space.start and "mass" in space.free
+    mass = space.start["mass"] if "mass" in space.start else float(data.mass)
+    xsm, v, a = derivatives(data.t, data.x, _NODE_WINDOW)
+    directions = _directions(data.t, data.x, v, reversals)
+    n_sub = _substeps(model, data, mass, float(np.max(np.abs(v))), n_sub)
+    X, V = model.Fc / model.sigma, model.Fc / math.sqrt(mass * model.sigma)
+    lay = _layout(data, min(SEGMENT, len(data) - 1), directions, np.array([X, V]))
     xs = max(float(np.ptp(data.x)) * 1e-3, 1e-300)
-    p = np.concatenate([data.t, data.x, data.u, space.scale, space.fixed_values(), [mass], rev.time, htau,
-                        [rev.s0], [xs]])
-    w0, lbw, ubw = _start(model, data, space, rev, mass)
-    sol = prob.solver(x0=w0, p=p, lbx=lbw, ubx=ubw, lbg=0.0, ubg=0.0)
-    stats = prob.solver.stats()
-    w = np.asarray(sol["x"]).ravel()
-    if not stats.get("success", False):
-        vals = space.values(w[: space.n_free])
-        raise SolverError(f"IPOPT did not converge ({stats.get('return_status')}) after {stats.get('iter_count')} "
-                          f"iterations, at {', '.join(f'{n} = {vals[n]:.6g}' for n in space.free)}; try start "
-                          f"values closer to the data, bounds, fixing a parameter, or cutting the record where "
-                          f"the motion sinks into the noise")
-    r, J, g, A, pred, sigma, Fc, T = (np.asarray(v) for v in prob.parts(w, p))
-    nz = model.n_states
-    Fc, sigma, T = Fc.item(), sigma.item(), T.item()
-    v_unit = Fc / sigma / T  # Fc / sqrt(m sigma)
-    nuisance: dict[str, Any] = {"initial velocity v0 [m/s]": float(w[space.n_free + 1]) * v_unit}
-    z0 = w[space.n_free + 2: space.n_free + 2 + nz].tolist()
-    nuisance["initial force F0 [N]"] = float(model.force(z0, [], float(w[space.n_free + 1]), rev.s0,
-                                                         _runtime(space, model, w, mass_free, mass))) * Fc
-    base = space.n_free + 2 + nz
-    dtau = w[base::2 + nz][: len(cuts)]
-    nuisance["reversal times [s]"] = rev.time + htau * dtau
-    return MotionSolution(w, r.ravel(), J, A, pred.ravel(), nuisance,
-                          f"IPOPT: {stats.get('return_status')} after {stats.get('iter_count')} iterations")
+    prob = _Problem(model, space, data, lay, n_sub, mass_free, mass, xs)
+    single = segment_functions(model, space, lay.K, n_sub, mass_free)[0]
+    for level in (0.5, 0.0):  # node states of the force balance, else of zero force (see _start)
+        w0 = prob.carry_states(_start(model, data, space, lay, xsm, v, a, mass, offset0, level), single)
+        prob.weigh(w0)
+        r0, g0 = prob.plain_eval(w0)
+        if np.all(np.isfinite(r0)) and np.all(np.isfinite(g0)):
+            break
+    else:
+        raise SolverError(f"the model's motion is not finite at the start values ({_at(space, w0)}); give start "
+                          f"values closer to the data or bounds")
+    lo, hi = space.theta_bounds()
+    out = solve(prob.full_eval, prob.plain_eval, w0, lo, hi, max_iter=max_iter, tol=tol,
+                progress=_progress if verbose or len(data) >= LONG else None)
+    if not out.success:
+        raise SolverError(f"the Motion fit did not converge ({out.message}), at {_at(space, out.w)}; try start "
+                          f"values closer to the data, bounds, fixing a parameter, more max_iter or a looser tol")
+    w = out.w
+    r, _g, res = prob.residuals(w)
+    Jred = prob.reduced_jacobian(w)
+    Xv = res["X"]
+    pred = Xv[0, prob.rows]
+    vel = Xv[1, prob.rows]
+    nuisance = _nuisance(model, space, w, prob, data, vel, mass_free, mass)
+    return MotionSolution(w, r * xs, Jred * xs, None, pred, nuisance,
+                          f"Gauss-Newton (multiple shooting, {lay.J} segments of {lay.K} samples, {n_sub} RK4 "
+                          f"sub-steps per sample): {out.message}")
 
 
-def _runtime(space: ParameterSpace, model: FrictionModel, w: np.ndarray, mass_free: bool, mass: float) -> list[float]:
-    """The run-time numbers of the fitted values (floats), for the reported initial force."""
+def _at(space: ParameterSpace, w: np.ndarray) -> str:
+    vals = space.values(w[: space.n_free])
+    return ", ".join(f"{n} = {vals[n]:.6g}" for n in space.free)
+
+
+def _directions(t: np.ndarray, x: np.ndarray, v: np.ndarray, given: Any) -> np.ndarray:
+    """Direction of motion at every sample: from the given reversal times (checked by
+    :func:`locate_reversals`), else the sign of the smoothed velocity."""
+    if given is not None:
+        rev = locate_reversals(t, x, given)
+        flips = np.searchsorted(rev.time, t, side="right")
+        return rev.s0 * np.where(flips % 2 == 0, 1.0, -1.0)
+    s = np.sign(v)
+    s[s == 0.0] = 1.0
+    return s
+
+
+def _start(model: FrictionModel, data: Motion, space: ParameterSpace, lay: _Layout, xsm: np.ndarray,
+           v: np.ndarray, a: np.ndarray, mass: float, offset0: float, level: float) -> np.ndarray:
+    """Start vector: scaled parameters, then each node's ``[x / X, v / V, z]`` from the smoothed
+    data, ``z`` the state of the force balance's friction ``u - m a - F_off`` clipped to
+    ``+-level Fc``."""
+    theta = np.array([offset0 / space.scale[i] if n == "offset" else space.start[n] / space.scale[i]
+                      for i, n in enumerate(space.free)])
+    X, V = lay.scl
+    nodes = []
+    for k, s in zip(lay.nodes, lay.s):
+        f = float(np.clip((data.u[k] - mass * a[k] - offset0) / model.Fc, -level, level))
+        nodes += [xsm[k] / X, v[k] / V, *model.initial_state(f, s)[0]]
+    return np.concatenate([theta, nodes])
+
+
+def _nuisance(model: FrictionModel, space: ParameterSpace, w: np.ndarray, prob: _Problem, data: Motion,
+              vel: np.ndarray, mass_free: bool, mass: float) -> dict:
+    """Initial velocity and force, and the reversal times of the fitted motion."""
+    fitted = space.build(space.values(w[: space.n_free]))
+    m = space.values(w[: space.n_free])["mass"] if mass_free else mass
     from prefriction.units import Scales
 
-    vals = space.values(w[: space.n_free])
-    fitted = space.build(vals)
-    m = vals["mass"] if mass_free else mass
     V = fitted.Fc / math.sqrt(m * fitted.sigma)
-    scales = Scales(x=fitted.Fc / fitted.sigma, F=fitted.Fc, t=math.sqrt(m / fitted.sigma), v=V,
-                    E=fitted.Fc**2 / fitted.sigma)
-    return [float(v) for v in fitted.runtime_params_for(scales)]
-
-
-def _start(model: FrictionModel, data: Motion, space: ParameterSpace, rev: Any, mass: float) -> tuple[np.ndarray, ...]:
-    """Start values and bounds of the optimisation vector from the data (smoothed) and the start model."""
-    sigma, Fc = model.sigma, model.Fc
-    X, V = Fc / sigma, Fc / math.sqrt(mass * sigma)
-    lo, hi = space.theta_bounds()
-
-    def state(i: int, s: float) -> list[float]:
-        f = float(np.clip((data.u[i] - mass * rev.a[i]) / Fc, -0.9, 0.9))
-        return list(model.initial_state(f, s)[0])
-
-    w0 = list(np.ones(space.n_free)) + [rev.x[0] / X, rev.v[0] / V, *state(0, rev.s0)]
-    lbw, ubw = list(lo), list(hi)
-    lbw += [-np.inf] * (2 + model.n_states)
-    ubw += [np.inf] * (2 + model.n_states)
-    s = rev.s0
-    for k, tau in zip(rev.index, rev.time):
-        s = -s
-        i = int(k) if abs(tau - data.t[k]) <= abs(tau - data.t[k + 1]) else int(k) + 1
-        w0 += [0.0, rev.x[i] / X, *state(i, s)]
-        lbw += [-1.0] + [-np.inf] * (1 + model.n_states)
-        ubw += [1.0] + [np.inf] * (1 + model.n_states)
-    return np.array(w0), np.array(lbw), np.array(ubw)
+    sc = Scales(x=fitted.Fc / fitted.sigma, F=fitted.Fc, t=math.sqrt(m / fitted.sigma), v=V,
+                E=fitted.Fc**2 / fitted.sigma)
+    q = [float(c) for c in fitted.runtime_params_for(sc)]
+    node0 = w[space.n_free: space.n_free + prob.ny]
+    v0 = float(node0[1] * prob.lay.scl[1])
+    F0 = float(model.force(list(node0[2:]), [], v0 / V, float(prob.lay.s[0]), q)) * fitted.Fc
+    t = data.t[prob.samples[prob.rows]]
+    k = np.flatnonzero(np.sign(vel[1:]) * np.sign(vel[:-1]) < 0)
+    tau = t[k] + (t[k + 1] - t[k]) * vel[k] / (vel[k] - vel[k + 1])
+    return {"initial velocity v0 [m/s]": v0, "initial force F0 [N]": F0, "reversal times [s]": tau}

@@ -28,7 +28,7 @@ import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
 from prefriction._validation import check_finite
-from prefriction.identify.data import ForceDisplacement, Motion
+from prefriction.identify.data import ForceDisplacement, ForceVelocity, Motion
 
 if TYPE_CHECKING:
     from prefriction.identify.result import FitResult
@@ -160,6 +160,8 @@ def predict(result: "FitResult", data: ForceDisplacement | Motion, **kwargs: Any
 
         return predict_motion(result, data, **kwargs)
     offset = result.estimate("offset") if "offset" in result.names else 0.0
+    if isinstance(data, ForceVelocity):  # a static map: its force at the record's velocities
+        return result.model.force(data.v) + offset
     return predict_force(result.model, data, offset=offset, **kwargs)
 
 
@@ -295,6 +297,9 @@ def validate(result: "FitResult", data: ForceDisplacement | Motion, *, skip: flo
     skip = check_finite("skip", skip)
     if isinstance(data, ForceDisplacement) and "F0" not in kwargs:
         kwargs["warmup"] = skip
+    if isinstance(data, ForceVelocity):
+        raise TypeError("validate scores records in time; ForceVelocity data have none: compare "
+                        "result.predict(data) [N] with data.F")
     y_hat = predict(result, data, **kwargs)
     keep = data.t >= data.t[0] + skip
     if skip < 0.0 or keep.sum() < 2:

@@ -18,10 +18,11 @@ reported separately. Peers integrate the same normalised equations
 (``docs/mathematics.md#normalised-units``), with ``rtol = tol`` and ``atol = tol / 100``. The
 error definition, the cases and the targets are described in ``docs/bench.md``.
 
-``--models``, ``--sweep``, ``--elements``, ``--loops`` and ``--compensation`` run other benchmarks
-instead: :mod:`prefriction.cli.bench.models`, :mod:`prefriction.cli.bench.sweep`,
-:mod:`prefriction.cli.bench.elements`, :mod:`prefriction.cli.bench_loops` and
-:mod:`prefriction.controllers.compensation_bench`. The modules of this package: ``options`` (the command
+``--models``, ``--sweep``, ``--elements``, ``--loops``, ``--compensation``, ``--identify``, ``--along`` and
+``--export`` run other benchmarks instead: :mod:`prefriction.cli.bench.models`,
+:mod:`prefriction.cli.bench.sweep`, :mod:`prefriction.cli.bench.elements`, :mod:`prefriction.cli.bench_loops`,
+:mod:`prefriction.controllers.compensation_bench`, :mod:`prefriction.cli.bench.identify`,
+:mod:`prefriction.along.bench` and :mod:`prefriction.export.bench`. The modules of this package: ``options`` (the command
 line), ``cases`` (cases, error, reference), ``peers``, ``work_precision`` (headline rows),
 ``stiff`` (stiff and extreme cases), ``reference_rows`` (rows against independent references),
 ``restarts`` (scipy DOP853 with restarts), ``costs`` (target 3, exact analytics),
@@ -87,6 +88,10 @@ def main(argv: Optional[list[str]] = None) -> int:
         text = export_bench.run(args.repeats or 5)
         print(text)
         return 0 if text.rstrip().endswith("PASS") else 1
+    if args.identify:
+        from prefriction.cli.bench import identify
+
+        return identify.main(args.quick)
     if args.sweep:
         from prefriction.cli.bench import sweep
 

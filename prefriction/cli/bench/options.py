@@ -37,7 +37,8 @@ examples:
   prefriction bench --loops          compiled PID loop against python-control
   prefriction bench --compensation   PID alone against PID with each friction compensator
                                      (writes compensation_*.png to --out)
-  prefriction bench --export         exported C code: ns per step against friction_along"""
+  prefriction bench --export         exported C code: ns per step against friction_along
+  prefriction bench --identify       Motion fit time and memory against the record length"""
 
 
 def repeats(text: str) -> int:
@@ -106,7 +107,7 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
     -------
     argparse.Namespace
         ``out`` (pathlib.Path, an existing directory; None with ``--loops``), ``quick``, ``repeats`` (int or None), and at most one of
-        ``stability``, ``models``, ``sweep``, ``elements``, ``loops``, ``compensation`` set.
+        ``stability``, ``models``, ``sweep``, ``elements``, ``loops``, ``compensation``, ``identify`` set.
 
     Raises
     ------
@@ -148,6 +149,9 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
     what.add_argument("--export", action="store_true",
                       help="instead: ns per step of the exported C code (prefriction.export) against friction_along "
                            "and FrictionStream, and the exported plant and loop; --repeats sets its passes (default 5)")
+    what.add_argument("--identify", action="store_true",
+                      help="instead: time and peak memory of a closed-loop Motion fit against the number of "
+                           "samples (1e3, 5e3, 2.5e4; --quick: 500, 1000, 2000), each in a fresh process")
     args = ap.parse_args(argv)
     if args.compensation and (args.quick or args.repeats is not None):
         ap.error("--quick and --repeats do not apply to --compensation")

@@ -1,0 +1,38 @@
+"""docs/identify_motion.md: every python block runs (in order, one namespace) and prints what the page says."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import re
+import warnings
+from pathlib import Path
+
+PAGE = (Path(__file__).resolve().parent.parent / "docs" / "identify_motion.md").read_text()
+
+
+def _shown(after: str) -> list[str]:
+    """What the page says the block prints: the next code block after "prints", or the inline `...`."""
+    m = re.match(r"\s*prints\s*\n\s*```\w*\n(.*?)```", after, flags=re.S)
+    if m:
+        return m.group(1).strip().splitlines()
+    m = re.match(r"\s*prints[^`]*`([^`]*)`", after, flags=re.S)
+    return [m.group(1)] if m else []
+
+
+def test_every_python_block_runs_and_prints_what_the_page_shows():
+    namespace: dict = {}
+    blocks = list(re.finditer(r"```python\n(.*?)```", PAGE, flags=re.S))
+    assert len(blocks) == 5
+    for b in blocks:
+        out = io.StringIO()
+        with contextlib.redirect_stdout(out), warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            exec(compile(b.group(1), "identify_motion.md", "exec"), namespace)
+        printed = out.getvalue().strip().splitlines()
+        shown = _shown(PAGE[b.end():])
+        assert shown, "every block says what it prints"
+        if len(shown) == 1 and len(printed) == 1:
+            assert printed[0].strip() == shown[0].strip()
+        else:
+            assert printed == shown
