@@ -109,8 +109,8 @@ class Run(StateIO, Rest):
 
     def _count_steps(self, call: BufferedIntegrator) -> None:
         """Add the steps of the last call (interpreted integrator only; else ``steps`` = None)."""
-        try:  # statistics exist for the interpreted integrator only (memory 1: the buffer's)
-            self.steps += int(call.fun.stats(1)["n_steps"])
+        try:  # statistics exist for the interpreted integrator only (of this thread's buffer)
+            self.steps += int(call.buf.stats()["n_steps"])
         except (RuntimeError, KeyError):
             self.steps = None
 
