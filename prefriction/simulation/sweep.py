@@ -18,7 +18,6 @@ import concurrent.futures as cf
 import inspect
 import itertools
 import math
-import sys
 import threading
 import time
 import warnings
@@ -27,6 +26,7 @@ from typing import Any, Hashable, Iterable, Optional, Sequence, Sized, Union
 
 import numpy as np
 
+from prefriction._progress import ProgressLine
 from prefriction._validation import check_bool, check_choice, check_count, check_finite, check_positive
 from prefriction.models import Oscillator
 from prefriction.simulation.feedback import LinearFeedback
@@ -338,12 +338,12 @@ def _outcome(future: cf.Future) -> Any:
 
 
 class _Progress:
-    """A progress line on stderr, rewritten in place (``mode``: None automatic, True, False)."""
+    """A progress line on stderr (``mode``: None automatic, True, False)."""
 
     def __init__(self, n: int, mode: Optional[bool], start: float) -> None:
         self.n, self.mode, self.start = n, mode, start
         self.last: Optional[float] = None
-        self.width = 0
+        self.line = ProgressLine()  # in place on a terminal, one line per update in a log
 
     def update(self, done: int) -> None:
         if self.mode is False:
@@ -359,14 +359,10 @@ class _Progress:
     def close(self, done: int) -> None:
         if self.mode is True or (self.mode is None and self.last is not None):
             self._write(done, time.perf_counter())
-            sys.stderr.write("\n")
-            sys.stderr.flush()
+            self.line.close()
 
     def _write(self, done: int, now: float) -> None:
-        text = f"sweep: {done}/{self.n} runs, {now - self.start:.1f} s"
-        sys.stderr.write("\r" + text.ljust(self.width))
-        sys.stderr.flush()
-        self.width = max(self.width, len(text))
+        self.line.show(f"sweep: {done}/{self.n} runs, {now - self.start:.1f} s")
 
 
 # --- validation ------------------------------------------------------------------------------
