@@ -123,9 +123,8 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
     rep = energy.analyze_samples(res.t, res.x, res.v, res.F, system=lugre, method="simpson")
     fig, axes = new_figure(1, 2, size=(12.0, 4.6))
     ax = axes[0, 0]
-    k = np.arange(0, len(rep))  # 0: first excursion, k: half-cycle from reversal k
-    vis = np.concatenate(([rep.D_viscous_initial], rep.D_viscous))
-    hys = np.concatenate(([rep.D_hysteretic_initial], rep.D_hysteretic))
+    k = np.arange(0, len(rep))  # 0: first excursion, k: half-cycle from reversal k (ending at k + 1)
+    vis, hys = rep.D_viscous, rep.D_hysteretic
     ax.semilogy(k, vis, "s-", color=COLORS[0], ms=4, label=r"viscous $\int(\sigma_1 z' + \sigma_2 v)\,v\,dt$")
     ax.semilogy(k, hys, "o-", color=COLORS[3], ms=4, label=r"hysteretic $\int \sigma_0^2 |v| z^2/g(v)\,dt$")
     ax.semilogy(k, np.concatenate(([rep.E_0], rep.E_p[:-1])), "--", color="0.3", lw=1.0,

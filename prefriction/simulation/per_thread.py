@@ -22,6 +22,10 @@ class PerThread:
         self._lock = threading.Lock()
         self._local = threading.local()
 
+    def __len__(self) -> int:
+        """Shared objects built so far (one per key)."""
+        return len(self._shared)
+
     def get(self, key: Hashable, build: Callable[[], Any], local: Callable[[Any], Any]) -> tuple[Any, Any, bool]:
         """This thread's part for ``key``, the shared part, and whether this call built the shared part.
 
