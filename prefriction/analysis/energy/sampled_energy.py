@@ -9,7 +9,7 @@ import numpy as np
 from scipy.integrate import cumulative_simpson, cumulative_trapezoid
 
 from prefriction.analysis.energy.balance import branch_energy
-from prefriction.analysis.energy.checks import check_method, check_samples, check_system, value_array
+from prefriction.analysis.energy.checks import check_method, check_samples, check_system, finite_energy, value_array
 from prefriction.analysis.energy.sampled_reversals import find_reversals
 from prefriction._validation import check_nonnegative, check_positive
 from prefriction.models import Oscillator
@@ -39,7 +39,9 @@ def kinetic_energy(v: Any, *, mass: float) -> np.ndarray:
     """
     m = check_positive("mass", mass)
     v = value_array("v", v)
-    return 0.5 * m * v * v
+    with np.errstate(over="ignore"):
+        E = 0.5 * m * v * v
+    return finite_energy("kinetic_energy", E, f"v (largest |v| = {float(np.max(np.abs(v))):.3g} m/s) and mass = {m:.3g} kg")
 
 
 def cumulative(t: np.ndarray, y: np.ndarray, method: str) -> np.ndarray:
@@ -79,9 +81,13 @@ def integrated_power(
     if not isinstance(reset_at_reversals, (bool, np.bool_)):
         raise TypeError(f"reset_at_reversals must be True or False, got {reset_at_reversals!r}")
     t, v, F = check_samples(t=t, v=v, F=F)
-    p = F * v
-    if not reset_at_reversals:
-        return cumulative(t, p, method)
+    with np.errstate(over="ignore", invalid="ignore"):
+        p = F * v
+        out = cumulative(t, p, method) if not reset_at_reversals else None
+    inputs = (f"t, v and F (largest |v| {float(np.max(np.abs(v))):.3g} m/s, |F| {float(np.max(np.abs(F))):.3g} N, "
+              f"span {float(t[-1] - t[0]):.3g} s)")
+    if out is not None:
+        return finite_energy("integrated_power", out, inputs)
     rev = find_reversals(t, v)
     out = np.empty_like(p)
     starts = np.concatenate(([0], rev.index + 1, [t.size]))
@@ -90,8 +96,9 @@ def integrated_power(
         if hi <= lo:
             continue
         base = 0.0 if k == 0 else 0.5 * p[lo] * (t[lo] - rev.t[k - 1])
-        out[lo:hi] = base + cumulative(t[lo:hi], p[lo:hi], method)
-    return out
+        with np.errstate(over="ignore", invalid="ignore"):
+            out[lo:hi] = base + cumulative(t[lo:hi], p[lo:hi], method)
+    return finite_energy("integrated_power", out, inputs)
 
 
 def work_integral(x: Any, F: Any) -> np.ndarray:
@@ -112,7 +119,10 @@ def work_integral(x: Any, F: Any) -> np.ndarray:
         ``int_{x[0]}^{x[j]} F dx`` along the path for every sample ``j`` [J].
     """
     x, F = check_samples(x=x, F=F)
-    return np.concatenate(([0.0], np.cumsum(0.5 * (F[1:] + F[:-1]) * np.diff(x))))
+    with np.errstate(over="ignore", invalid="ignore"):
+        E = np.concatenate(([0.0], np.cumsum(0.5 * (F[1:] + F[:-1]) * np.diff(x))))
+    return finite_energy("work_integral", E, f"x and F (largest |x| {float(np.max(np.abs(x))):.3g} m, "
+                                             f"|F| {float(np.max(np.abs(F))):.3g} N)")
 
 
 def loop_integral(x: Any, F: Any, *, closure_tol: float = 1e-6) -> float:
