@@ -8,6 +8,7 @@ import subprocess
 import sys
 import re
 import textwrap
+import time
 
 import numpy as np
 import pytest
@@ -153,3 +154,21 @@ def test_sizes_and_amplitudes_beyond_the_limits_are_refused_before_any_work() ->
     assert MAX_PERIODS == 10**7
     with pytest.raises(TypeError, match="dense must be True, False or a 1-D array of sample times"):
         pf.simulate(system, 0.01, t_end=1.0, dense="fast")
+
+
+def test_one_size_budget_for_runs_that_grow(monkeypatch) -> None:
+    """A t_end run that a fast input would fill beyond the table's budget is refused up front; one
+    that reaches the budget anyway (unforced Dahl keeps reversing) stops there with the time reached."""
+    import prefriction as pf
+    from prefriction.simulation import simulate as sim_module
+
+    start = time.perf_counter()
+    with pytest.raises(ValueError, match=r"allows about 2e\+09 reversals.*t_end <= 0\.0005 s"):
+        pf.simulate(pf.Oscillator(pf.Dahl(1e4, 1.0), u=pf.signals.Sine(1.0, 1e9)), 0.0, t_end=1.0)
+    with pytest.raises(ValueError, match="allows about"):
+        pf.simulate(pf.Oscillator(pf.Dahl(1e4, 1.0), u=pf.signals.Sine(0.5, 1.0) + pf.signals.Sine(0.1, 1e8)),
+                    0.0, t_end=1.0)
+    assert time.perf_counter() - start < 5.0
+    monkeypatch.setattr(sim_module, "MAX_REVERSALS", 300)
+    with pytest.raises(ValueError, match=r"t_end = 1e\+09 s needs more than 300 reversals.*reached 300 at t = "):
+        pf.simulate(pf.Oscillator(pf.Dahl(1e4, 1.0, 2.0)), 1.0, t_end=1e9)
