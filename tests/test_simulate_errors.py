@@ -172,3 +172,14 @@ def test_one_size_budget_for_runs_that_grow(monkeypatch) -> None:
     monkeypatch.setattr(sim_module, "MAX_REVERSALS", 300)
     with pytest.raises(ValueError, match=r"t_end = 1e\+09 s needs more than 300 reversals.*reached 300 at t = "):
         pf.simulate(pf.Oscillator(pf.Dahl(1e4, 1.0, 2.0)), 1.0, t_end=1e9)
+
+
+def test_motion_that_dies_out_says_so_and_asks_for_t_end() -> None:
+    """An overdamped LuGre oscillator creeps to rest after two reversals: the third never comes."""
+    import prefriction as pf
+
+    system = pf.Oscillator(pf.LuGre(1e5, 1e4, 0.4, 1.0, 1.5, 1e-3))
+    with pytest.raises(pf.SolverError, match=r"died out after 2 reversals.*Give t_end"):
+        pf.simulate(system, 1.0, reversals=5)
+    res = pf.simulate(system, 1.0, t_end=100.0)
+    assert res.status == 0 and len(res.reversals) == 2
