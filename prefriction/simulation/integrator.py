@@ -9,6 +9,7 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
+from prefriction.models.sizes import check_sizes
 from prefriction.simulation.compiled import compiled, jit_available
 from prefriction.simulation.per_thread import PerThread
 from prefriction.simulation.plant import Layout, PlantSpec, build_integrator
@@ -51,6 +52,7 @@ def integrator(spec: PlantSpec, jit: bool) -> tuple[BufferedIntegrator, float, s
 def _build(spec: PlantSpec, jit: bool) -> tuple[Any, str, float]:
     """The Function of ``spec`` (compiled or loaded from the cache if ``jit``), its mode and setup time."""
     start = time.perf_counter()
+    check_sizes(spec.model)  # a user model's sizes, once per structure
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", FutureWarning)
         fun = build_integrator(spec)

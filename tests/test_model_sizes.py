@@ -1,0 +1,37 @@
+"""A user model whose methods return the wrong number of entries is refused once per structure,
+before the plant is built, with the method, its count and the declared size named."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import pytest
+
+import prefriction as pf
+from test_protocol import ElasticPlastic  # the protocol test's worked example
+
+
+@dataclass(frozen=True)
+class RateTooLong(ElasticPlastic):
+    def rate(self, z, m, v, s, q):
+        return [v * (1.0 - m[0]), 0.0 * v]
+
+
+@dataclass(frozen=True)
+class EventsMissing(ElasticPlastic):
+    def events(self, z, m, v, s, q):
+        return []
+
+
+@pytest.mark.parametrize("cls, match", [
+    (RateTooLong, r"RateTooLong\.rate\(\) returned 2 entries; the model declares n_states = 1"),
+    (EventsMissing, r"EventsMissing\.events\(\) returned 0 entries; the model declares n_events = 1"),
+])
+def test_wrong_sizes_are_refused_by_simulate(cls, match) -> None:
+    with pytest.raises(TypeError, match=match):
+        pf.simulate(pf.Oscillator(cls(1e4, 1.0)), 1.0, reversals=3)
+
+
+def test_a_correct_model_passes() -> None:
+    res = pf.simulate(pf.Oscillator(ElasticPlastic(1e4, 1.0)), 0.02, reversals=3)
+    assert len(res.reversals) == 3
