@@ -162,6 +162,9 @@ class FitResult:
         """
         import matplotlib.pyplot as plt
 
+        if not Path(path).parent.is_dir():
+            raise ValueError(f"path must be in an existing directory: {Path(path).parent} does not exist "
+                             f"(create it first), got path = {str(path)!r}")
         d = self.data
         fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7.0, 6.5), height_ratios=[2.2, 1.0], layout="constrained")
         name = type(self.model).__name__

@@ -152,6 +152,11 @@ def simulate(
         If the integrator fails; the message names the time, the state and what to try.
     """
     model = check_oscillator(system, "simulate")
+    try:
+        hash(model.structure_key)
+    except TypeError:
+        raise TypeError(f"{type(model).__name__}.structure_key must be hashable (a tuple of numbers and strings): "
+                        f"it keys the compiled plant; got {model.structure_key!r:.120}") from None
     v0 = check_finite("v0", v0)
     x0 = check_finite("x0", x0)
     F0 = check_finite("F0", F0)

@@ -18,7 +18,7 @@ import concurrent.futures as cf
 import inspect
 import itertools
 import math
-import threading
+import pickle
 import time
 import warnings
 from numbers import Real
@@ -41,10 +41,6 @@ _PROGRESS_AFTER = 1.0  # automatic progress: show only once the sweep has run th
 _PROGRESS_EVERY = 0.5  # least interval between two progress lines [s]
 _MAX_LISTED = 10  # failed indices listed in the warning and in summary()
 
-# Runs of the same structure share one compiled integrator and its argument buffers per process
-# (prefriction.simulation.integrator), so two runs must never overlap in one process: threads of
-# a ThreadPoolExecutor or of a multi-threaded dask worker take turns on this lock.
-_RUN_LOCK = threading.Lock()
 
 
 class SweepResult(list):
@@ -139,7 +135,9 @@ def sweep(
         code is in the disk cache before the workers start (workers on other machines need the
         cache directory ``$PREFRICTION_CACHE`` on a shared file system, or compile once each).
         With a ``ProcessPoolExecutor`` the systems are pickled: a callable input ``u`` must be a
-        module-level function (dask pickles lambdas too).
+        module-level function (dask pickles lambdas too); one that cannot be pickled is refused
+        before any run. Runs in threads (``ThreadPoolExecutor``) do not interfere: each thread
+        calls the shared compiled code through its own buffers.
     progress : bool, optional
         ``None`` (default): print a progress line such as ``sweep: 12/40 runs, 3.1 s`` to
         stderr, updated in place every 0.5 s, once the sweep has run for 1 s (short sweeps print
@@ -231,6 +229,8 @@ def sweep(
             results[i] = _run_caught(systems[i], v0s[i], kwargs)
             bar.update(i + 1)
     else:
+        if isinstance(executor, cf.ProcessPoolExecutor):
+            _check_picklable(systems, kwargs)
         _run_on(executor, systems, v0s, kwargs, results, bar)
     bar.close(n)
 
@@ -240,10 +240,31 @@ def sweep(
     return out
 
 
+def _check_picklable(systems: list, kwargs: dict) -> None:
+    """``TypeError`` before any run if a system or keyword cannot be sent to a process pool."""
+    seen: set = set()
+    for i, system in enumerate(systems):
+        for part, what in ((system.u, "input u"), (system.friction, "friction model")):
+            if id(part) in seen:
+                continue
+            seen.add(id(part))
+            try:
+                pickle.dumps(part)
+            except Exception as exc:  # noqa: BLE001 - any pickling failure, reported with its reason
+                raise TypeError(
+                    f"systems[{i}].{'u' if part is system.u else 'friction'} ({what}) cannot be sent to a "
+                    f"ProcessPoolExecutor: {exc}. Use a prefriction.signals input (Sine, Step, Ramp, Chirp, Samples) "
+                    f"or a module-level function instead of a lambda or local function, or a ThreadPoolExecutor"
+                ) from None
+    try:
+        pickle.dumps(kwargs)
+    except Exception as exc:  # noqa: BLE001
+        raise TypeError(f"the keyword arguments cannot be sent to a ProcessPoolExecutor: {exc}") from None
+
+
 def _run_one(system: Oscillator, v0: float, kwargs: dict) -> Any:
     """One :func:`prefriction.simulate` run (module level, so that executors can pickle it)."""
-    with _RUN_LOCK:
-        return simulate(system, v0, **kwargs)
+    return simulate(system, v0, **kwargs)
 
 
 def _run_caught(system: Oscillator, v0: float, kwargs: dict) -> Any:
