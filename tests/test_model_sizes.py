@@ -35,3 +35,18 @@ def test_wrong_sizes_are_refused_by_simulate(cls, match) -> None:
 def test_a_correct_model_passes() -> None:
     res = pf.simulate(pf.Oscillator(ElasticPlastic(1e4, 1.0)), 0.02, reversals=3)
     assert len(res.reversals) == 3
+
+
+@dataclass(frozen=True)
+class NoBranchEnergy(ElasticPlastic):
+    branch_energy_of_force = pf.FrictionModel.branch_energy_of_force
+
+
+def test_rate_independent_model_without_branch_energy_is_refused_before_a_run() -> None:
+    from prefriction.testing import check_model
+
+    match = r"NoBranchEnergy is rate-independent .* does not implement branch_energy_of_force"
+    with pytest.raises(TypeError, match=match):
+        pf.simulate(pf.Oscillator(NoBranchEnergy(1e4, 1.0)), 1.0, reversals=3)
+    with pytest.raises(TypeError, match=match):
+        check_model(NoBranchEnergy(1e4, 1.0))

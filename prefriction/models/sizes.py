@@ -1,4 +1,4 @@
-"""The sizes a friction model's methods return, checked once per structure before a plant is built.
+"""What a friction model must provide, checked once per structure before a plant is built.
 
 A user model whose ``rate()`` returns more entries than ``n_states``, or whose ``events()``
 returns fewer indicators than ``n_events``, used to fail deep inside the plant (a ``KeyError``
@@ -23,8 +23,17 @@ def _count(what: Any) -> int:
 
 
 def check_sizes(model: Any) -> None:
-    """``TypeError`` naming the method whose output size differs from the model's declared sizes."""
+    """``TypeError`` naming the method whose output size differs from the model's declared sizes,
+    or a rate-independent model without ``branch_energy_of_force`` (every run's reversal table
+    takes its potential energies from it)."""
     name = type(model).__name__
+    from prefriction.models.base import FrictionModel
+
+    if model.rate_independent and type(model).branch_energy_of_force is FrictionModel.branch_energy_of_force:
+        raise TypeError(
+            f"{name} is rate-independent (rate_independent = True) but does not implement "
+            f"branch_energy_of_force(F, s), which gives the potential energy E_p at every reversal: implement it "
+            f"(docs/models.md#energy), or declare rate_independent = False if the model is not")
     nz, nm, ne = int(model.n_states), int(model.n_flags), int(model.n_events)
     nq = len(model.runtime_params())
     z, m = ca.SX.sym("z", nz), ca.SX.sym("m", nm)

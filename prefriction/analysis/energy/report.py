@@ -48,9 +48,8 @@ class EnergyReport:
         friction force's work over half-cycle k by quadrature of the samples ((2.5), (2.7);
         ``E_0`` less the kinetic energy for ``k = 0``): it fails when the input's work, the
         forces or the reversals are wrong (e.g. a controller's force left out). Table:
-        ``max_k |E_p[k-1] + W_u[k] - E_d[k] - E_p[k]|`` of the table's columns (independent
-        for a simulated table, whose ``E_d`` is integrated; an exact table computes ``E_d``
-        from ``E_p``).
+        ``max_k |E_p[k-1] + W_u[k] - E_d[k] - E_p[k]|``, the consistency of the table's columns
+        only (a table computes ``E_d`` from ``E_p``; its independent check is ``E_p_check``).
     E_p_check : numpy.ndarray or None
         Independent estimate of ``E_p``: the peak kinetic energy in each complete unforced
         half-cycle (samples, length n - 1, paper's note after (3.9)), or the branch potential
