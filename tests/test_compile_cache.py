@@ -151,3 +151,18 @@ def test_hanging_compiler_stalls_one_process_only(tmp_path) -> None:
     out, err = _run(tmp_path / "cache", "hang", env=env)
     assert time.perf_counter() - start < 20  # no second wait for the compiler (import ~1 s)
     assert out["hang"][0] == "interpreted" and "earlier process" in err and "delete" in err
+
+
+def test_compile_time_of_the_process_is_counted(tmp_path, monkeypatch) -> None:
+    """``prefriction bench`` reports compiled_seconds(): every compile of the process counts."""
+    import casadi as ca
+
+    from prefriction.simulation.compiled import compiled, compiled_seconds
+
+    monkeypatch.setenv("PREFRICTION_CACHE", str(tmp_path))
+    monkeypatch.delenv("PREFRICTION_NO_JIT", raising=False)
+    before = compiled_seconds()
+    x = ca.SX.sym("x", 2)
+    _, info = compiled(ca.Function("f_counted", [x], [ca.cos(x) * 7]))
+    assert info.mode == "compiled" and info.seconds > 0
+    assert compiled_seconds() == pytest.approx(before + info.seconds)

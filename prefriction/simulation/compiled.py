@@ -28,7 +28,14 @@ import casadi as ca
 
 from prefriction.simulation import library_store as store
 
-__all__ = ["CompileInfo", "cache_dir", "compile_timeout", "compiled", "jit_available"]
+__all__ = ["CompileInfo", "cache_dir", "compile_timeout", "compiled", "compiled_seconds", "jit_available"]
+
+_SPENT = [0.0]  # wall time spent generating and compiling code in this process [s]
+
+
+def compiled_seconds() -> float:
+    """Wall time [s] this process has spent generating and compiling code (all calls of :func:`compiled`)."""
+    return _SPENT[0]
 
 
 @dataclass(frozen=True)
@@ -156,7 +163,9 @@ def compiled(fun: ca.Function, what: str = "") -> tuple[ca.Function, CompileInfo
         ext, problem = store.load(fun, dest, key)
         if ext is None:
             return _interpreted(fun, lib, f"the freshly compiled library could not be used: {problem}", record=False)
-    return ext, CompileInfo("compiled", time.perf_counter() - start, str(dest))
+    seconds = time.perf_counter() - start
+    _SPENT[0] += seconds
+    return ext, CompileInfo("compiled", seconds, str(dest))
 
 
 def _run_compiler(cmd: list[str]) -> None:

@@ -112,8 +112,8 @@ class LuGreEnergyReport:
         head = (f"{'i':>5} {'t [s]':>12} {'F [N]':>12} {'E_p [J]':>11} {'E_d [J]':>11} "
                 f"{'viscous [J]':>11} {'hyster. [J]':>11} {'W_u [J]':>11}")
         n = len(self)
-        half = max(1, max_rows // 2)
-        idx = list(range(n)) if n <= max_rows else list(range(half)) + list(range(n - half, n))
+        first, last = (max_rows + 1) // 2, max_rows // 2  # max_rows rows: the first and last halves
+        idx = list(range(n)) if n <= max_rows else list(range(first)) + list(range(n - last, n))
         lines = ["LuGre energy per half-cycle i (ending at reversal i; i = 1 the first excursion)", head, "-" * len(head)]
         prev = -1
         for i in idx:

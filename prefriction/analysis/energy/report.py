@@ -103,8 +103,8 @@ class EnergyReport:
             f"{'E_d(i) [J]':>12} {'sum E_d(n>=i)':>13} {'E_p/bound':>10}"
         )
         n = len(self)
-        half = max_rows // 2
-        idx = list(range(n)) if n <= max_rows else list(range(half)) + list(range(n - half, n))
+        first, last = (max_rows + 1) // 2, max_rows // 2  # max_rows rows: the first and last halves
+        idx = list(range(n)) if n <= max_rows else list(range(first)) + list(range(n - last, n))
         lines = [f"Energy at reversals ({self.source}); E_d(i): half-cycle ending at reversal i", head, "-" * len(head)]
         prev = -1
         for i in idx:
