@@ -30,3 +30,13 @@ def test_table_into_a_closed_pipe_exits_quietly() -> None:
     cmd = (f"{sys.executable} -m prefriction.cli table --n 20000 --rows 20000 | head -1")
     out = subprocess.run(["bash", "-o", "pipefail", "-c", cmd], env=env, capture_output=True, text=True, timeout=120)
     assert out.returncode == 0 and "Traceback" not in out.stderr and "BrokenPipe" not in out.stderr
+
+
+def test_messages_show_numpy_scalars_as_numbers() -> None:
+    import numpy as np
+
+    from prefriction._validation import check_real
+
+    with pytest.raises(TypeError) as err:
+        check_real("v0", np.complex128(0.0304j))
+    assert "0.0304j" in str(err.value) and "np." not in str(err.value)
