@@ -65,3 +65,12 @@ def test_sweep_with_a_lambda_input_on_a_process_pool_is_refused_up_front() -> No
     with ProcessPoolExecutor(max_workers=1) as pool:
         with pytest.raises(TypeError, match=r"systems\[0\]\.u \(input u\) cannot be sent.*prefriction\.signals"):
             pf.sweep(systems, 0.0, t_end=1.0, executor=pool)
+
+
+@pytest.mark.parametrize("u", [1j, True])
+def test_motion_constant_input_must_be_real(u) -> None:
+    from prefriction import identify
+
+    t = np.linspace(0.0, 1.0, 50)
+    with pytest.raises(TypeError, match="u must be a real number"):
+        identify.Motion(t, np.sin(t), u=u)
