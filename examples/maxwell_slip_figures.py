@@ -171,4 +171,4 @@ if __name__ == "__main__":
     from prefriction.plotting import script_args
 
     outdir, quick = script_args(sys.argv[1:])
-    print(main(outdir, quick=quick)["pngs"])
+    print("\n".join(str(p) for p in main(outdir, quick=quick)["pngs"]))
