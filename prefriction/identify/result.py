@@ -169,19 +169,21 @@ class FitResult:
         fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7.0, 6.5), height_ratios=[2.2, 1.0], layout="constrained")
         name = type(self.model).__name__
         if isinstance(d, ForceDisplacement):
-            ax1.plot(d.x * 1e6, d.F, ".", ms=3, color="0.55", label="data")
-            ax1.plot(d.x * 1e6, self.fitted, "-", lw=1.2, color="C0", label=f"fitted {name}")
-            ax1.set_xlabel("displacement x [um]")
+            k, unit = _length_unit(d.x)
+            ax1.plot(d.x * k, d.F, ".", ms=3, color="0.55", label="data")
+            ax1.plot(d.x * k, self.fitted, "-", lw=1.2, color="C0", label=f"fitted {name}")
+            ax1.set_xlabel(f"displacement $x$ [{unit}]")
             ax1.set_ylabel("friction force F [N]")
             ax2.set_ylabel("residual F - fit [N]")
             ax2.plot(d.t, self.residuals, ".", ms=3, color="C3")
         else:
-            ax1.plot(d.t, d.x * 1e6, ".", ms=3, color="0.55", label="data")
-            ax1.plot(d.t, self.fitted * 1e6, "-", lw=1.2, color="C0", label=f"fitted {name}")
+            k, unit = _length_unit(d.x)
+            ax1.plot(d.t, d.x * k, ".", ms=3, color="0.55", label="data")
+            ax1.plot(d.t, self.fitted * k, "-", lw=1.2, color="C0", label=f"fitted {name}")
             ax1.set_xlabel("time t [s]")
-            ax1.set_ylabel("position x [um]")
-            ax2.set_ylabel("residual x - fit [um]")
-            ax2.plot(d.t, self.residuals * 1e6, ".", ms=3, color="C3")
+            ax1.set_ylabel(f"position $x$ [{unit}]")
+            ax2.set_ylabel(f"residual $x$ - fit [{unit}]")
+            ax2.plot(d.t, self.residuals * k, ".", ms=3, color="C3")
         ax1.legend(loc="best", frameon=True)
         ax1.grid(alpha=0.3)
         ax2.axhline(0.0, color="0.3", lw=0.8)
@@ -195,3 +197,9 @@ class FitResult:
             plt.show()
         plt.close(fig)
         return out
+
+
+def _length_unit(x: np.ndarray) -> tuple[float, str]:
+    """Factor and label that bring lengths [m] of the size of ``x`` to mm, µm or nm."""
+    peak = float(np.max(np.abs(x))) if np.size(x) else 0.0
+    return (1e3, "mm") if peak >= 1e-3 else (1e6, "µm") if peak >= 1e-6 else (1e9, "nm")
