@@ -41,3 +41,19 @@ def test_dahl_describing_function_at_extreme_amplitudes(A: float) -> None:
 def test_energies_that_overflow_are_refused(call, match) -> None:
     with pytest.raises(ValueError, match=match):
         call()
+
+
+def test_total_energy_through_gross_sliding_with_positions() -> None:
+    """Unforced, E_k + E_branch is constant along a branch (E_0 = m v0^2 / 2 from F = 0) even where
+    the force has rounded to Fc; without the positions the saturated samples are refused."""
+    import prefriction as pf
+
+    system = pf.Oscillator(pf.Dahl(1e4, 1.0), mass=1.0)
+    v0 = 300 * pf.Scales.of(system).v
+    res = pf.simulate(system, v0, reversals=2, rtol=1e-10, dense=True)
+    with pytest.raises(ValueError, match="branch energy is infinite"):
+        energy.total_energy(res.t, res.v, res.F, system=system)
+    E = energy.total_energy(res.t, res.v, res.F, system=system, x=res.x)
+    first = res.t < res.reversals.t[0]
+    assert np.any(np.abs(res.F[first]) == 1.0)  # the force did round to Fc
+    assert np.max(np.abs(E[first] - 0.5 * v0 * v0)) < 1e-3 * 0.5 * v0 * v0

@@ -184,7 +184,7 @@ def _sample_directions(v: np.ndarray) -> np.ndarray:
     return sgn[nz[nxt]]
 
 
-def total_energy(t: Any, v: Any, F: Any, *, system: Oscillator) -> np.ndarray:
+def total_energy(t: Any, v: Any, F: Any, *, system: Oscillator, x: Any = None) -> np.ndarray:
     """Mechanical energy ``E_k + E_branch`` of a Dahl oscillator at every sample [J].
 
     ``E_branch`` is :func:`branch_energy` with the direction of motion (a sample with
@@ -192,6 +192,12 @@ def total_energy(t: Any, v: Any, F: Any, *, system: Oscillator) -> np.ndarray:
     along each branch and drops by the half-cycle dissipation ``E_d`` (2.10) at each
     reversal; right after reversal ``k`` it equals ``E_p[k]``. Its drift along a branch
     measures the energy error of a simulation.
+
+    In deep gross sliding the force rounds to ``s Fc``, where the stored energy of a model
+    with unbounded energy there (Dahl with ``gamma >= 1``) is no longer a function of the force.
+    Given the positions ``x``, such samples take the energy of the last sample of their branch
+    where it is, plus the work ``int F dx`` since (trapezoid rule; along a branch
+    ``d E_branch = F dx``, the definition of the branch energy (2.8)).
 
     Parameters
     ----------
@@ -203,6 +209,9 @@ def total_energy(t: Any, v: Any, F: Any, *, system: Oscillator) -> np.ndarray:
         Friction forces [N].
     system : Oscillator
         The oscillator (mass and Dahl friction model).
+    x : array_like, optional
+        Positions [m] at the samples (e.g. ``SimulationResult.x``): needed only where the force
+        has rounded to the saturation force.
 
     Returns
     -------
@@ -213,10 +222,29 @@ def total_energy(t: Any, v: Any, F: Any, *, system: Oscillator) -> np.ndarray:
     ------
     ValueError
         Invalid arrays, ``|F| > Fc``, ``v = 0`` at every sample (no direction), or a sample
-        with ``s F = Fc`` for a model whose stored energy is unbounded there (Dahl with
-        ``gamma >= 1``: deep gross sliding rounds the force to ``Fc``, and the energy is no
-        longer a function of the force; the message names the sample).
+        with ``s F = Fc`` for a model whose stored energy is unbounded there without ``x`` (or
+        on a branch that starts there); the message names the sample.
     """
     friction, mass = check_system(system)
-    t, v, F = check_samples(t=t, v=v, F=F)
-    return kinetic_energy(v, mass=mass) + branch_energy(F, _sample_directions(v), friction=friction)
+    if x is None:
+        t, v, F = check_samples(t=t, v=v, F=F)
+        return kinetic_energy(v, mass=mass) + branch_energy(F, _sample_directions(v), friction=friction)
+    t, v, F, x = check_samples(t=t, v=v, F=F, x=x)
+    s = _sample_directions(v)
+    unbounded = getattr(friction, "gamma", 0.0) >= 1.0  # Dahl: infinite stored energy at s F = Fc
+    good = np.abs(F) < friction.Fc * (1.0 - 1e-12) if unbounded else np.ones(F.size, bool)
+    E_b = np.zeros(F.size)
+    E_b[good] = branch_energy(F[good], s[good], friction=friction)
+    bad = np.flatnonzero(~good)
+    if bad.size:
+        work = np.concatenate(([0.0], np.cumsum(0.5 * (F[1:] + F[:-1]) * np.diff(x))))  # int F dx along the path
+        starts = np.concatenate(([0], np.flatnonzero(np.diff(s)) + 1))  # first sample of each branch
+        branch_start = starts[np.searchsorted(starts, np.arange(F.size), side="right") - 1]
+        last_good = np.maximum.accumulate(np.where(good, np.arange(F.size), -1))
+        anchor = last_good[bad]
+        if np.any(anchor < branch_start[bad]):
+            j = int(bad[np.flatnonzero(anchor < branch_start[bad])[0]])
+            raise ValueError(f"F[{j}] = {float(F[j])!r} N has rounded to the saturation force on a branch that starts "
+                             f"there: its stored energy cannot be computed from the samples (start the samples earlier)")
+        E_b[bad] = E_b[anchor] + work[bad] - work[anchor]
+    return kinetic_energy(v, mass=mass) + E_b
