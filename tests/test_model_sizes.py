@@ -50,3 +50,24 @@ def test_rate_independent_model_without_branch_energy_is_refused_before_a_run() 
         pf.simulate(pf.Oscillator(NoBranchEnergy(1e4, 1.0)), 1.0, reversals=3)
     with pytest.raises(TypeError, match=match):
         check_model(NoBranchEnergy(1e4, 1.0))
+
+
+@dataclass(frozen=True)
+class SelfGamma(pf.Dahl):
+    """Reads its own gamma instead of q[0]: every instance would reuse the first one's plant."""
+
+    def rate(self, z, m, v, s, q):
+        import casadi as ca
+
+        own = ca.vertcat(self.gamma, *[q[i] for i in range(1, q.numel())]) if isinstance(q, ca.SX) else \
+            [self.gamma] + list(q)[1:]
+        return pf.Dahl.rate(self, z, m, v, s, own)
+
+
+def test_check_model_catches_both_mistakes_on_one_instance() -> None:
+    from prefriction.testing import check_model
+
+    with pytest.raises(AssertionError, match="must use q, not the instance's numbers"):
+        check_model(SelfGamma(1e4, 1.0, 2.5))
+    with pytest.raises(TypeError, match=r"events\(\) returned 0 entries"):
+        check_model(EventsMissing(1e4, 1.0))
