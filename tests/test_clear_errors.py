@@ -74,3 +74,20 @@ def test_motion_constant_input_must_be_real(u) -> None:
     t = np.linspace(0.0, 1.0, 50)
     with pytest.raises(TypeError, match="u must be a real number"):
         identify.Motion(t, np.sin(t), u=u)
+
+
+LUGRE = pf.Oscillator(pf.LuGre(1e5, 1e5 ** 0.5, 0.4, 1.0, 1.5, 1e-3), mass=1.0)
+
+
+def test_sensitivities_of_a_pd_loop_leave_out_ki() -> None:
+    """A PD has no integrator: ki is not among its parameters (central differences at ki = 0
+    used to build an invalid PID with ki < 0)."""
+    res = pf.sensitivities(LUGRE, controller=controllers.pd(100, 5), reference=0.01, t_end=0.2)
+    assert "ki" not in res.parameters and "kp" in res.parameters
+    with pytest.raises(ValueError, match="'ki' needs a controller with an integrator"):
+        pf.sensitivities(LUGRE, controller=controllers.pd(100, 5), reference=0.01, t_end=0.2, parameters=("ki",))
+
+
+def test_sensitivities_through_a_stick_say_so() -> None:
+    with pytest.raises(pf.SolverError, match=r"is a stick .* end t_end before it"):
+        pf.sensitivities(LUGRE, controller=controllers.pd(100, 5), reference=0.01, t_end=0.5)
