@@ -93,3 +93,12 @@ def test_bad_linear_part_is_refused(H, error, match) -> None:
 def test_block_without_describing_function_is_refused() -> None:
     with pytest.raises(TypeError, match="block must be"):
         predict_limit_cycle(H_MULTIPLE, np.sign, AMPLITUDES)
+
+
+def test_measure_limit_cycle_bad_samples_are_named() -> None:
+    with pytest.raises(ValueError, match="same length"):
+        measure_limit_cycle([0.0, 1.0], [0.0, 1.0, 2.0], t_start=0.1)
+    with pytest.raises(ValueError, match="strictly increasing"):
+        measure_limit_cycle([0.0, 2.0, 1.0], [0.0, 1.0, 2.0], t_start=0.1)
+    with pytest.raises(TypeError, match="y must be"):
+        measure_limit_cycle([0.0, 1.0], ["a", "b"], t_start=0.1)

@@ -22,7 +22,7 @@ import numpy as np
 from scipy.optimize import root
 
 from prefriction._progress import ProgressLine
-from prefriction._validation import check_count, check_interval, check_positive
+from prefriction._validation import check_count, check_interval, check_positive, check_real_array
 from prefriction.describing.stability import cycle_stability
 from prefriction.describing.velocity import controller_tf
 from prefriction.models import Oscillator, check_oscillator
@@ -327,8 +327,12 @@ def measure_limit_cycle(t: Any, y: Any, *, t_start: float) -> MeasuredCycle:
     ValueError
         Fewer than two full periods in the window (no limit cycle there).
     """
-    t = np.asarray(t, dtype=float)
-    y = np.asarray(y, dtype=float)
+    t = check_real_array("t", t, "s")
+    y = check_real_array("y", y)
+    if t.ndim != 1 or y.shape != t.shape:
+        raise ValueError(f"t and y must be 1-D arrays of the same length, got shapes {t.shape} and {y.shape}")
+    if np.any(np.diff(t) <= 0):
+        raise ValueError("t must be strictly increasing [s]")
     t_start = check_positive("t_start", t_start)
     keep = t >= t_start
     t, y = t[keep], y[keep]
