@@ -48,3 +48,27 @@ def test_sampled_loop_from_four_threads_equals_serial() -> None:
         for _ in range(4):
             threaded = list(pool.map(_loop_run, steps * 2))
             assert all(np.array_equal(s, r) for s, r in zip(serial * 2, threaded))
+
+
+def test_motion_fits_from_threads_equal_serial() -> None:
+    """identify.fit on motion data shares one IPOPT problem per layout: threads take turns on the
+    solve (concurrent solves crashed the process with a segmentation fault)."""
+    import warnings
+
+    from prefriction import identify
+    from prefriction.identify.synthetic import dahl_free_decay
+
+    true, mass = pf.Dahl(sigma=1.0e4, Fc=1.0, gamma=1.0), 1.0
+    t = np.linspace(0.0, 16.0 * np.sqrt(mass / true.sigma), 81)
+    clean = dahl_free_decay(true, mass, 1.2 / np.sqrt(true.sigma), t, 0.0, np.random.default_rng(0)).x
+
+    def fit(seed: int) -> np.ndarray:
+        x = clean + 3e-7 * np.random.default_rng(seed).standard_normal(clean.size)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            return identify.fit(pf.Dahl(1.3e4, 0.8, 1.0), identify.Motion(t, x, 0.0, mass), fixed=["gamma"]).estimates
+
+    serial = [fit(s) for s in range(4)]
+    with ThreadPoolExecutor(2) as pool:
+        threaded = list(pool.map(fit, range(4)))
+    assert all(np.array_equal(a, b) for a, b in zip(serial, threaded))

@@ -20,6 +20,7 @@ so refits of data with the same layout reuse it.
 from __future__ import annotations
 
 import math
+import threading
 from dataclasses import dataclass
 from typing import Any
 
@@ -38,6 +39,8 @@ __all__ = ["MotionSolution", "fit_motion"]
 _SLACK = 1.5
 """Half-width of a reversal time's bracket, in samples around its estimate."""
 _CACHE: dict[Any, "_ShootingProblem"] = {}
+_SOLVE_LOCK = threading.Lock()
+"""One IPOPT solve at a time per process: fits from several threads take turns (they crashed the process)."""
 
 
 @dataclass(frozen=True)
@@ -196,8 +199,9 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
     p = np.concatenate([data.t, data.x, data.u, space.scale, space.fixed_values(), [mass], rev.time, htau,
                         [rev.s0], [xs]])
     w0, lbw, ubw = _start(model, data, space, rev, mass)
-    sol = prob.solver(x0=w0, p=p, lbx=lbw, ubx=ubw, lbg=0.0, ubg=0.0)
-    stats = prob.solver.stats()
+    with _SOLVE_LOCK:  # IPOPT with MUMPS is not thread-safe, and stats() reports the solver's last call
+        sol = prob.solver(x0=w0, p=p, lbx=lbw, ubx=ubw, lbg=0.0, ubg=0.0)
+        stats = prob.solver.stats()
     w = np.asarray(sol["x"]).ravel()
     if not stats.get("success", False):
         vals = space.values(w[: space.n_free])
