@@ -178,6 +178,14 @@ class LoopResult:
         k = outside[-1] + 1
         return float(self.t[min(k, len(self.t) - 1)])
 
+    def __reduce__(self) -> tuple:
+        """Pickle the controller as its matrices (python-control's StateSpace holds a lambda)."""
+        fields = dict(vars(self))
+        C = fields.pop("controller")
+        if isinstance(C, control.StateSpace):
+            C = (C.A, C.B, C.C, C.D, C.dt)
+        return _unpickle, (fields, C)
+
     def __repr__(self) -> str:
         kind = f"sampled, Ts = {self.Ts:.4g} s" if self.Ts is not None else "continuous"
         return (f"LoopResult({kind}, {len(self.t)} samples to t = {self.t[-1]:.6g} s, residual error "
@@ -208,3 +216,10 @@ class LoopResult:
             f"  velocity reversals      {len(self.reversals)}",
         ]
         return "\n".join(lines)
+
+
+def _unpickle(fields: dict, C: object) -> LoopResult:
+    """A :class:`LoopResult` from :meth:`LoopResult.__reduce__`'s parts."""
+    if isinstance(C, tuple):
+        C = control.ss(*C[:4], dt=C[4])
+    return LoopResult(controller=C, **fields)

@@ -22,7 +22,7 @@ from .plotting import plot_steps
 
 M, SIGMA, FC = 1.0, 1e6, 1.0  # kg, N/m, N
 TS = 1e-4  # s (10 kHz)
-STEPS = ((1e-6, "1 um"), (1e-8, "10 nm"))  # m: one pre-sliding range, and 1 % of it
+STEPS = ((1e-6, "1 µm"), (1e-8, "10 nm"))  # m: one pre-sliding range, and 1 % of it
 
 
 def stage() -> prefriction.Oscillator:

@@ -16,20 +16,25 @@ from ._loop import LoopResult
 
 
 def _scale(values: np.ndarray) -> tuple[float, str]:
-    """Factor and unit label that bring a displacement [m] to um or nm."""
+    """Factor and unit label that bring a displacement [m] to µm or nm."""
     peak = float(np.max(np.abs(values))) if values.size else 0.0
-    return (1e6, "um") if peak >= 1e-7 else (1e9, "nm")
+    return (1e6, "µm") if peak >= 1e-7 else (1e9, "nm")
 
 
-def _headroom(ax, values: np.ndarray, level: "float | None") -> None:
-    """Log y-limits with the top third of the panel free for the legend (it covers no curve)."""
+def _headroom(ax, values: np.ndarray, level: "float | None") -> bool:
+    """Log y-limits of the data with about a decade free above it for the legend; the ``level``
+    line is included if it lies within two decades of the data. Returns whether it is."""
     pos = values[values > 0]
     if pos.size == 0:
-        return
+        return False
     lo = math.log10(float(np.min(pos)))
-    hi = math.log10(max(float(np.max(pos)), level or 0.0))
+    hi = math.log10(float(np.max(pos)))
+    shown = level is not None and level > 0 and math.log10(level) <= hi + 2.0
+    if shown:
+        hi = max(hi, math.log10(level))
     span = max(hi - lo, 1.0)
-    ax.set_ylim(10 ** (lo - 0.05 * span), 10 ** (hi + 0.6 * span))
+    ax.set_ylim(10 ** (lo - 0.05 * span), 10 ** (hi + min(0.4 * span, 1.5)))
+    return shown
 
 
 def plot_steps(
@@ -70,8 +75,11 @@ def plot_steps(
         ax.plot(t_ms, res.F, lw=1, label="friction force F")
         ax.set(xlabel="time t [ms]", ylabel="force [N]", title=f"{label}: forces")
         fmax = max(float(np.max(np.abs(res.F))), 1e-12)
-        if np.max(np.abs(res.u)) > 20 * fmax:  # derivative kick dwarfs the friction force
-            ax.set_yscale("symlog", linthresh=10.0 ** np.ceil(np.log10(fmax)))
+        umax = float(np.max(np.abs(res.u)))
+        if umax > 20 * fmax:  # a derivative kick dwarfs the friction force: keep the axis on F, say where u goes
+            ax.set_ylim(-4.0 * fmax, 6.0 * fmax)
+            ax.text(0.98, 0.04, f"u reaches {umax:.3g} N in the first samples (off scale)", transform=ax.transAxes,
+                    ha="right", va="bottom", fontsize="small", color="C0")
         ax.legend(loc="upper right")
         ax = row[2]
         lx, lF = res.friction_loop()
@@ -81,22 +89,23 @@ def plot_steps(
         if len(rv):
             ax.plot(rv.x * k, rv.F, "o", ms=4, mfc="none", label=f"reversals ({len(rv)})")
         lo, hi = float(np.min(lF)), float(np.max(lF))
-        if np.max(np.abs(lF)) > 0.2 * res.Fc:
-            ax.axhline(res.Fc, color="0.5", lw=0.8, ls=":")
-            ax.axhline(-res.Fc, color="0.5", lw=0.8, ls=":", label="+-Fc")
-            lo, hi = -res.Fc, res.Fc
+        for level in (res.Fc, -res.Fc):  # drawn where the data come near them, not stretching the axis
+            if lo - 0.3 * (hi - lo) <= level <= hi + 0.3 * (hi - lo):
+                ax.axhline(level, color="0.5", lw=0.8, ls=":", label=r"$\pm F_c$" if level > 0 else None)
+                lo, hi = min(lo, level), max(hi, level)
         span = max(hi - lo, 1e-300)
         ax.set_ylim(lo - 0.05 * span, hi + 0.6 * span)  # the top third free for the legend
         ax.set(xlabel=f"position x [{unit}]", ylabel="friction force F [N]", title=f"{label}: friction loop")
         ax.legend(loc="upper left", ncol=2, fontsize="small")
         ax = row[3]
         err = np.abs(res.error) * k
-        ax.semilogy(t_ms, np.where(err > 0, err, np.nan), lw=1, label="|e| = |r - x|")
+        ax.semilogy(t_ms, np.where(err > 0, err, np.nan), lw=1, label="$|e| = |r - x|$")
         level = res.error_bound if bound is None else bound
+        shown = _headroom(ax, err, None if level is None else level * k)
         if level is not None:
-            note = "" if res.error_bound is not None else " (PD bound)"
-            ax.axhline(level * k, color="C3", ls="--", label=f"Fc/kp = {level * k:.3g} {unit}{note}")
-        _headroom(ax, err, None if level is None else level * k)
+            note = "" if res.error_bound is not None else ", a PD's bound (a PID has none)"
+            where = "" if shown else ", above the axis"
+            ax.axhline(level * k, color="C3", ls="--", label=f"Fc/kp = {level * k:.3g} {unit}{note}{where}")
         ax.set(xlabel="time t [ms]", ylabel=f"|error| [{unit}]", title=f"{label}: error")
         ax.legend(loc="upper right", fontsize="small")
         for a in row:

@@ -35,7 +35,7 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
         ``x_next``, ``F_next`` (exact next reversal), ``x_next_approx`` (corrected (3.13)),
         ``x_next_printed`` ((3.13) as printed); ``sigma`` [N/m]; ``png``.
     """
-    fig, axes = new_figure(size=(7.0, 4.8))
+    fig, axes = new_figure(size=(9.2, 4.8))
     ax = axes[0, 0]
     curves: dict[float, dict] = {}
     printed_notes = []
@@ -59,7 +59,7 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
         ax.axhline(Fc, color=color, lw=0.8, ls=":")
         ax.axhline(-Fc, color=color, lw=0.8, ls=":")
         if not (0.0 < x_next_printed < 1.5 * x_next):
-            printed_notes.append(f"Fc = {Fc:g} N: {x_next_printed:.3g} m")
+            printed_notes.append(rf"$F_c$ = {Fc:g} N: {x_next_printed:.3g} m")
     ax.axhline(0.0, color="0.5", lw=0.8)
     ax.axvline(0.0, color="0.5", lw=0.8)
     ax.plot([], [], "ko", ms=5, label="reversals $x_i$, $x_{i+1}$ (exact)")
@@ -68,10 +68,10 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
     ax.set_xlabel(r"displacement $x$ [m] (force zero crossing at $x = 0$)")
     ax.set_ylabel(r"restoring force $f[x]$ [N]")
     ax.grid(True, alpha=0.3)
-    ax.legend(loc="lower right", fontsize=9)
+    ax.legend(loc="center left", bbox_to_anchor=(1.02, 0.5), fontsize=9)  # outside: no data or +-Fc line covered
     ax.set_title("Fig. 5: force-displacement curve between two reversals")
-    add_note(fig, f"sigma = {SIGMA:g} N/m and F_i = -Fc (not stated in the paper).\n"
-                  "(3.13) as printed puts x_{i+1} off the curve at " + "; ".join(printed_notes) + ".",
+    add_note(fig, rf"$\sigma$ = {SIGMA:g} N/m and $F_i = -F_c$ (not stated in the paper)." "\n"
+                  r"(3.13) as printed puts $x_{i+1}$ off the curve at " + "; ".join(printed_notes) + ".",
              lines=2)
     png = save(fig, outdir, "fig5_force_displacement.png")
     return {"curves": curves, "sigma": SIGMA, "png": png}

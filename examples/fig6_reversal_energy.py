@@ -81,21 +81,24 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
         printed = {ratio: iterate(lambda a, r=ratio: dahl.next_amplitude_paper(a, sigma_over_Fc=r), A0, n.size - 1)
                    for ratio in RATIOS}
         e_printed = {ratio: seq - np.log1p(seq) for ratio, seq in printed.items()}
-    upper, lower = e_printed[RATIOS[0]], e_printed[RATIOS[-1]]  # the bracket of (3.13) grows with sigma/Fc
-    ax.fill_between(n, lower, upper, color=COLORS[3], alpha=0.3, lw=0,
-                    label=rf"(3.13) as printed, $\sigma/F_c$ = {RATIOS[0]:g} m$^{{-1}}$ " "(\u25b2) to "
-                          rf"{RATIOS[-1]:g} m$^{{-1}}$ " "(\u25bc)")
-    ax.semilogy(n, upper, "^-", color=COLORS[3], lw=1.0, ms=3.5)
-    ax.semilogy(n, lower, "v-", color=COLORS[3], lw=1.0, ms=3.5)
+    # (3.13) as printed, one line per sigma/Fc, drawn while it stays on the axis; an arrow where it leaves
+    for (ratio, e), color, mark in zip(e_printed.items(), ("#d62728", "#8c1d40", "#ff7f0e"), ("^", "v", "D")):
+        on = np.flatnonzero(e >= Y_MIN)
+        last = int(on[-1]) if on.size else 0
+        ax.semilogy(n[: last + 1], e[: last + 1], "-", marker=mark, color=color, lw=1.0, ms=5, mfc="white",
+                    label=rf"(3.13) as printed, $\sigma/F_c$ = {ratio:g} m$^{{-1}}$")
+        if last + 1 < n.size:  # falls below the axis after reversal n[last]
+            ax.annotate("", xy=(n[last] + 0.35, Y_MIN), xytext=(n[last], e[last]),
+                        arrowprops=dict(arrowstyle="->", color=color, lw=1.0))
     ax.set_ylim(Y_MIN, 1.0)
     ax.set_xticks(n[:: 2 if n_rev > 10 else 1])
     ax.set_xlabel(r"reversal number $n$ after reversal $i$ [-]")
     ax.set_ylabel(r"normalised potential energy $E_p\,\sigma/F_c^2$ [-]")
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(loc="center right", fontsize=8)
+    ax.legend(loc="lower right", fontsize=8, title=r"arrows: below $10^{-12}$ next", title_fontsize=8)
     ax.set_title("(b) exact map against the paper's recursion")
     fig.suptitle("Fig. 6: potential energy at consecutive reversals")
-    add_note(fig, f"Fc = {FC:g} N, first reversal at F_i = -Fc (both not stated in the paper).")
+    add_note(fig, rf"$F_c$ = {FC:g} N, first reversal at $F_i = -F_c$ (both not stated in the paper).")
     png = save(fig, outdir, "fig6_reversal_energy.png")
     first = energies[RATIOS[0]]
     return {

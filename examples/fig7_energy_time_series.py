@@ -17,6 +17,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+from matplotlib.lines import Line2D
 
 from prefriction import Dahl, Oscillator, dahl, simulate
 from prefriction.plotting import COLORS, add_note, new_figure, save
@@ -80,16 +81,20 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
                     label=r"$|E_f|$: restoring-force work (2.8) since the last reversal")
         ax.plot(t_peak, E_p_rev[: len(t_peak)], "o", color="k", ms=4, mfc="none",
                 label=r"$E_p$ (3.9) of the preceding reversal")
-        ax.set_ylim(1e-6 * E_k0, 1e4 * E_k0)
+        ax.set_ylim(0.5 * floor, 2.0 * E_k0)  # the data's range
         ax.set_ylabel("energy [J]")
         ax.set_title(rf"$\sigma/F_c$ = {ratio:g} m$^{{-1}}$: {len(rev.t)} reversals in {t_end:g} s", fontsize=10)
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(loc="upper right", ncol=3, fontsize=7.5)
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    handles[0] = Line2D([], [], color="0.35", lw=1.2)
+    labels[0] = r"kinetic $E_k = m\dot x^2/2$ (colour of the panel)"
+    axes[0, 0].set_ylim(0.5 * floor, 5e3 * E_k0)  # one legend, in the top panel only
+    axes[0, 0].legend(handles, labels, loc="upper right", ncol=2, fontsize=7.5)
     axes[-1, 0].set_xlabel("time $t$ [s]")
     axes[-1, 0].set_xlim(0.0, t_end)
     fig.suptitle("Fig. 7: energy time series of the simulated oscillator (2.1) with (3.4)")
-    add_note(fig, f"m = {MASS:g} kg, Fc = {FC:g} N, x(0) = 0, F(0) = 0, v(0) = {V0:g} m/s "
-                  "(mass and initial state not stated in the paper); gamma = 1.")
+    add_note(fig, rf"$m$ = {MASS:g} kg, $F_c$ = {FC:g} N, $x(0) = 0$, $F(0) = 0$, $v(0)$ = {V0:g} m/s "
+                  r"(mass and initial state not stated in the paper); $\gamma = 1$.")
     png = save(fig, outdir, "fig7_energy_time_series.png")
     return {"runs": runs, "mass": MASS, "v0": V0, "Fc": FC, "t_end": t_end, "png": png}
 

@@ -65,10 +65,10 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
     ax.plot(exact.t[: tau.size] * 1e3, exact.x[: tau.size] * 1e6, "o", mfc="none", color="C1", ms=7,
             label="exact reversals")
     ax.plot(tau * 1e3, xr * 1e6, "x", color="C3", ms=6, label="fitted reversal times")
-    lines = ", ".join(f"{n} = {v:.5g} +- {1.96 * s:.2g}" for n, v, s in zip(res.names, res.estimates, res.stderr))
+    lines = ", ".join(f"{n} = {v:.5g} ± {1.96 * s:.2g}{'' if u == '-' else ' ' + u}" for n, u, v, s in zip(res.names, res.units, res.estimates, res.stderr))
     ax.set_title(f"free decay, mass {MASS} kg known: {lines} (95 %)", fontsize=9)
     ax.set_xlabel("time t [ms]")
-    ax.set_ylabel("position x [um]")
+    ax.set_ylabel("position $x$ [µm]")
     ax.legend(loc="upper right", fontsize=8)
     ax.grid(alpha=0.3)
     axr.plot(t * 1e3, res.residuals * 1e9, ".", ms=3, color="C3")

@@ -66,10 +66,10 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
         ax, axr = axes[0, col], axes[1, col]
         ax.plot(d.x * 1e6, d.F, ".", ms=3, color="0.6", label="data (Dahl + noise)")
         ax.plot(d.x * 1e6, r.fitted, "-", lw=1.1, color="C0", label="fitted Dahl")
-        ax.set_xlabel("displacement x [um]")
+        ax.set_xlabel("displacement $x$ [µm]")
         ax.set_ylabel("friction force F [N]")
-        lines = [f"{n} = {v:.4g} (not identifiable)" if n in r.unidentifiable else f"{n} = {v:.4g} +- {1.96 * s:.2g}"
-                 for n, v, s in zip(r.names, r.estimates, r.stderr)]
+        lines = [f"{n} = {v:.4g}{'' if u == '-' else ' ' + u} (not identifiable)" if n in r.unidentifiable else f"{n} = {v:.4g} ± {1.96 * s:.2g}{'' if u == '-' else ' ' + u}"
+                 for n, u, v, s in zip(r.names, r.units, r.estimates, r.stderr)]
         ax.set_title(title + "\n" + ", ".join(lines) + " (95 %)", fontsize=9)
         ax.legend(loc="lower right", fontsize=8)
         ax.grid(alpha=0.3)

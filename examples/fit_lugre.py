@@ -89,9 +89,9 @@ def _figure(res: identify.FitResult, t: np.ndarray, coverage: dict, seeds: int, 
     ax = axes["L"]
     ax.plot(d.x * 1e6, d.F, ".", ms=2.5, color="0.6", label="data (Radau reference + noise)")
     ax.plot(d.x * 1e6, res.fitted, "-", lw=0.9, color="C0", label="fitted LuGre")
-    ax.set_xlabel("displacement x [um]")
+    ax.set_xlabel("displacement $x$ [µm]")
     ax.set_ylabel("friction force F [N]")
-    lines = [f"{n} = {v:.4g} +- {1.96 * s:.2g}" for n, v, s in zip(res.names, res.estimates, res.stderr)]
+    lines = [f"{n} = {v:.4g} ± {1.96 * s:.2g}{'' if u == '-' else ' ' + u}" for n, u, v, s in zip(res.names, res.units, res.estimates, res.stderr)]
     ax.set_title("force along the prescribed motion (95 %):\n" + ", ".join(lines[:3]) + "\n"
                  + ", ".join(lines[3:]), fontsize=8)
     ax.legend(loc="lower right", fontsize=8)

@@ -76,7 +76,7 @@ def _figure(res: identify.FitResult, truth: np.ndarray, coverage: dict, seeds: i
     ax = axes["L"]
     ax.plot(d.x * 1e6, d.F, ".", ms=3, color="0.6", label="data (stop operators + noise)")
     ax.plot(d.x * 1e6, res.fitted, "-", lw=1.0, color="C0", label="fitted Maxwell-slip")
-    ax.set_xlabel("displacement x [um]")
+    ax.set_xlabel("displacement $x$ [µm]")
     ax.set_ylabel("friction force F [N]")
     ax.set_title(f"growing loops, 4 elements, noise sd {NOISE * 1e3:.0f} mN; residual sd "
                  f"{res.statistics.sigma_hat * 1e3:.2f} mN", fontsize=9)
@@ -92,7 +92,7 @@ def _figure(res: identify.FitResult, truth: np.ndarray, coverage: dict, seeds: i
     ax.plot(truth[:n] / 1e3, truth[n:], "o", mfc="none", ms=11, color="C3", label="true elements")
     offsets = [(8, -16), (8, -16), (-100, -16), (8, -16)]  # points; element 2 left of element 1
     for i in range(n):
-        ax.annotate(f"{i}: W/k = {1e6 * truth[n + i] / truth[i]:.0f} um", (truth[i] / 1e3, truth[n + i]),
+        ax.annotate(f"{i}: W/k = {1e6 * truth[n + i] / truth[i]:.0f} µm", (truth[i] / 1e3, truth[n + i]),
                     textcoords="offset points", xytext=offsets[i], fontsize=8)
     ax.set_xlabel("element stiffness k_i [kN/m]")
     ax.set_ylabel("element slip force W_i [N]")

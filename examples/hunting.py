@@ -61,7 +61,7 @@ def _harmonic(t: np.ndarray, y: np.ndarray, a: float, b: float) -> complex:
 def _nyquist(ax: plt.Axes, G, lim: tuple) -> None:
     om = np.logspace(-2, 4, 4000)
     Gw = np.array([complex(G(1j * v)) for v in om])
-    ax.plot(Gw.real, Gw.imag, color="C0", label="G(i omega) = i omega / (m (i omega)^2 + C(i omega))")
+    ax.plot(Gw.real, Gw.imag, color="C0", label=r"$G(i\omega) = i\omega\,/\,(m (i\omega)^2 + C(i\omega))$")
     ax.axhline(0, color="k", lw=0.4)
     ax.axvline(0, color="k", lw=0.4)
     ax.set(xlabel="Re [m/(N s)]", ylabel="Im [m/(N s)]", xlim=lim[:2], ylim=lim[2:])
@@ -104,25 +104,25 @@ def main(outdir: str | Path = ".", *, t_end: float = 24.0, steps: int = 30) -> d
     Av = np.logspace(-4, 0, 9)
     Nh = np.array([VelocityDescribingFunction(LUGRE, wh, **DF).describing_function(v) for v in Av])
     ax[0, 1].plot((-1 / Nh).real, (-1 / Nh).imag, "o-", ms=3, color="C1",
-                  label=f"-1/N_v(A_v), LuGre at {wh:.2f} rad/s, A_v = 0.1 mm/s ... 1 m/s")
+                  label=rf"$-1/N_v(A_v)$, LuGre at {wh:.2f} rad/s, $A_v$ = 0.1 mm/s ... 1 m/s")
     Gh = complex(G_h(1j * wh))
     ax[0, 1].plot(Gh.real, Gh.imag, "*", ms=13, color="C3",
-                  label=f"simulated hunting: -V1/F1 = G(i {wh:.2f}), stiffness {-wh * N_eff.imag:.0f} N/m")
+                  label=rf"simulated hunting: $-V_1/F_1 = G(i\,{wh:.2f})$, stiffness {-wh * N_eff.imag:.0f} N/m")
     ax[0, 1].set_title("(b) hunting: no intersection (friction would need k < 0)")
-    ax[0, 1].legend(loc="lower left", fontsize=8)
+    ax[0, 1].legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), fontsize=8)  # below: the curve fills the axes
 
     _nyquist(ax[1, 0], G_u, (-0.9, 0.3, -0.6, 0.6))
     Au = np.logspace(-1, 0.7, 12)
     Nu = np.array([VelocityDescribingFunction(LUGRE, cyc.omega, **DF).describing_function(v) for v in Au])
     ax[1, 0].plot((-1 / Nu).real, (-1 / Nu).imag, "o-", ms=3, color="C1",
-                  label=f"-1/N_v(A_v), LuGre at {cyc.omega:.3f} rad/s, A_v = 0.1 ... 5 m/s (left: larger)")
+                  label=rf"$-1/N_v(A_v)$, LuGre at {cyc.omega:.3f} rad/s, $A_v$ = 0.1 ... 5 m/s (left: larger)")
     p = -1 / cyc.N
     ax[1, 0].plot(p.real, p.imag, "s", ms=14, mfc="none", mew=1.5, color="C3",
-                  label=f"predicted (unstable): A_v = {cyc.amplitude:.4f} m/s, T = {cyc.period:.4f} s")
+                  label=rf"predicted (unstable): $A_v$ = {cyc.amplitude:.4f} m/s, $T$ = {cyc.period:.4f} s")
     Ns = VelocityDescribingFunction(LUGRE, 2 * math.pi / tr.period, **DF).describing_function(tr.amplitude)
     q = -1 / Ns
     ax[1, 0].plot(q.real, q.imag, "x", ms=10, mew=2, color="k",
-                  label=f"simulated: A_v = {tr.amplitude:.4f} m/s, T = {tr.period:.4f} s (-1/N_v there)")
+                  label=rf"simulated: $A_v$ = {tr.amplitude:.4f} m/s, $T$ = {tr.period:.4f} s ($-1/N_v$ there)")
     ax[1, 0].set_title("(c) PID (100, 300, 1), linear loop unstable")
     ax[1, 0].legend(loc="upper left", fontsize=8)
 
@@ -131,14 +131,14 @@ def main(outdir: str | Path = ".", *, t_end: float = 24.0, steps: int = 30) -> d
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             r = simulate_from_cycle(LUGRE, UNSTABLE, cyc, lam, periods=22)
-        ax[1, 1].plot(r.t, r.v, lw=0.6, color=color, label=f"lambda* {'-' if color == 'C2' else '+'} 1e-4: {what}")
+        ax[1, 1].plot(r.t, r.v, lw=0.6, color=color, label=rf"$\lambda^* {'-' if color == 'C2' else '+'} 10^{{-4}}$: {what}")
     for s in (1, -1):
         ax[1, 1].axhline(s * tr.amplitude, color="k", ls="--", lw=0.8,
-                         label="simulated cycle: +-V1" if s == 1 else None)
+                         label=r"simulated cycle: $\pm V_1$" if s == 1 else None)
         ax[1, 1].axhline(s * cyc.amplitude, color="C1", ls=":", lw=1.2,
-                         label="predicted: +-A_v" if s == 1 else None)
-    ax[1, 1].set(xlabel="time t [s]", ylabel="velocity v [m/s]", ylim=(-3.0, 4.6),
-                 title=f"(d) runs from lambda x predicted sinusoid, lambda* = {tr.scale:.8f}")
+                         label=r"predicted: $\pm A_v$" if s == 1 else None)
+    ax[1, 1].set(xlabel="time $t$ [s]", ylabel="velocity $v$ [m/s]", ylim=(-3.0, 4.6),
+                 title=rf"(d) runs from $\lambda\,\times$ predicted sinusoid, $\lambda^*$ = {tr.scale:.8f}")
     ax[1, 1].legend(loc="upper center", fontsize=8, ncol=2)
     fig.tight_layout()
     png = outdir / "hunting_df.png"

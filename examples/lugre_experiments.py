@@ -478,8 +478,10 @@ def _fig_stick_slip(outdir: Path, d: dict) -> Path:
     ax.grid(True, alpha=0.3)
     ax.legend(loc="upper left", fontsize=8)
     ax = axes[1, 0]
-    ax.plot(d["t"], d["F"], color=COLORS[0], lw=1.4, label="friction force $F$")
-    ax.plot(d["t"], d["u"], color=COLORS[3], lw=1.0, ls=":", label="spring force $u$")
+    # while the mass sticks F = u: the spring force is drawn wide and light beneath the friction force
+    ax.plot(d["t"], d["u"], color=COLORS[3], lw=5.0, alpha=0.35, solid_capstyle="butt",
+            label="spring force $u$ (= $F$ while stuck)")
+    ax.plot(d["t"], d["F"], color=COLORS[0], lw=1.2, label="friction force $F$")
     ax.set_xlabel("time $t$ [s]")
     ax.set_ylabel("force [N]")
     ax.set_ylim(0.0, 2.4)
@@ -490,7 +492,7 @@ def _fig_stick_slip(outdir: Path, d: dict) -> Path:
     ax2.set_ylim(-0.02, 0.6)
     h1, l1 = ax.get_legend_handles_labels()
     h2, l2 = ax2.get_legend_handles_labels()
-    ax.legend(h1 + h2, l1 + l2, loc="upper left", fontsize=8, ncol=3)
+    ax.legend(h1 + h2, l1 + l2, loc="upper left", fontsize=8, ncol=2)
     add_note(fig, "u = k (0.1 t - x) as LinearFeedback(D = k, reference = Ramp(0, 0.1)); "
                   f"prefriction.simulate, rtol {RTOL:g}.")
     return save(fig, outdir, "lugre_stick_slip.png")
@@ -507,11 +509,14 @@ def _fig_hunting(outdir: Path, d: dict) -> Path:
     ax.grid(True, alpha=0.3)
     ax.legend(loc="upper right", fontsize=8, ncol=2)
     ax = axes[1, 0]
-    ax.plot(d["t"], d["F"], color=COLORS[0], lw=1.3, label="friction force $F$")
-    ax.plot(d["t"], d["u"], color=COLORS[3], lw=1.0, ls=":", label="control force $u$")
+    ax.plot(d["t"], d["u"], color=COLORS[3], lw=5.0, alpha=0.35, solid_capstyle="butt",
+            label="control force $u$ (= $F$ while stuck)")
+    ax.plot(d["t"], d["F"], color=COLORS[0], lw=1.2, label="friction force $F$")
     ax.set_xlabel("time $t$ [s]")
     ax.set_ylabel("force [N]")
-    ax.set_ylim(-3.5, 5.5)
+    top = float(max(np.max(d["F"]), np.max(d["u"])))
+    bottom = float(min(np.min(d["F"]), np.min(d["u"])))
+    ax.set_ylim(bottom - 0.1 * (top - bottom), top + 0.35 * (top - bottom))  # room for the legend above the data
     ax.grid(True, alpha=0.3)
     ax.legend(loc="upper right", fontsize=8, ncol=2)
     add_note(fig, "u = Kp (1 - x) + Ki int (1 - x) dt - Kv dx/dt: PI LinearFeedback on LuGre(sigma2 + Kv) "
@@ -582,4 +587,4 @@ if __name__ == "__main__":
     from prefriction.plotting import script_args
 
     outdir, quick = script_args(sys.argv[1:])
-    print([str(p) for p in main(outdir, quick=quick)["pngs"]])
+    print("\n".join(str(p) for p in main(outdir, quick=quick)["pngs"]))

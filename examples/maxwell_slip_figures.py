@@ -148,7 +148,8 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
             k = int(np.argmin(pos))
             ax.annotate(f"{name}: below the limit from\nreversal {k + 1} on: no slip, undamped",
                         xy=(n[k - 1], excess[k - 1]), xytext=(14, 1e-3), color=colors[name],
-                        fontsize=8, arrowprops=dict(arrowstyle="->", color=colors[name]))
+                        fontsize=8, arrowprops=dict(arrowstyle="-|>", color="0.45", lw=0.6, ls=":",
+                                                    shrinkA=2, shrinkB=4, mutation_scale=8))
         else:
             ratio = 1.0 - 2.0 * limits[name].kappa_1
             ref = excess[10] * ratio ** (n[:m_show] - n[10])
@@ -171,4 +172,4 @@ if __name__ == "__main__":
     from prefriction.plotting import script_args
 
     outdir, quick = script_args(sys.argv[1:])
-    print(main(outdir, quick=quick)["pngs"])
+    print("\n".join(str(p) for p in main(outdir, quick=quick)["pngs"]))

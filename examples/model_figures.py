@@ -28,6 +28,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+from scipy.integrate import cumulative_trapezoid
 
 import prefriction as pf
 from prefriction import energy
@@ -123,9 +124,8 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
     rep = energy.analyze_samples(res.t, res.x, res.v, res.F, system=lugre, method="simpson")
     fig, axes = new_figure(1, 2, size=(12.0, 4.6))
     ax = axes[0, 0]
-    k = np.arange(0, len(rep))  # 0: first excursion, k: half-cycle from reversal k
-    vis = np.concatenate(([rep.D_viscous_initial], rep.D_viscous))
-    hys = np.concatenate(([rep.D_hysteretic_initial], rep.D_hysteretic))
+    k = np.arange(0, len(rep))  # 0: first excursion, k: half-cycle from reversal k (ending at k + 1)
+    vis, hys = rep.D_viscous, rep.D_hysteretic
     ax.semilogy(k, vis, "s-", color=COLORS[0], ms=4, label=r"viscous $\int(\sigma_1 z' + \sigma_2 v)\,v\,dt$")
     ax.semilogy(k, hys, "o-", color=COLORS[3], ms=4, label=r"hysteretic $\int \sigma_0^2 |v| z^2/g(v)\,dt$")
     ax.semilogy(k, np.concatenate(([rep.E_0], rep.E_p[:-1])), "--", color="0.3", lw=1.0,
@@ -136,17 +136,28 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(loc="lower left", fontsize=8)
     ax = axes[0, 1]
+    # cumulative dissipation along the samples: the powers of (1)-(3) with z from the samples
+    f = lugre.friction
+    z = energy.bristle_deflection(res.t, res.v, res.F, friction=f)
+    g = f.Fc + (f.Fs - f.Fc) * np.exp(-(res.v / f.vs) ** 2)
+    zd = res.v - f.sigma0 * np.abs(res.v) * z / g
+    p_vis = (f.sigma1 * zd + f.sigma2 * res.v) * res.v
+    p_hys = f.sigma0 ** 2 * np.abs(res.v) * z * z / g
+    t_ms = res.t * 1e3
+    ax.plot(t_ms, cumulative_trapezoid(p_vis, res.t, initial=0.0) * 1e6, color=COLORS[0], label="viscous, cumulative")
+    ax.plot(t_ms, cumulative_trapezoid(p_hys, res.t, initial=0.0) * 1e6, color=COLORS[3], label="hysteretic, cumulative")
+    ax.plot(t_ms, 0.5 * f.sigma0 * z * z * 1e6, color="0.55", lw=0.8, label=r"stored bristle energy $\sigma_0 z^2/2$")
     ends = np.concatenate(([res.t[0]], rep.t))
-    ax.plot(ends * 1e3, np.concatenate(([0.0], np.cumsum(vis))) * 1e6, "s-", color=COLORS[0], ms=4, label="viscous, cumulative")
-    ax.plot(ends * 1e3, np.concatenate(([0.0], np.cumsum(hys))) * 1e6, "o-", color=COLORS[3], ms=4, label="hysteretic, cumulative")
-    ax.plot(ends * 1e3, np.concatenate(([rep.E_0], rep.E_p)) * 1e6, "^-", color="0.3", ms=4,
-            label=r"stored bristle energy $\sigma_0 z^2/2$ at reversals")
+    ax.plot(ends * 1e3, np.concatenate(([0.0], np.cumsum(vis))) * 1e6, "s", color=COLORS[0], ms=4,
+            label="viscous, at reversals (report)")
+    ax.plot(ends * 1e3, np.concatenate(([0.0], np.cumsum(hys))) * 1e6, "o", color=COLORS[3], ms=4,
+            label="hysteretic, at reversals (report)")
     ax.set_xlabel("time $t$ [ms]")
     ax.set_ylabel(r"energy [$\mu$J]")
     ax.set_title("LuGre: where the released energy goes", fontsize=10)
     ax.grid(True, alpha=0.3)
     ax.legend(loc="center right", fontsize=8)
-    add_note(fig, f"E_0 = {rep.E_0 * 1e6:.4g} uJ; viscous {rep.total_viscous / rep.E_0:.1%}, hysteretic "
+    add_note(fig, f"E_0 = {rep.E_0 * 1e6:.4g} µJ; viscous {rep.total_viscous / rep.E_0:.1%}, hysteretic "
                   f"{rep.total_hysteretic / rep.E_0:.1%} of E_0; balance residual {rep.residual:.1e} (Simpson on "
                   f"{res.t.size} samples).")
     png_energy = save(fig, outdir, "model_lugre_energy.png", dpi=dpi)
@@ -157,4 +168,4 @@ if __name__ == "__main__":
     from prefriction.plotting import script_args
 
     outdir, quick = script_args(sys.argv[1:])
-    print(main(outdir, quick=quick)["pngs"])
+    print("\n".join(str(p) for p in main(outdir, quick=quick)["pngs"]))

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from prefriction import controllers
-from prefriction.controllers.example_stage import FC, TS, stage, title
+from prefriction.controllers.example_stage import TS, stage, title
 from prefriction.controllers.plotting import plot_steps
 
 T_END = 0.03  # s
@@ -33,12 +33,12 @@ def main(outdir: "str | Path" = ".") -> dict:
     pid = controllers.design_pid(system, wn=2 * np.pi * 150.0, zeta=0.7, u_max=U_MAX)
     clip_only = controllers.PID(kp=pid.kp, ki=pid.ki, kd=pid.kd, tau=pid.tau, u_max=U_MAX, t_track=1e6)
     results = {
-        f"anti-windup (T_t = {pid.tracking_time * 1e3:.2g} ms)": controllers.simulate_loop(system, pid, STEP, T_END, Ts=TS),
+        f"anti-windup ($T_t$ = {pid.tracking_time * 1e3:.2g} ms)": controllers.simulate_loop(system, pid, STEP, T_END, Ts=TS),
         "clipping only": controllers.simulate_loop(system, clip_only, STEP, T_END, Ts=TS),
     }
     path = plot_steps(
-        results, Path(outdir) / "stage_antiwindup.png", bound=FC / pid.kp,
-        title=title(pid, ", 5 um step"),
+        results, Path(outdir) / "stage_antiwindup.png",
+        title=title(pid, ", 5 µm step"),
     )
     cases = {}
     for label, res in zip(("anti-windup", "clipping only"), results.values()):

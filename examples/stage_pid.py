@@ -1,13 +1,14 @@
-"""PID positioning of a friction stage: 1 um and 10 nm steps, sampled at 10 kHz (controllers issue).
+"""PID positioning of a friction stage: 1 µm and 10 nm steps, sampled at 10 kHz (controllers issue).
 
 Stage as in ``stage_pd.py`` (see :mod:`controllers.example_stage`: m = 1 kg, sigma = 1e6 N/m,
-Fc = 1 N, Dahl gamma = 1; pre-sliding range Fc/sigma = 1 um; chosen, not fitted to a machine).
+Fc = 1 N, Dahl gamma = 1; pre-sliding range Fc/sigma = 1 µm; chosen, not fitted to a machine).
 
 Controller: PID placed on the pre-sliding linearisation 1/(m s^2 + sigma): pole pair at
 wn = 2 pi 150 Hz, zeta = 0.7, real pole at -wn, derivative filter at 10 wn, ZOH at Ts = 1e-4 s.
 The integrator removes the residual error that a PD loop leaves (|e| <= Fc/kp): near rest the
 Dahl friction acts as the pre-sliding spring, and the final value theorem on the linearised
-loop gives e -> 0. The error panel draws Fc/kp of this PID's proportional gain for comparison.
+loop gives e -> 0 (``pd_bound`` of the result: Fc/kp of a PD with this kp, not drawn: a PID
+has no such bound).
 
 Run: ``python examples/stage_pid.py [outdir]`` writes ``stage_pid.png``.
 """
@@ -28,7 +29,7 @@ T_END = 0.04  # s
 def main(outdir: "str | Path" = ".") -> dict:
     """Simulate both steps, write ``outdir/stage_pid.png`` and return the plotted numbers (SI)."""
     design = controllers.design_pid(stage(), wn=2 * np.pi * 150.0, zeta=0.7, alpha=1.0)
-    out = step_responses(design, T_END, Path(outdir) / "stage_pid.png", bound=FC / design.kp)
+    out = step_responses(design, T_END, Path(outdir) / "stage_pid.png")
     return {**out, "kp": design.kp, "ki": design.ki, "kd": design.kd, "tau": design.tau, "pd_bound": FC / design.kp}
 
 

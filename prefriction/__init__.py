@@ -26,6 +26,12 @@ Public API, re-exported from private modules:
 
 from __future__ import annotations
 
+import casadi as _casadi
+
+from prefriction._requirements import check_casadi as _check_casadi
+
+_check_casadi(_casadi.__version__)
+
 from prefriction.errors import PrefrictionError, SolverError
 from prefriction.along import AlongResult, FrictionStream, friction_along
 from prefriction.models import GMS, Dahl, FrictionModel, LuGre, MaxwellSlip, Oscillator, Parallel, Parameter, Viscous

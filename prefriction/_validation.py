@@ -13,8 +13,8 @@ MAX_ARRAY_SIZE = 100_000_000
 
 
 def _short(value: Any, limit: int = 80) -> str:
-    """``repr(value)`` cut to ``limit`` characters."""
-    text = repr(value)
+    """``repr(value)`` cut to ``limit`` characters (a numpy scalar as its Python value: ``0.5``, not ``np.float64(0.5)``)."""
+    text = repr(value.item() if isinstance(value, np.generic) else value)
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
 

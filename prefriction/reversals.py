@@ -101,7 +101,8 @@ class ReversalTable:
         """Return the table as aligned text, at most ``max_rows`` rows (first and last half)."""
         head = f"{'i':>5} {'t [s]':>14} {'x [m]':>14} {'F [N]':>14} {'E_p [J]':>12} {'E_d [J]':>12}"
         n = len(self)
-        idx = list(range(n)) if n <= max_rows else list(range(max_rows // 2)) + list(range(n - max_rows // 2, n))
+        first, last = (max_rows + 1) // 2, max_rows // 2  # max_rows rows: the first and last halves
+        idx = list(range(n)) if n <= max_rows else list(range(first)) + list(range(n - last, n))
         lines = [head, "-" * len(head)]
         prev = -1
         for i in idx:

@@ -17,6 +17,7 @@ import casadi as ca
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from prefriction.models.sizes import check_sizes
 from prefriction._validation import check_choice, check_count, check_finite, check_interval, check_positive
 from prefriction.models import FrictionModel, Oscillator
 
@@ -259,6 +260,7 @@ def check_model(model: FrictionModel, *, v0: float = 1.5, reversals: int = 12, r
     rtol = check_interval("rtol", rtol, 1e-13, 1e-2)
     tol_factor = check_positive("tol_factor", tol_factor)
     seed = check_count("seed", seed, minimum=0)
+    check_sizes(model)
     _contract(model, np.random.default_rng(seed))
     system = Oscillator(model, mass=1.0)
     sc = Scales.of(system)

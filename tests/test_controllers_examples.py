@@ -51,7 +51,7 @@ def test_stage_pd_example(tmp_path):
         assert np.all(np.isfinite(s["x"])) and len(s["x"]) == len(s["t"]) == len(s["F"]) == len(s["u"])
         np.testing.assert_allclose(s["t"][1:] - s["t"][:-1], 1e-4, rtol=1e-9)
     # 1 um step: friction reaches the nonlinear part of (3.2), still |e| <= Fc/kp with margin
-    assert 0.05 * bound < abs(out["steps"]["1 um"]["residual_error"]) < 0.9 * bound
+    assert 0.05 * bound < abs(out["steps"]["1 µm"]["residual_error"]) < 0.9 * bound
     # 10 nm step: |F| <= 1.3 % of Fc, nearly the pre-sliding spring: final value theorem of the
     # linearised loop, e = r sigma / (sigma + kp), holds to the hysteresis (about 1 %)
     s = out["steps"]["10 nm"]

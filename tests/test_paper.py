@@ -89,7 +89,7 @@ def test_paper_help_is_plain_text(capsys):
 
 
 def test_examples_dir_is_found_beside_the_package_from_any_directory(tmp_path, monkeypatch):
-    beside = Path(paper.__file__).resolve().parents[2] / "examples"
+    beside = Path(paper.__file__).resolve().parents[1] / "examples"  # prefriction/examples (installed with it)
     if not (beside / "fig3_potential_energy.py").is_file():
         pytest.skip("prefriction is imported from an installed copy, not the source tree")
     monkeypatch.chdir(tmp_path)

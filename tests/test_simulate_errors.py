@@ -8,6 +8,7 @@ import subprocess
 import sys
 import re
 import textwrap
+import time
 
 import numpy as np
 import pytest
@@ -153,3 +154,33 @@ def test_sizes_and_amplitudes_beyond_the_limits_are_refused_before_any_work() ->
     assert MAX_PERIODS == 10**7
     with pytest.raises(TypeError, match="dense must be True, False or a 1-D array of sample times"):
         pf.simulate(system, 0.01, t_end=1.0, dense="fast")
+
+
+def test_one_size_budget_for_runs_that_grow(monkeypatch) -> None:
+    """A t_end run that a fast input would fill beyond the table's budget is refused up front; one
+    that reaches the budget anyway (unforced Dahl keeps reversing) stops there with the time reached."""
+    import prefriction as pf
+    from prefriction.simulation import simulate as sim_module
+
+    start = time.perf_counter()
+    allowed = f"{sim_module.MAX_REVERSALS / 2e9:g}".replace(".", r"\.")  # two reversals per period of 1 GHz
+    with pytest.raises(ValueError, match=rf"allows about 2e\+09 reversals.*t_end <= {allowed} s"):
+        pf.simulate(pf.Oscillator(pf.Dahl(1e4, 1.0), u=pf.signals.Sine(1.0, 1e9)), 0.0, t_end=1.0)
+    with pytest.raises(ValueError, match="allows about"):
+        pf.simulate(pf.Oscillator(pf.Dahl(1e4, 1.0), u=pf.signals.Sine(0.5, 1.0) + pf.signals.Sine(0.1, 1e8)),
+                    0.0, t_end=1.0)
+    assert time.perf_counter() - start < 5.0
+    monkeypatch.setattr(sim_module, "MAX_REVERSALS", 300)
+    with pytest.raises(ValueError, match=r"t_end = 1e\+09 s needs more than 300 reversals.*reached 300 at t = "):
+        pf.simulate(pf.Oscillator(pf.Dahl(1e4, 1.0, 2.0)), 1.0, t_end=1e9)
+
+
+def test_motion_that_dies_out_says_so_and_asks_for_t_end() -> None:
+    """An overdamped LuGre oscillator creeps to rest after two reversals: the third never comes."""
+    import prefriction as pf
+
+    system = pf.Oscillator(pf.LuGre(1e5, 1e4, 0.4, 1.0, 1.5, 1e-3))
+    with pytest.raises(pf.SolverError, match=r"died out after 2 reversals.*Give t_end"):
+        pf.simulate(system, 1.0, reversals=5)
+    res = pf.simulate(system, 1.0, t_end=100.0)
+    assert res.status == 0 and len(res.reversals) == 2

@@ -97,7 +97,8 @@ def test_serial_sweep_is_the_same_with_a_thread_pool(serial: SweepResult) -> Non
 def test_progress_line(capsys: pytest.CaptureFixture) -> None:
     sweep(SYSTEMS[:2], 1.0, reversals=N_REV, progress=True)
     err = capsys.readouterr().err
-    assert err.startswith("\rsweep: ") and "2/2 runs" in err and err.endswith("\n")
+    # stderr is not a terminal here: whole lines, no carriage returns (prefriction._progress)
+    assert err.startswith("sweep: ") and "2/2 runs" in err and err.endswith("\n") and "\r" not in err
     sweep(SYSTEMS[:2], 1.0, reversals=N_REV)  # automatic: a short sweep prints nothing
     sweep(SYSTEMS[:2], 1.0, reversals=N_REV, progress=False)
     assert capsys.readouterr().err == ""

@@ -5,8 +5,9 @@ Runs every script ``examples/fig*.py`` and ``examples/beyond_*.py`` (each has
 seconds), and writes ``DIR/report.md``: each figure with a caption, the key numbers, the
 erratum in (3.13) and every place where the toolbox disagrees with the paper, with numbers.
 
-The examples live in the source tree (``examples/`` beside the package); they are found next
-to the package or, for a non-editable install, in ``./examples`` of the working directory.
+The examples live in the source tree (``examples/``) and are installed with the package as
+``prefriction/examples/`` (the symlink ``prefriction/examples -> ../examples`` in the tree), so
+the command runs from an installed wheel as from the repository.
 """
 
 from __future__ import annotations
@@ -39,21 +40,22 @@ FIGURES = (
 
 
 def examples_dir() -> Path:
-    """Directory holding the figure scripts: beside the package, else ``./examples``.
+    """Directory holding the figure scripts: ``prefriction/examples`` (installed with the package),
+    else ``./examples``.
 
     Raises
     ------
     FileNotFoundError
         If neither place holds ``fig3_potential_energy.py``; names both places.
     """
-    candidates = [Path(__file__).resolve().parents[2] / "examples", Path.cwd() / "examples"]
+    candidates = [Path(__file__).resolve().parents[1] / "examples", Path.cwd() / "examples"]
     for cand in candidates:
         if (cand / "fig3_potential_energy.py").is_file():
             return cand
     raise FileNotFoundError(
         "the figure scripts (examples/fig*.py) were not found in "
         + " or ".join(str(c) for c in candidates)
-        + "; run 'prefriction paper' from the repository root or install with 'pip install -e .'"
+        + "; reinstall prefriction (pip install .) or run 'prefriction paper' from the repository root"
     )
 
 

@@ -9,7 +9,8 @@
   rate-dependent blocks);
 - :func:`velocity_loop`, :class:`VelocityDescribingFunction`: friction as a nonlinearity of the
   velocity, ``G(s) = s / (m s^2 + C(s))``;
-- :func:`friction_loop`, :func:`predict_limit_cycle` (with Loeb's stability test),
+- :func:`friction_loop`, :func:`predict_limit_cycles` / :func:`predict_limit_cycle` (every
+  harmonic balance, stability over all modes),
   :func:`measure_limit_cycle`, :func:`trace_unstable_cycle`, :func:`simulate_from_cycle`: predicted against simulated limit
   cycles.
 
@@ -24,6 +25,7 @@ from prefriction.describing.limit_cycle import (
     friction_loop,
     measure_limit_cycle,
     predict_limit_cycle,
+    predict_limit_cycles,
 )
 from prefriction.describing.nonlinearity import FrictionDescribingFunction, PlantDescribingFunction
 from prefriction.describing.trace import TracedCycle, simulate_from_cycle, trace_unstable_cycle
@@ -44,6 +46,7 @@ __all__ = [
     "measure_limit_cycle",
     "plant_describing_function",
     "predict_limit_cycle",
+    "predict_limit_cycles",
     "simulate_from_cycle",
     "trace_unstable_cycle",
     "velocity_loop",

@@ -20,7 +20,11 @@ from prefriction.describing.cycle import friction_describing_function, plant_des
 from prefriction.describing.dahl import dahl_describing_function
 from prefriction.models import Dahl, Oscillator, check_oscillator
 
-__all__ = ["FrictionDescribingFunction", "PlantDescribingFunction"]
+__all__ = ["BLOCK_OPTIONS", "FrictionDescribingFunction", "PlantDescribingFunction"]
+
+BLOCK_OPTIONS = {"rtol": 1e-8, "tol": 1e-6}
+"""Defaults of the settled-cycle integration inside a block (``N`` to about 1e-5, far inside the
+describing function's own approximation; 5-10 times faster than the function's defaults)."""
 
 
 class _Block(control.DescribingFunctionNonlinearity):
@@ -85,7 +89,8 @@ class FrictionDescribingFunction(_Block):
     omega : float, optional
         Angular frequency [rad/s]; required for rate-dependent models.
     **options
-        Passed to :func:`friction_describing_function` (``rtol``, ``tol``, ``max_cycles``, ``method``).
+        Passed to :func:`friction_describing_function` (``rtol``, ``tol``, ``max_cycles``, ``method``);
+        defaults :data:`BLOCK_OPTIONS` (``rtol=1e-8, tol=1e-6``).
     """
 
     def __init__(self, system: Oscillator, omega: Optional[float] = None, **options: Any) -> None:
@@ -98,7 +103,7 @@ class FrictionDescribingFunction(_Block):
         f = self.system.friction
         if self._closed:
             return complex(dahl_describing_function(A, f.sigma, f.Fc))
-        return friction_describing_function(self.system, A, self.omega or 1.0, **self._options)
+        return friction_describing_function(self.system, A, self.omega or 1.0, **{**BLOCK_OPTIONS, **self._options})
 
 
 class PlantDescribingFunction(_Block):

@@ -12,13 +12,13 @@ just below and just above the boundary while they still agree (``docs/describing
 from __future__ import annotations
 
 import math
-import sys
 from dataclasses import dataclass
 from typing import Any
 
 import control
 import numpy as np
 
+from prefriction._progress import ProgressLine
 from prefriction._validation import check_choice, check_count, check_interval
 from prefriction.describing.limit_cycle import LimitCycle
 from prefriction.describing.velocity import controller_tf
@@ -187,14 +187,15 @@ def trace_unstable_cycle(system: Oscillator, controller: Any, cycle: LimitCycle,
 
     if grows(lo, 0)[0] or not grows(hi, 0)[0]:
         raise ValueError(f"bracket {bracket!r}: lambda = {lo!r} must decay and lambda = {hi!r} grow; widen it")
+    line = ProgressLine()
     for k in range(1, steps + 1):
         mid = 0.5 * (lo + hi)
         if grows(mid, k)[0]:
             hi = mid
         else:
             lo = mid
-        print(f"\rtrace_unstable_cycle: step {k}/{steps}, lambda in [{lo:.10g}, {hi:.10g}]", end="", file=sys.stderr)
-    print(file=sys.stderr)
+        line.show(f"trace_unstable_cycle: step {k}/{steps}, lambda in [{lo:.10g}, {hi:.10g}]")
+    line.close()
     n_run = min(periods, 4 + steps)
     r_lo, r_hi = (_run(system, controller, X, w, b, n_run, rtol) for b in (lo, hi))
     p_lo, p_hi = _peaks(r_lo, n_run), _peaks(r_hi, n_run)

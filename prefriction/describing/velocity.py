@@ -27,7 +27,7 @@ import numpy as np
 
 from prefriction.describing.cycle import friction_describing_function
 from prefriction.describing.dahl import dahl_describing_function
-from prefriction.describing.nonlinearity import _Block
+from prefriction.describing.nonlinearity import BLOCK_OPTIONS, _Block
 from prefriction.models import Dahl, Oscillator, check_oscillator
 
 __all__ = ["VelocityDescribingFunction", "controller_tf", "velocity_loop"]
@@ -85,7 +85,8 @@ class VelocityDescribingFunction(_Block):
     omega : float, optional
         Angular frequency [rad/s]; required before evaluating (or use ``.at(omega)``).
     **options
-        Passed to :func:`friction_describing_function` (``rtol``, ``tol``, ``max_cycles``, ``method``).
+        Passed to :func:`friction_describing_function` (``rtol``, ``tol``, ``max_cycles``, ``method``);
+        defaults ``BLOCK_OPTIONS`` (``rtol=1e-8, tol=1e-6``).
     """
 
     def __init__(self, system: Oscillator, omega: Optional[float] = None, **options: Any) -> None:
@@ -99,5 +100,5 @@ class VelocityDescribingFunction(_Block):
         if self._closed:
             Nx = complex(dahl_describing_function(A / w, f.sigma, f.Fc))
         else:
-            Nx = friction_describing_function(self.system, A / w, w, **self._options)
+            Nx = friction_describing_function(self.system, A / w, w, **{**BLOCK_OPTIONS, **self._options})
         return Nx / (1j * w)

@@ -167,8 +167,11 @@ class Motion:
         _same_length(t, "x", x)
         _moving("x", x, "m")
         if np.ndim(self.u) == 0 and not isinstance(self.u, (str, bytes)) and self.u is not None:
-            u_val = float(np.asarray(self.u, dtype=float)) if not isinstance(self.u, bool) else None
-            if u_val is None or not np.isfinite(u_val):
+            if isinstance(self.u, (bool, np.bool_)) or not isinstance(self.u, (int, float, np.integer, np.floating)):
+                raise TypeError(f"u must be a real number [N] or one sample per time, got {self.u!r} of type "
+                                f"{type(self.u).__name__}")
+            u_val = float(self.u)
+            if not np.isfinite(u_val):
                 raise ValueError(f"u must be a finite number [N] or one sample per time, got {self.u!r}")
             u = np.full(t.size, u_val)
             u.flags.writeable = False

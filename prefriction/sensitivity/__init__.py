@@ -88,9 +88,23 @@ def sensitivities(system: Oscillator, v0: float = 0.0, *, reversals: Optional[in
     v0 = check_finite("v0", v0)
     rtol = check_interval("rtol", rtol, 1e-13, 1e-6)
     band = check_interval("band", band, 0.0, 1.0)
+    if band == 0.0:
+        raise ValueError("band must lie in (0, 1] (a settling band of 0 is never entered: the settling time "
+                         "would be t_end), got 0.0")
     fields = tuple(p.name for p in model.parameters)
-    allowed = fields + ("mass", "v0") + (_PID if controller is not None else ())
+    gains = _PID if controller is not None else ()
+    if controller is not None and getattr(controller, "ki", None) == 0.0:
+        gains = tuple(g for g in gains if g != "ki")  # a PD has no integrator state to perturb
+        if parameters is not None and "ki" in parameters:
+            raise ValueError("parameters: 'ki' needs a controller with an integrator (ki > 0); this PD controller "
+                             f"has none, so its loop has no derivative with respect to ki; allowed: "
+                             f"{fields + ('mass', 'v0') + gains}")
+    allowed = fields + ("mass", "v0") + gains
+    if isinstance(parameters, str):
+        raise TypeError(f"parameters must be a sequence of names, e.g. ({parameters!r},), got the string {parameters!r}")
     names = tuple(allowed if parameters is None else parameters)
+    if not names:
+        raise ValueError(f"parameters must name at least one of {allowed}, got an empty sequence")
     for n in names:
         if n not in allowed:
             raise ValueError(f"parameters: unknown name {n!r}; allowed: {allowed}")

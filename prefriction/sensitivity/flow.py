@@ -146,9 +146,16 @@ def _newton(flow: Flow, y: np.ndarray, Pn: np.ndarray, T: float, s: float, where
         T += dT
         if abs(dT) <= 1e-13 * T or (it >= 2 and abs(dT) <= flow.rtol * T):  # at the integration noise
             return T
+    state = np.array2string(yf, precision=6)
+    if abs(acc) <= 1e-6 * max(1.0, float(np.max(np.abs(Pn)))):  # v = 0 and no acceleration: the mass sticks
+        raise SolverError(
+            f"sensitivities: the reversal {where} is a stick (the mass comes to rest there: v and the acceleration "
+            f"both vanish, state {state}), where the reversal time has no derivative; sensitivities cover runs "
+            f"whose reversals are crossings of v = 0: end t_end before it"
+        )
     raise SolverError(
         f"sensitivities: the reversal {where} was not located (Newton on v = 0 from the simulator's time "
-        f"did not converge; state {yf!r}); try a tighter rtol"
+        f"did not converge; state {state}); try a tighter rtol"
     )
 
 
@@ -174,7 +181,7 @@ def run_flow(system: Oscillator, v0: float, names: Sequence[str], times: np.ndar
     t_acc, dt_acc = 0.0, np.zeros(len(names))
     rows, drows, starts = [], [], [(y.copy(), S.copy(), s, t_acc, dt_acc.copy())]
     for i, t_guess in enumerate(times):
-        T = _newton(flow, y, Pn, float(t_guess) / sc.t - t_acc, s, f"{i} near t = {t_guess!r} s")
+        T = _newton(flow, y, Pn, float(t_guess) / sc.t - t_acc, s, f"{i} near t = {float(t_guess):.9g} s")
         yf, Jy, Jp = (np.asarray(a) for a in flow.step(y, np.r_[Pn, T, s]))
         yf = yf.ravel()
         dT = -(Jy[1] @ S + Jp[1, :nP] @ J) / Jp[1, nP]
@@ -220,7 +227,8 @@ def settling(out: dict, t_guess: float, band: float) -> tuple[float, np.ndarray]
         if abs(dT) <= 1e-13 * T or (it >= 2 and abs(dT) <= flow.rtol * T):
             break
     else:
-        raise SolverError(f"sensitivities: the settling crossing near t = {t_guess!r} s was not located; try a tighter rtol")
+        raise SolverError(f"sensitivities: the settling crossing near t = {float(t_guess):.9g} s was not located; "
+                          f"try a tighter rtol")
     yT, Jy, Jp = (np.asarray(a) for a in flow.step(y, np.r_[Pn, T, s]))
     yT = yT.ravel()
     side = math.copysign(1.0, yT[0] - xf)

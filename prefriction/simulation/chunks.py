@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import concurrent.futures as cf
 import math
-import threading
 from typing import Any, Callable, Optional
 
 from prefriction.models import Oscillator
@@ -30,22 +29,11 @@ _CHUNKS_PER_WORKER = 8  # automatic chunk size: about this many chunks per worke
 _IN_FLIGHT_PER_WORKER = 3  # chunks submitted ahead per worker: none waits for the parent
 _WAIT = 0.5  # longest wait for a chunk before the progress line is refreshed [s]
 
-# Runs of the same structure share one compiled integrator and its argument buffers per process
-# (prefriction.simulation.integrator), so two runs must never overlap in one process: threads of
-# a ThreadPoolExecutor or of a multi-threaded dask worker take turns on this lock.
-RUN_LOCK = threading.Lock()
-
-
-def run_one(system: Oscillator, v0: float, kwargs: dict) -> Any:
-    """One :func:`prefriction.simulate` run, holding :data:`RUN_LOCK`."""
-    with RUN_LOCK:
-        return simulate(system, v0, **kwargs)
-
-
 def run_caught(system: Oscillator, v0: float, kwargs: dict) -> Any:
-    """:func:`run_one`, returning the exception instead of raising it (``Exception`` only)."""
+    """One :func:`prefriction.simulate` run (thread-safe: each thread has its own buffers),
+    returning the exception instead of raising it (``Exception`` only)."""
     try:
-        return run_one(system, v0, kwargs)
+        return simulate(system, v0, **kwargs)
     except Exception as exc:  # noqa: BLE001 - a failed run is a result of the sweep
         return exc
 

@@ -4,8 +4,10 @@
 with the system C compiler (``gcc -O2 -shared``) into a shared library named by the SHA-256 of
 the generated code, and loads it with ``casadi.external``. The library is kept in the cache
 directory (``$PREFRICTION_CACHE``, else ``~/.cache/prefriction``), so a second process with the
-same Function loads it without compiling. Without a compiler, with ``PREFRICTION_NO_JIT=1``, or
-if compiling fails, the interpreted Function is returned: same results, slower calls.
+same Function loads it without compiling; :mod:`prefriction.simulation.library_store` writes
+libraries atomically and verifies a checksum before loading one. Without a compiler, with
+``PREFRICTION_NO_JIT=1``, or if compiling fails, the interpreted Function is returned: same
+results, slower calls.
 """
 
 from __future__ import annotations
@@ -14,6 +16,7 @@ import functools
 import hashlib
 import os
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
@@ -23,7 +26,16 @@ from pathlib import Path
 
 import casadi as ca
 
-__all__ = ["CompileInfo", "cache_dir", "compiled", "jit_available"]
+from prefriction.simulation import library_store as store
+
+__all__ = ["CompileInfo", "cache_dir", "compile_timeout", "compiled", "compiled_seconds", "jit_available"]
+
+_SPENT = [0.0]  # wall time spent generating and compiling code in this process [s]
+
+
+def compiled_seconds() -> float:
+    """Wall time [s] this process has spent generating and compiling code (all calls of :func:`compiled`)."""
+    return _SPENT[0]
 
 
 @dataclass(frozen=True)
@@ -63,8 +75,29 @@ def jit_available() -> bool:
     return os.environ.get("PREFRICTION_NO_JIT", "") in ("", "0") and _compiler() is not None
 
 
+def compile_timeout() -> float:
+    """Longest wait for the C compiler [s]: ``$PREFRICTION_COMPILE_TIMEOUT``, else 120."""
+    try:
+        value = float(os.environ.get("PREFRICTION_COMPILE_TIMEOUT", "120"))
+    except ValueError:
+        return 120.0
+    return value if value > 0 else 120.0
+
+
+def _say(line: str) -> None:
+    print(f"prefriction: {line}", file=sys.stderr, flush=True)
+
+
 def compiled(fun: ca.Function, what: str = "") -> tuple[ca.Function, CompileInfo]:
     """Return a compiled equivalent of ``fun`` (loaded from the cache if present) and how it was made.
+
+    A cached library is used only if it matches the checksum stored beside it and has the inputs
+    and outputs of ``fun`` (:mod:`prefriction.simulation.library_store`); otherwise it is rebuilt,
+    with one line on stderr saying what was wrong. If the cache cannot hold the library (not
+    writable, a directory in its place), the library is built in a directory of this process and
+    the line says so. A compiler that runs longer than :func:`compile_timeout` is stopped, the
+    interpreted Function is used, and later processes use it at once (the line names the file
+    to delete to try again).
 
     Parameters
     ----------
@@ -94,31 +127,63 @@ def compiled(fun: ca.Function, what: str = "") -> tuple[ca.Function, CompileInfo
             cg.generate(tmp + os.sep)
         except RuntimeError as exc:  # the Function cannot be code-generated
             return fun, CompileInfo("interpreted", 0.0, reason=f"code generation failed: {exc}")
-        code = src.read_bytes()
-        key = hashlib.sha256(code + cc.encode()).hexdigest()[:24]
+        key = hashlib.sha256(src.read_bytes() + cc.encode() + ca.__version__.encode()).hexdigest()[:24]
         directory = cache_dir()
         lib = directory / f"{name}_{key}.so"
-        if lib.exists():
-            try:
-                return ca.external(name, str(lib)), CompileInfo("cached", 0.0, str(lib))
-            except RuntimeError:
-                lib.unlink(missing_ok=True)  # corrupt or foreign library: rebuild it below
-        print(f"prefriction: compiling {name} ({what or 'plant'}) once per structure; cached in {directory}",
-              file=sys.stderr, flush=True)
+        ext, problem = store.load(fun, lib, key)
+        if ext is not None:
+            return ext, CompileInfo("cached", 0.0, str(lib))
+        earlier = store.failure_note(lib)
+        if earlier:
+            _say(f"{name}: {earlier}; using the interpreted Function (same results, slower)")
+            return fun, CompileInfo("interpreted", 0.0, reason=earlier)
+        blocked = store.unwritable(directory, lib)
+        dest = store.private_dir() / lib.name if blocked else lib
+        where = (f"{blocked}: compiled code kept for this process only, in {dest.parent}" if blocked
+                 else f"cached in {directory}")
+        _say(f"compiling {name} ({what or 'plant'}) once per structure; "
+             + (f"replacing a bad library: {problem}; " if problem else "") + where)
+        part = Path(tmp) / lib.name
         try:
-            directory.mkdir(parents=True, exist_ok=True)
-            part = Path(tmp) / lib.name
-            subprocess.run(
-                [cc, "-O2", "-shared", "-fPIC", str(src), "-o", str(part), "-lm"],
-                check=True,
-                capture_output=True,
-                timeout=300,
-            )
-            # atomic publish: concurrent processes never load a half-written library
-            staged = directory / f".{lib.name}.{os.getpid()}"
-            shutil.copyfile(part, staged)
-            os.replace(staged, lib)
-            ext = ca.external(name, str(lib))
-        except (OSError, subprocess.SubprocessError, RuntimeError) as exc:
-            return fun, CompileInfo("interpreted", 0.0, reason=f"compiling failed: {exc}")
-    return ext, CompileInfo("compiled", time.perf_counter() - start, str(lib))
+            _run_compiler([cc, "-O2", "-shared", "-fPIC", str(src), "-o", str(part), "-lm"])
+        except subprocess.TimeoutExpired:
+            why = f"compiling {name} with {cc} took longer than {compile_timeout():g} s (PREFRICTION_COMPILE_TIMEOUT)"
+            return _interpreted(fun, lib, why)
+        except subprocess.CalledProcessError as exc:
+            detail = exc.stderr.decode(errors="replace").strip().splitlines()[-1:] or [f"exit status {exc.returncode}"]
+            return _interpreted(fun, lib, f"compiling {name} with {cc} failed: {detail[0]}")
+        except OSError as exc:
+            return _interpreted(fun, lib, f"running the compiler {cc} failed: {exc}", record=False)
+        try:
+            store.publish(part, dest, key)
+        except OSError as exc:  # the cache changed under us: keep the library for this process
+            dest = store.private_dir() / lib.name
+            store.publish(part, dest, key)
+            _say(f"{lib} could not be written ({exc.strerror or exc}); compiled code kept in {dest.parent}")
+        ext, problem = store.load(fun, dest, key)
+        if ext is None:
+            return _interpreted(fun, lib, f"the freshly compiled library could not be used: {problem}", record=False)
+    seconds = time.perf_counter() - start
+    _SPENT[0] += seconds
+    return ext, CompileInfo("compiled", seconds, str(dest))
+
+
+def _run_compiler(cmd: list[str]) -> None:
+    """Run the compiler; on timeout stop it and everything it started (``TimeoutExpired``)."""
+    with subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True) as proc:
+        try:
+            out, err = proc.communicate(timeout=compile_timeout())
+        except subprocess.TimeoutExpired:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.communicate()
+            raise
+    if proc.returncode:
+        raise subprocess.CalledProcessError(proc.returncode, cmd, out, err)
+
+
+def _interpreted(fun: ca.Function, lib: Path, why: str, record: bool = True) -> tuple[ca.Function, CompileInfo]:
+    """Fall back to the interpreted ``fun`` with one line on stderr; note a compiler failure beside ``lib``."""
+    if record:
+        store.record_failure(lib, why)
+    _say(f"{why}; using the interpreted Function (same results, slower)")
+    return fun, CompileInfo("interpreted", 0.0, reason=why)

@@ -4,14 +4,17 @@ from __future__ import annotations
 
 import time
 import warnings
+from typing import Any
 
 import casadi as ca
 import numpy as np
 
+from prefriction.models.sizes import check_sizes
 from prefriction.simulation.compiled import compiled, jit_available
+from prefriction.simulation.per_thread import PerThread
 from prefriction.simulation.plant import Layout, PlantSpec, build_integrator
 
-_CACHE: dict = {}
+_CACHE = PerThread()  # one Function per structure and process, its buffers per thread
 INTEGRATOR_FAILED = (
     "the integrator stopped with an error before the end of its interval (a non-finite right-hand "
     "side such as a NaN input, a step below its minimum, or more steps or events than allowed)"
@@ -36,12 +39,20 @@ class BufferedIntegrator:
 
 def integrator(spec: PlantSpec, jit: bool) -> tuple[BufferedIntegrator, float, str]:
     """Build (or reuse) the integrator of the structure ``spec``; returns it, the setup time and
-    the JIT mode. One per structure and process: numbers and tolerances are run-time inputs."""
+    the JIT mode. One Function per structure and process (numbers and tolerances are run-time
+    inputs), called through buffers of the calling thread: runs in threads do not interfere."""
     jit = jit and jit_available()  # PREFRICTION_NO_JIT may change between calls
-    key = (spec, jit)
-    if key in _CACHE:
-        return _CACHE[key][0], 0.0, _CACHE[key][1] if _CACHE[key][1] == "interpreted" else "cached"
+    call, (_, mode, setup), built = _CACHE.get(
+        (spec, jit), lambda: _build(spec, jit), lambda made: BufferedIntegrator(made[0], Layout(spec), spec.n_out))
+    if built:
+        return call, setup, mode
+    return call, 0.0, mode if mode == "interpreted" else "cached"
+
+
+def _build(spec: PlantSpec, jit: bool) -> tuple[Any, str, float]:
+    """The Function of ``spec`` (compiled or loaded from the cache if ``jit``), its mode and setup time."""
     start = time.perf_counter()
+    check_sizes(spec.model)  # a user model's sizes, once per structure
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", FutureWarning)
         fun = build_integrator(spec)
@@ -49,10 +60,7 @@ def integrator(spec: PlantSpec, jit: bool) -> tuple[BufferedIntegrator, float, s
     if jit:
         fun, info = compiled(fun, _describe(spec))
         mode = info.mode
-    call = BufferedIntegrator(fun, Layout(spec), spec.n_out)
-    setup = time.perf_counter() - start
-    _CACHE[key] = (call, mode)
-    return call, setup, mode
+    return fun, mode, time.perf_counter() - start
 
 
 def _describe(spec: PlantSpec) -> str:

@@ -24,6 +24,7 @@ from prefriction.models import Oscillator
 from prefriction.units import Scales
 
 N_DENSE = 16  # output times per call of the dense-output integrator
+_DIED_OUT = 1e-20  # normalised speed below which an unforced motion has died out (no reversal comes)
 
 
 class Run(StateIO, Rest):
@@ -110,14 +111,22 @@ class Run(StateIO, Rest):
 
     def _count_steps(self, call: BufferedIntegrator) -> None:
         """Add the steps of the last call (interpreted integrator only; else ``steps`` = None)."""
-        try:  # statistics exist for the interpreted integrator only (memory 1: the buffer's)
-            self.steps += int(call.fun.stats(1)["n_steps"])
+        try:  # statistics exist for the interpreted integrator only (of this thread's buffer)
+            self.steps += int(call.buf.stats()["n_steps"])
         except (RuntimeError, KeyError):
             self.steps = None
 
     def _failure(self, why: str) -> SolverError:
         """The SolverError of a failed call: time, state, reversals so far and what to try."""
         sc, st = self.sc, self.st
+        if not self.spec.forced and abs(st["v"]) < _DIED_OUT and abs(st["F"]) < _DIED_OUT ** 0.5:
+            return SolverError(
+                f"simulate stopped at t = {st['t'] * sc.t:.9g} s: the motion has died out after {len(self.rev)} "
+                f"reversals (v = {st['v'] * sc.v:.3g} m/s, F = {st['F'] * sc.F:.3g} N, x = {st['x'] * sc.x:.6g} m), "
+                f"so it will not reverse again and the requested reversals cannot come (the integrator then "
+                f"failed: {why}). Give t_end to simulate up to a time instead, or ask for at most "
+                f"{len(self.rev)} reversals."
+            )
         return SolverError(
             f"simulate failed after t = {st['t'] * sc.t:.9g} s (state there: x = {st['x'] * sc.x:.6g} m, "
             f"v = {st['v'] * sc.v:.6g} m/s, F = {st['F'] * sc.F:.6g} N, direction {int(st['s']):+d}, "

@@ -44,6 +44,7 @@ from prefriction.simulation.rest import initial_direction
 from prefriction.simulation.run import N_DENSE, Run
 from prefriction.simulation.plant import Layout, PlantSpec
 from prefriction.simulation.force_scale import applied_force_scale
+from prefriction.simulation.budget import check_input_budget
 from prefriction._validation import check_count, check_finite, check_positive
 from prefriction.models import Oscillator, check_oscillator
 from prefriction.reversals import ReversalTable
@@ -66,7 +67,9 @@ MAX_AMPLITUDE = 1e100
 """Largest amplitude of the motion (normalised units) that :func:`simulate` accepts: energies
 ``A^2`` and first excursions ``~A^2 / 2`` stay far from the double-precision range."""
 MAX_REVERSALS = 10**7
-"""Most reversals of one :func:`simulate` call (the table holds them in memory: about 1 GB)."""
+"""Most reversals of one :func:`simulate` call, requested or reached by ``t_end`` (the run holds
+its table in memory: about 100 bytes per reversal at the peak, so about 1 GB;
+``docs/simulator.md#limits``)."""
 MAX_PERIODS = 10**7
 """Most sample periods ``t_end / Ts`` of a sampled controller (one Python step and one sample each)."""
 _CAL = 0.1  # calibration of the run-time tolerance eps: global error over 50 reversals ~ 0.7 rtol
@@ -150,6 +153,11 @@ def simulate(
         If the integrator fails; the message names the time, the state and what to try.
     """
     model = check_oscillator(system, "simulate")
+    try:
+        hash(model.structure_key)
+    except TypeError:
+        raise TypeError(f"{type(model).__name__}.structure_key must be hashable (a tuple of numbers and strings): "
+                        f"it keys the compiled plant; got {model.structure_key!r:.120}") from None
     v0 = check_finite("v0", v0)
     x0 = check_finite("x0", x0)
     F0 = check_finite("F0", F0)
@@ -160,9 +168,11 @@ def simulate(
                          f"{type(system.friction).__name__}), got {F0!r}")
     if reversals is None and t_end is None:
         raise ValueError("give reversals (number of reversals) or t_end (end time [s]) or both; got neither")
-    n_target = math.inf if reversals is None else check_count(
+    # one budget for every run that can grow: at most MAX_REVERSALS reversals, requested or reached by t_end
+    n_target = MAX_REVERSALS if reversals is None else check_count(
         "reversals", reversals, 1, MAX_REVERSALS, "the reversal table is held in memory")
     t_end_si = math.inf if t_end is None else check_positive("t_end", t_end)
+    check_input_budget(system.u, t_end_si, MAX_REVERSALS)
     rtol = check_positive("rtol", rtol)
     if not 1e-13 <= rtol <= 1e-2:
         raise ValueError(f"rtol must lie in [1e-13, 1e-2], got {rtol!r}")
@@ -234,6 +244,11 @@ def simulate(
     else:
         samples = []
         run.advance(t_end_n, n_target)
+    if reversals is None and len(run.rev) >= n_target:
+        raise ValueError(
+            f"t_end = {t_end_si:.6g} s needs more than {MAX_REVERSALS:_} reversals (the reversal table is held in "
+            f"memory): the run reached {MAX_REVERSALS:_} at t = {run.rev[-1][0] * sc.t:.6g} s; allowed: a t_end below "
+            f"that, or reversals=n to stop after n reversals")
     if len(run.rev) >= n_target:
         status, message = 1, f"reached {int(n_target)} reversals at t = {run.rev.t[int(n_target) - 1] * sc.t:.9g} s"
     else:

@@ -18,7 +18,7 @@ import concurrent.futures as cf
 import inspect
 import itertools
 import math
-import sys
+import pickle
 import time
 import warnings
 from numbers import Real
@@ -26,6 +26,7 @@ from typing import Any, Hashable, Iterable, Optional, Sequence, Sized, Union
 
 import numpy as np
 
+from prefriction._progress import ProgressLine
 from prefriction._validation import check_bool, check_choice, check_count, check_finite, check_positive
 from prefriction.models import Oscillator
 from prefriction.simulation.chunks import run_caught, run_chunks
@@ -136,7 +137,9 @@ def sweep(
         code is in the disk cache before the workers start (workers on other machines need the
         cache directory ``$PREFRICTION_CACHE`` on a shared file system, or compile once each).
         With a ``ProcessPoolExecutor`` the systems are pickled: a callable input ``u`` must be a
-        module-level function (dask pickles lambdas too).
+        module-level function (dask pickles lambdas too); one that cannot be pickled is refused
+        before any run. Runs in threads (``ThreadPoolExecutor``) do not interfere: each thread
+        calls the shared compiled code through its own buffers.
     progress : bool, optional
         ``None`` (default): print a progress line such as ``sweep: 12/40 runs, 3.1 s`` to
         stderr, updated in place every 0.5 s, once the sweep has run for 1 s (short sweeps print
@@ -236,6 +239,8 @@ def sweep(
             results[i] = run_caught(systems[i], v0s[i], kwargs)
             bar.update(i + 1)
     else:
+        if isinstance(executor, cf.ProcessPoolExecutor):
+            _check_picklable(systems, kwargs)
         _run_on(executor, systems, v0s, kwargs, results, bar, chunksize)
     bar.close(n)
 
@@ -243,6 +248,28 @@ def sweep(
     if out.failed:
         warnings.warn(_failure_message(out), RuntimeWarning, stacklevel=2)
     return out
+
+
+def _check_picklable(systems: list, kwargs: dict) -> None:
+    """``TypeError`` before any run if a system or keyword cannot be sent to a process pool."""
+    seen: set = set()
+    for i, system in enumerate(systems):
+        for part, what in ((system.u, "input u"), (system.friction, "friction model")):
+            if id(part) in seen:
+                continue
+            seen.add(id(part))
+            try:
+                pickle.dumps(part)
+            except Exception as exc:  # noqa: BLE001 - any pickling failure, reported with its reason
+                raise TypeError(
+                    f"systems[{i}].{'u' if part is system.u else 'friction'} ({what}) cannot be sent to a "
+                    f"ProcessPoolExecutor: {exc}. Use a prefriction.signals input (Sine, Step, Ramp, Chirp, Samples) "
+                    f"or a module-level function instead of a lambda or local function, or a ThreadPoolExecutor"
+                ) from None
+    try:
+        pickle.dumps(kwargs)
+    except Exception as exc:  # noqa: BLE001
+        raise TypeError(f"the keyword arguments cannot be sent to a ProcessPoolExecutor: {exc}") from None
 
 
 def _group_key(system: Oscillator, kwargs: dict) -> Hashable:
@@ -296,12 +323,12 @@ def _run_on(executor: cf.Executor, systems: list, v0s: list, kwargs: dict, resul
 
 
 class _Progress:
-    """A progress line on stderr, rewritten in place (``mode``: None automatic, True, False)."""
+    """A progress line on stderr (``mode``: None automatic, True, False)."""
 
     def __init__(self, n: int, mode: Optional[bool], start: float) -> None:
         self.n, self.mode, self.start = n, mode, start
         self.last: Optional[float] = None
-        self.width = 0
+        self.line = ProgressLine()  # in place on a terminal, one line per update in a log
 
     def update(self, done: int) -> None:
         if self.mode is False:
@@ -317,14 +344,10 @@ class _Progress:
     def close(self, done: int) -> None:
         if self.mode is True or (self.mode is None and self.last is not None):
             self._write(done, time.perf_counter())
-            sys.stderr.write("\n")
-            sys.stderr.flush()
+            self.line.close()
 
     def _write(self, done: int, now: float) -> None:
-        text = f"sweep: {done}/{self.n} runs, {now - self.start:.1f} s"
-        sys.stderr.write("\r" + text.ljust(self.width))
-        sys.stderr.flush()
-        self.width = max(self.width, len(text))
+        self.line.show(f"sweep: {done}/{self.n} runs, {now - self.start:.1f} s")
 
 
 # --- validation ------------------------------------------------------------------------------

@@ -29,12 +29,14 @@ Every public function raises ``TypeError`` or ``ValueError`` naming the argument
 the allowed range for ``None``, strings, complex numbers, NaN, inf, negative energies, empty or
 mismatched arrays and unsorted times.
 
-Conventions (as in :class:`prefriction.ReversalTable`): reversal ``k`` ends half-cycle ``k - 1`` and starts
-half-cycle ``k``; ``E_p[k]`` is the potential energy at reversal ``k``, i.e. the energy the new
-branch returns as kinetic energy until its force zero crossing; ``E_d[k]`` (this module) is
-the energy dissipated in the half-cycle from reversal ``k`` to reversal ``k + 1``, which is the
-paper's ``E_d(i)`` in (2.10). :class:`prefriction.ReversalTable` indexes ``E_d`` by the
-half-cycle that *ends* at a reversal instead: ``table.E_d[k + 1]`` is ``E_d[k]`` here.
+Conventions (as in :class:`prefriction.ReversalTable`): reversal ``k`` ends half-cycle ``k``
+(half-cycle 0 is the first excursion from the initial state); ``E_p[k]`` is the potential
+energy at reversal ``k``, i.e. the energy the new branch returns as kinetic energy until its
+force zero crossing; ``E_d[k]`` and ``W_u[k]`` of a report are the energy dissipated and the
+input's work in the half-cycle that *ends* at reversal ``k``, one entry per reversal, so
+``report.E_d[k]`` and ``table.E_d[k]`` are the same half-cycle. ``E_d[k]`` for ``k >= 1`` is the
+paper's ``E_d(k - 1)`` in (2.10). The functions on bare arrays, :func:`dissipation` and
+:func:`series`, take the half-cycles between reversals (``E_d[1:]``).
 
 The functions live in private modules of :mod:`prefriction.analysis.energy`: reversals in
 samples ``sampled_reversals``, energies along samples ``sampled_energy``, the input's work

@@ -13,7 +13,7 @@ from prefriction.analysis.energy.lugre_report import LuGreEnergyReport, analyze_
 from prefriction.analysis.energy.report import EnergyReport, _rel_residual
 from prefriction.analysis.energy.sampled_energy import kinetic_energy
 from prefriction.analysis.energy.sampled_reversals import SampledReversals, find_reversals
-from prefriction.analysis.energy.work import input_work
+from prefriction.analysis.energy.work import input_work, split_integrals
 from prefriction.models import LuGre, Oscillator
 from prefriction.simulation.result import SimulationResult
 
@@ -144,14 +144,16 @@ def analyze_samples(
         dev = _rel_residual(check - E_p[: check.size], float(np.max(E_p))) if check.size else None
     else:
         check, label, dev = None, "peak kinetic energy (unforced only)", None
-    w_half = W[1:]
-    E_d = dissipation(E_p, input_work=w_half)
-    S, R = series(E_p, E_d)
+    E_d = np.concatenate(([E_0 + float(W[0]) - float(E_p[0])], dissipation(E_p, input_work=W[1:])))
+    S, R = series(E_p, E_d[1:])
+    # (2.10) against the friction force's own work int F dx = int F v dt per half-cycle ((2.5), (2.7))
+    W_F = split_integrals(t, (F * v)[None, :], rev, method)[0]
+    E_pot0 = E_0 - float(kinetic_energy(v[0], mass=mass))
+    E_d_F = np.concatenate(([E_pot0], E_p[:-1])) + W_F - E_p
     return EnergyReport(
         source="samples", t=rev.t, x=rev.x, F=rev.F, direction=rev.direction, E_p=E_p, E_d=E_d,
-        W_u=w_half, W_u_initial=float(W[0]), E_0=E_0, E_d_initial=E_0 + float(W[0]) - float(E_p[0]),
-        series_partial=S, series_remainder=R,
-        residual_2_10=_rel_residual(E_p[:-1] + w_half - E_d - E_p[1:], float(np.max(E_p))),
+        W_u=W, E_0=E_0, series_partial=S, series_remainder=R,
+        residual_2_10=_rel_residual(E_d - E_d_F, float(np.max(E_p))),
         E_p_check=check, E_p_check_label=label, E_p_check_max_rel_dev=dev,
         bound=bound_check(E_p, friction=friction, E_0=E_0),
     )

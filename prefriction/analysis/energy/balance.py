@@ -77,7 +77,7 @@ def branch_energy(F: Any, direction: Any, *, friction: FrictionModel) -> np.ndar
 def dissipation(E_p: Any, *, input_work: Any = None) -> np.ndarray:
     """Energy dissipated in each half-cycle between reversals [J] (2.10).
 
-    ``E_d[k] = E_p[k] - E_p[k + 1]`` (+ ``input_work[k]``, the work of an external force over
+    ``out[k] = E_p[k] - E_p[k + 1]`` (+ ``input_work[k]``, the work of an external force over
     the half-cycle, for forced motion).
 
     Parameters
@@ -97,7 +97,7 @@ def dissipation(E_p: Any, *, input_work: Any = None) -> np.ndarray:
     Returns
     -------
     numpy.ndarray
-        Length n - 1.
+        Length n - 1: the half-cycles between reversals (``report.E_d[1:]`` of an energy report).
     """
     E_p = value_array("E_p", E_p, nonnegative=True)
     E_p = np.atleast_1d(E_p)
@@ -123,7 +123,8 @@ def series(E_p: Any, E_d: Any) -> tuple[np.ndarray, np.ndarray]:
     E_p : array_like
         Potential energy at the reversals [J], length n >= 1, each finite and >= 0.
     E_d : array_like
-        Dissipation per half-cycle [J], length n - 1 (``E_d[k]`` from reversal k to k + 1),
+        Dissipation per half-cycle between reversals [J], length n - 1 (entry k from reversal k to
+        k + 1: ``report.E_d[1:]`` or ``table.E_d[1:]``),
         finite (negative under forcing, see the module notes).
 
     Returns

@@ -47,6 +47,17 @@ def first_bad(name: str, arr: np.ndarray, bad: np.ndarray, allowed: str) -> None
         raise ValueError(f"{name} must be {allowed} (every entry), got {where} = {float(arr[i])!r}")
 
 
+def finite_energy(what: str, E: np.ndarray, inputs: str) -> np.ndarray:
+    """``E`` [J] if every entry is finite; else ``ValueError`` naming the first overflow and its inputs."""
+    bad = ~np.isfinite(E)
+    if np.any(bad):
+        i = int(np.flatnonzero(bad.ravel())[0])
+        raise ValueError(
+            f"{what} overflows the double-precision range (|E| > 1.8e308 J) at entry {i}: {inputs} are too large; "
+            f"allowed: inputs whose energies stay below 1.8e308 J (rescale the units)")
+    return E
+
+
 def value_array(name: str, values: Any, *, nonnegative: bool = False, min_size: int = 1, ndim: int = 1) -> np.ndarray:
     """Return ``values`` as a finite float array of at most ``ndim`` dimensions (a number counts
     as length 1) with at least ``min_size`` entries, entries >= 0 if ``nonnegative``."""

@@ -18,8 +18,9 @@ from prefriction.models import LuGre, Oscillator
 class LuGreEnergyReport:
     """Energy balance of a sampled LuGre oscillator, split per half-cycle (docs/mathematics.md#lugre-energy).
 
-    Half-cycle ``k`` runs from reversal ``k`` to ``k + 1`` (length n - 1 arrays); the first
-    excursion runs from the first sample to reversal 1 (the ``*_initial`` scalars).
+    Entry ``k`` of each per-half-cycle array is the half-cycle that *ends* at reversal ``k``
+    (length n, as in :class:`prefriction.ReversalTable`); entry 0 is the first excursion, from
+    the first sample to reversal 1.
 
     Attributes
     ----------
@@ -35,17 +36,16 @@ class LuGreEnergyReport:
     W_u : numpy.ndarray
         Work of the input force ``int u v dt`` per half-cycle [J] (zeros unforced).
     E_d : numpy.ndarray
-        Energy lost per half-cycle from the reversal states, ``E_p[k] + W_u[k] - E_p[k+1]`` [J].
+        Energy lost per half-cycle from the reversal states, ``E_p[k-1] + W_u[k] - E_p[k]`` [J]
+        (``E_0 + W_u[0] - E_p[0]`` for the first excursion).
     D_sigma2, D_sigma1 : numpy.ndarray
         ``int sigma2 v^2 dt`` (>= 0) and ``int sigma1 z' v dt`` (either sign) per half-cycle [J].
     D_viscous : numpy.ndarray
         Viscous dissipation ``D_sigma2 + D_sigma1``, the work of the rate terms ``sigma1 z' + sigma2 v`` [J].
     D_hysteretic : numpy.ndarray
         Hysteretic dissipation ``int sigma0^2 |v| z^2 / g(v) dt >= 0`` per half-cycle [J].
-    W_u_initial, E_d_initial, D_viscous_initial, D_hysteretic_initial : float
-        The same for the first excursion [J] (``E_d_initial = E_0 + W_u_initial - E_p[0]``).
     residual : float
-        ``max |E_d - D_viscous - D_hysteretic|`` over the first excursion and every half-cycle,
+        ``max |E_d - D_viscous - D_hysteretic|`` over every half-cycle,
         relative to ``max(E_0, max E_p)``: how well the quadrature of the powers closes the
         balance (an estimate of the split's error).
     interpolated : int
@@ -68,10 +68,6 @@ class LuGreEnergyReport:
     D_sigma1: np.ndarray
     D_viscous: np.ndarray
     D_hysteretic: np.ndarray
-    W_u_initial: float
-    E_d_initial: float
-    D_viscous_initial: float
-    D_hysteretic_initial: float
     residual: float
     interpolated: int
     method: str
@@ -83,12 +79,12 @@ class LuGreEnergyReport:
     @property
     def total_viscous(self) -> float:
         """Viscous dissipation from the first sample to the last reversal [J]."""
-        return self.D_viscous_initial + float(np.sum(self.D_viscous))
+        return float(np.sum(self.D_viscous))
 
     @property
     def total_hysteretic(self) -> float:
         """Hysteretic dissipation from the first sample to the last reversal [J]."""
-        return self.D_hysteretic_initial + float(np.sum(self.D_hysteretic))
+        return float(np.sum(self.D_hysteretic))
 
     def __repr__(self) -> str:
         return (
@@ -104,10 +100,10 @@ class LuGreEnergyReport:
             f"LuGre energy balance: {len(self)} reversals in samples (quadrature {self.method}); "
             f"{self.interpolated} samples with an interpolated bristle deflection",
             f"E_0 = {self.E_0:.6e} J, E_p from {self.E_p[0]:.6e} J (reversal 1) to {self.E_p[-1]:.6e} J (reversal {len(self)}), "
-            f"input work {self.W_u_initial + float(np.sum(self.W_u)):.6e} J",
+            f"input work {float(np.sum(self.W_u)):.6e} J",
             f"dissipated up to the last reversal: viscous {self.total_viscous:.6e} J, "
             f"hysteretic {self.total_hysteretic:.6e} J ({100 * share:.2f} % of the loss)",
-            f"balance E_p(i) + W_u(i) - E_p(i+1) = D_viscous(i) + D_hysteretic(i): max relative residual {self.residual:.3e}",
+            f"balance E_p(i-1) + W_u(i) - E_p(i) = D_viscous(i) + D_hysteretic(i): max relative residual {self.residual:.3e}",
             self.bound.format().splitlines()[0],
         ])
 
@@ -116,15 +112,14 @@ class LuGreEnergyReport:
         head = (f"{'i':>5} {'t [s]':>12} {'F [N]':>12} {'E_p [J]':>11} {'E_d [J]':>11} "
                 f"{'viscous [J]':>11} {'hyster. [J]':>11} {'W_u [J]':>11}")
         n = len(self)
-        half = max(1, max_rows // 2)
-        idx = list(range(n)) if n <= max_rows else list(range(half)) + list(range(n - half, n))
-        lines = ["LuGre energy per half-cycle i (reversal i to i+1)", head, "-" * len(head)]
+        first, last = (max_rows + 1) // 2, max_rows // 2  # max_rows rows: the first and last halves
+        idx = list(range(n)) if n <= max_rows else list(range(first)) + list(range(n - last, n))
+        lines = ["LuGre energy per half-cycle i (ending at reversal i; i = 1 the first excursion)", head, "-" * len(head)]
         prev = -1
         for i in idx:
             if i != prev + 1:
                 lines.append(f"{'...':>5}")
-            cells = (f"{self.E_d[i]:>11.4e} {self.D_viscous[i]:>11.4e} {self.D_hysteretic[i]:>11.4e} {self.W_u[i]:>11.4e}"
-                     if i < n - 1 else f"{'-':>11} {'-':>11} {'-':>11} {'-':>11}")
+            cells = f"{self.E_d[i]:>11.4e} {self.D_viscous[i]:>11.4e} {self.D_hysteretic[i]:>11.4e} {self.W_u[i]:>11.4e}"
             lines.append(f"{i + 1:>5} {self.t[i]:>12.6g} {self.F[i]:>12.5g} {self.E_p[i]:>11.4e} {cells}")
             prev = i
         return "\n".join(lines + ["", self.summary()])
@@ -142,17 +137,13 @@ def analyze_lugre_samples(
     E_p = F_rev**2 / (2.0 * friction.sigma0)
     z0 = float(split["z"][0])
     E_0 = 0.5 * system.mass * float(v[0]) ** 2 + 0.5 * friction.sigma0 * z0 * z0
-    s2, s1, h = split["half"]
-    f2, f1, fh = (float(a) for a in split["first"])
-    fw, w = float(W[0]), W[1:]
-    E_d = E_p[:-1] + w - E_p[1:]
-    E_d_initial = E_0 + fw - float(E_p[0])
-    lost = np.concatenate(([E_d_initial - f2 - f1 - fh], E_d - s2 - s1 - h))
+    s2, s1, h = (np.concatenate(([first], half)) for first, half in zip(split["first"], split["half"]))
+    E_d = np.concatenate(([E_0], E_p[:-1])) + W - E_p
+    lost = E_d - s2 - s1 - h
     scale = max(E_0, float(np.max(E_p)))
     return LuGreEnergyReport(
-        t=rev.t, x=rev.x, F=F_rev, direction=rev.direction, E_p=E_p, E_0=E_0, W_u=w, E_d=E_d,
+        t=rev.t, x=rev.x, F=F_rev, direction=rev.direction, E_p=E_p, E_0=E_0, W_u=W, E_d=E_d,
         D_sigma2=s2, D_sigma1=s1, D_viscous=s2 + s1, D_hysteretic=h,
-        W_u_initial=fw, E_d_initial=E_d_initial, D_viscous_initial=f2 + f1, D_hysteretic_initial=fh,
         residual=float(np.max(np.abs(lost)) / scale) if scale > 0 else float(np.max(np.abs(lost))),
         interpolated=split["interpolated"], method=method, bound=lugre_bound(E_p, friction, E_0),
     )

@@ -27,26 +27,29 @@ class EnergyReport:
         Potential energy at each reversal [J]: the branch potential of the Dahl model,
         (3.9) for ``gamma = 1`` (samples), or the table's ``E_p``.
     E_d : numpy.ndarray
-        Energy dissipated in the half-cycle from reversal k to k + 1 [J], length n - 1,
-        (2.10): ``E_p[k] + W_u[k] - E_p[k+1]`` (samples; ``W_u`` the input's work, zero
-        unforced) or the table's ``E_d[1:]``. Under forcing a reversal can occur before the
-        force zero crossing; the Dahl branch potential then rises at the reversal and that
-        ``E_d`` is negative (the Dahl model has no dissipation rate ``D >= 0``, paper after (2.3)).
+        Energy dissipated in the half-cycle that *ends* at reversal k [J], length n, as in
+        :class:`prefriction.ReversalTable`: ``E_d[0]`` the first excursion from the initial
+        state (``E_0 + W_u[0] - E_p[0]``, may include gross sliding), ``E_d[k] = E_p[k-1] +
+        W_u[k] - E_p[k]`` (2.10) for ``k >= 1`` (samples; ``W_u`` the input's work, zero
+        unforced) or the table's ``E_d``. Under forcing a reversal can occur before the force
+        zero crossing; the Dahl branch potential then rises at the reversal and that ``E_d`` is
+        negative (the Dahl model has no dissipation rate ``D >= 0``, paper after (2.3)).
     W_u : numpy.ndarray
-        Work of the input force ``int u v dt`` in the half-cycle from reversal k to k + 1 [J],
-        length n - 1 (the applied force: an input signal, a controller's force; zeros unforced).
-    W_u_initial : float
-        Work of the input force in the first excursion, from the initial state to reversal 1 [J].
+        Work of the input force ``int u v dt`` in the half-cycle ending at reversal k [J],
+        length n, ``W_u[0]`` the first excursion (the applied force: an input signal, a
+        controller's force; zeros unforced).
     E_0 : float
         Energy of the initial state [J].
-    E_d_initial : float
-        Energy dissipated in the first excursion, from the initial state to the first
-        reversal [J] (may include gross sliding; not part of (2.10)-(2.12)).
     series_partial, series_remainder : numpy.ndarray
-        Truncated series (2.11), see :func:`series`.
+        Truncated series (2.11) of ``E_d[1:]``, see :func:`series`.
     residual_2_10 : float
-        ``max_k |E_p[k] - E_d[k] - E_p[k+1] + W_u[k]|`` relative to ``max(E_p)``: how well the
-        dissipation and potential energies agree with (2.10) (0 by construction for samples).
+        The check of (2.10) against an independent computation, relative to ``max(E_p)``.
+        Samples: ``max_k |E_d[k] - (E_p[k-1] + int F dx - E_p[k])|`` with ``int F dx`` the
+        friction force's work over half-cycle k by quadrature of the samples ((2.5), (2.7);
+        ``E_0`` less the kinetic energy for ``k = 0``): it fails when the input's work, the
+        forces or the reversals are wrong (e.g. a controller's force left out). Table:
+        ``max_k |E_p[k-1] + W_u[k] - E_d[k] - E_p[k]|``, the consistency of the table's columns
+        only (a table computes ``E_d`` from ``E_p``; its independent check is ``E_p_check``).
     E_p_check : numpy.ndarray or None
         Independent estimate of ``E_p``: the peak kinetic energy in each complete unforced
         half-cycle (samples, length n - 1, paper's note after (3.9)), or the branch potential
@@ -67,9 +70,7 @@ class EnergyReport:
     E_p: np.ndarray
     E_d: np.ndarray
     W_u: np.ndarray
-    W_u_initial: float
     E_0: float
-    E_d_initial: float
     series_partial: np.ndarray
     series_remainder: np.ndarray
     residual_2_10: float
@@ -102,27 +103,30 @@ class EnergyReport:
             f"{'E_d(i) [J]':>12} {'sum E_d(n>=i)':>13} {'E_p/bound':>10}"
         )
         n = len(self)
-        half = max_rows // 2
-        idx = list(range(n)) if n <= max_rows else list(range(half)) + list(range(n - half, n))
-        lines = [f"Energy at reversals ({self.source}); E_d(i): half-cycle from reversal i to i+1", head, "-" * len(head)]
+        first, last = (max_rows + 1) // 2, max_rows // 2  # max_rows rows: the first and last halves
+        idx = list(range(n)) if n <= max_rows else list(range(first)) + list(range(n - last, n))
+        lines = [f"Energy at reversals ({self.source}); E_d(i): half-cycle ending at reversal i", head, "-" * len(head)]
         prev = -1
         for i in idx:
             if i != prev + 1:
                 lines.append(f"{'...':>5}")
-            e_d = f"{self.E_d[i]:>12.5e}" if i < n - 1 else f"{'-':>12}"
+            e_d = f"{self.E_d[i]:>12.5e}"
             lines.append(
                 f"{i + 1:>5} {self.t[i]:>13.7g} {self.x[i]:>13.6g} {self.F[i]:>13.6g} {self.E_p[i]:>12.5e} "
                 f"{e_d} {self.series_partial[i]:>13.5e} {self.E_p[i] / self.bound.bound:>10.6f}"
             )
             prev = i
         lines.append("")
-        lines.append(f"first excursion (initial state to reversal 1) dissipated {self.E_d_initial:.6e} J")
-        if np.any(self.W_u != 0.0) or self.W_u_initial != 0.0:
-            lines.append(f"input work: {self.W_u_initial:.6e} J in the first excursion, "
-                         f"{float(np.sum(self.W_u)):.6e} J in the {self.W_u.size} half-cycles")
+        if n:
+            lines.append(f"first excursion (initial state to reversal 1) dissipated {self.E_d[0]:.6e} J")
+        if np.any(self.W_u != 0.0):
+            lines.append(f"input work: {self.W_u[0]:.6e} J in the first excursion, "
+                         f"{float(np.sum(self.W_u[1:])):.6e} J in the {self.W_u.size - 1} half-cycles")
         if n:
             lines.append(f"E_p strictly decreasing: {'yes' if self.E_p_decreasing else 'NO'}")
-            lines.append(f"(2.10) E_p(i) = E_d(i) + E_p(i+1): max relative residual {self.residual_2_10:.3e}")
+            check = "against int F dx of the samples" if self.source == "samples" else "of the table's columns"
+            lines.append(f"(2.10) E_d(i) = E_p(i-1) + W_u(i) - E_p(i), {check}: max relative residual "
+                         f"{self.residual_2_10:.3e}")
             lines.append(
                 f"(2.11) E_p(i) = sum E_d(n>=i) + remainder; over {max(n - 1, 0)} half-cycles the remainder is E_p(last) = "
                 f"{self.E_p[-1]:.4e} J = {self.E_p[-1] / self.E_p[0] if self.E_p[0] > 0 else 0.0:.3e} E_p(first)"

@@ -9,7 +9,7 @@ import numpy as np
 from scipy.integrate import cumulative_simpson, cumulative_trapezoid
 
 from prefriction.analysis.energy.balance import branch_energy
-from prefriction.analysis.energy.checks import check_method, check_samples, check_system, value_array
+from prefriction.analysis.energy.checks import check_method, check_samples, check_system, finite_energy, value_array
 from prefriction.analysis.energy.sampled_reversals import find_reversals
 from prefriction._validation import check_nonnegative, check_positive
 from prefriction.models import Oscillator
@@ -39,7 +39,9 @@ def kinetic_energy(v: Any, *, mass: float) -> np.ndarray:
     """
     m = check_positive("mass", mass)
     v = value_array("v", v)
-    return 0.5 * m * v * v
+    with np.errstate(over="ignore"):
+        E = 0.5 * m * v * v
+    return finite_energy("kinetic_energy", E, f"v (largest |v| = {float(np.max(np.abs(v))):.3g} m/s) and mass = {m:.3g} kg")
 
 
 def cumulative(t: np.ndarray, y: np.ndarray, method: str) -> np.ndarray:
@@ -79,9 +81,13 @@ def integrated_power(
     if not isinstance(reset_at_reversals, (bool, np.bool_)):
         raise TypeError(f"reset_at_reversals must be True or False, got {reset_at_reversals!r}")
     t, v, F = check_samples(t=t, v=v, F=F)
-    p = F * v
-    if not reset_at_reversals:
-        return cumulative(t, p, method)
+    with np.errstate(over="ignore", invalid="ignore"):
+        p = F * v
+        out = cumulative(t, p, method) if not reset_at_reversals else None
+    inputs = (f"t, v and F (largest |v| {float(np.max(np.abs(v))):.3g} m/s, |F| {float(np.max(np.abs(F))):.3g} N, "
+              f"span {float(t[-1] - t[0]):.3g} s)")
+    if out is not None:
+        return finite_energy("integrated_power", out, inputs)
     rev = find_reversals(t, v)
     out = np.empty_like(p)
     starts = np.concatenate(([0], rev.index + 1, [t.size]))
@@ -90,8 +96,9 @@ def integrated_power(
         if hi <= lo:
             continue
         base = 0.0 if k == 0 else 0.5 * p[lo] * (t[lo] - rev.t[k - 1])
-        out[lo:hi] = base + cumulative(t[lo:hi], p[lo:hi], method)
-    return out
+        with np.errstate(over="ignore", invalid="ignore"):
+            out[lo:hi] = base + cumulative(t[lo:hi], p[lo:hi], method)
+    return finite_energy("integrated_power", out, inputs)
 
 
 def work_integral(x: Any, F: Any) -> np.ndarray:
@@ -112,7 +119,10 @@ def work_integral(x: Any, F: Any) -> np.ndarray:
         ``int_{x[0]}^{x[j]} F dx`` along the path for every sample ``j`` [J].
     """
     x, F = check_samples(x=x, F=F)
-    return np.concatenate(([0.0], np.cumsum(0.5 * (F[1:] + F[:-1]) * np.diff(x))))
+    with np.errstate(over="ignore", invalid="ignore"):
+        E = np.concatenate(([0.0], np.cumsum(0.5 * (F[1:] + F[:-1]) * np.diff(x))))
+    return finite_energy("work_integral", E, f"x and F (largest |x| {float(np.max(np.abs(x))):.3g} m, "
+                                             f"|F| {float(np.max(np.abs(F))):.3g} N)")
 
 
 def loop_integral(x: Any, F: Any, *, closure_tol: float = 1e-6) -> float:
@@ -174,7 +184,7 @@ def _sample_directions(v: np.ndarray) -> np.ndarray:
     return sgn[nz[nxt]]
 
 
-def total_energy(t: Any, v: Any, F: Any, *, system: Oscillator) -> np.ndarray:
+def total_energy(t: Any, v: Any, F: Any, *, system: Oscillator, x: Any = None) -> np.ndarray:
     """Mechanical energy ``E_k + E_branch`` of a Dahl oscillator at every sample [J].
 
     ``E_branch`` is :func:`branch_energy` with the direction of motion (a sample with
@@ -182,6 +192,12 @@ def total_energy(t: Any, v: Any, F: Any, *, system: Oscillator) -> np.ndarray:
     along each branch and drops by the half-cycle dissipation ``E_d`` (2.10) at each
     reversal; right after reversal ``k`` it equals ``E_p[k]``. Its drift along a branch
     measures the energy error of a simulation.
+
+    In deep gross sliding the force rounds to ``s Fc``, where the stored energy of a model
+    with unbounded energy there (Dahl with ``gamma >= 1``) is no longer a function of the force.
+    Given the positions ``x``, such samples take the energy of the last sample of their branch
+    where it is, plus the work ``int F dx`` since (trapezoid rule; along a branch
+    ``d E_branch = F dx``, the definition of the branch energy (2.8)).
 
     Parameters
     ----------
@@ -193,6 +209,9 @@ def total_energy(t: Any, v: Any, F: Any, *, system: Oscillator) -> np.ndarray:
         Friction forces [N].
     system : Oscillator
         The oscillator (mass and Dahl friction model).
+    x : array_like, optional
+        Positions [m] at the samples (e.g. ``SimulationResult.x``): needed only where the force
+        has rounded to the saturation force.
 
     Returns
     -------
@@ -203,10 +222,29 @@ def total_energy(t: Any, v: Any, F: Any, *, system: Oscillator) -> np.ndarray:
     ------
     ValueError
         Invalid arrays, ``|F| > Fc``, ``v = 0`` at every sample (no direction), or a sample
-        with ``s F = Fc`` for a model whose stored energy is unbounded there (Dahl with
-        ``gamma >= 1``: deep gross sliding rounds the force to ``Fc``, and the energy is no
-        longer a function of the force; the message names the sample).
+        with ``s F = Fc`` for a model whose stored energy is unbounded there without ``x`` (or
+        on a branch that starts there); the message names the sample.
     """
     friction, mass = check_system(system)
-    t, v, F = check_samples(t=t, v=v, F=F)
-    return kinetic_energy(v, mass=mass) + branch_energy(F, _sample_directions(v), friction=friction)
+    if x is None:
+        t, v, F = check_samples(t=t, v=v, F=F)
+        return kinetic_energy(v, mass=mass) + branch_energy(F, _sample_directions(v), friction=friction)
+    t, v, F, x = check_samples(t=t, v=v, F=F, x=x)
+    s = _sample_directions(v)
+    unbounded = getattr(friction, "gamma", 0.0) >= 1.0  # Dahl: infinite stored energy at s F = Fc
+    good = np.abs(F) < friction.Fc * (1.0 - 1e-12) if unbounded else np.ones(F.size, bool)
+    E_b = np.zeros(F.size)
+    E_b[good] = branch_energy(F[good], s[good], friction=friction)
+    bad = np.flatnonzero(~good)
+    if bad.size:
+        work = np.concatenate(([0.0], np.cumsum(0.5 * (F[1:] + F[:-1]) * np.diff(x))))  # int F dx along the path
+        starts = np.concatenate(([0], np.flatnonzero(np.diff(s)) + 1))  # first sample of each branch
+        branch_start = starts[np.searchsorted(starts, np.arange(F.size), side="right") - 1]
+        last_good = np.maximum.accumulate(np.where(good, np.arange(F.size), -1))
+        anchor = last_good[bad]
+        if np.any(anchor < branch_start[bad]):
+            j = int(bad[np.flatnonzero(anchor < branch_start[bad])[0]])
+            raise ValueError(f"F[{j}] = {float(F[j])!r} N has rounded to the saturation force on a branch that starts "
+                             f"there: its stored energy cannot be computed from the samples (start the samples earlier)")
+        E_b[bad] = E_b[anchor] + work[bad] - work[anchor]
+    return kinetic_energy(v, mass=mass) + E_b

@@ -101,17 +101,16 @@ def analyze_table(
             )
         W = _work_per_reversal(work_input, n, required=False, system=system)
         E_p = np.asarray(table.E_p, dtype=float)
-        E_d = np.asarray(table.E_d, dtype=float)[1:]
-        E_0, E_d_initial = float(table.E_0), float(table.E_d[0])
+        E_d = np.asarray(table.E_d, dtype=float)
+        E_0 = float(table.E_0)
         check = branch_energy(F, direction, friction=friction)
         label = "branch potential of the tabulated F_i, (3.9) for gamma = 1"
     else:
         E_p, E_0, W = _undefined_table_energy(table, system, friction, direction, F0, work_input)
-        E_d = E_p[:-1] + W[1:] - E_p[1:]
-        E_d_initial = E_0 + float(W[0]) - float(E_p[0])
+        E_d = np.concatenate(([E_0 + float(W[0]) - float(E_p[0])], E_p[:-1] + W[1:] - E_p[1:]))
         check, label = None, "none: E_p is computed from the tabulated forces"
     top = float(np.max(E_p))
-    S, R = series(E_p, E_d)
+    S, R = series(E_p, E_d[1:])
     bound = lugre_bound(E_p, friction, E_0) if isinstance(friction, LuGre) else bound_check(E_p, friction=friction, E_0=E_0)
     return EnergyReport(
         source="reversal table",
@@ -121,13 +120,11 @@ def analyze_table(
         direction=direction,
         E_p=E_p,
         E_d=E_d,
-        W_u=W[1:],
-        W_u_initial=float(W[0]),
+        W_u=W,
         E_0=E_0,
-        E_d_initial=E_d_initial,
         series_partial=S,
         series_remainder=R,
-        residual_2_10=_rel_residual(E_p[:-1] - E_d - E_p[1:] + W[1:], top),
+        residual_2_10=_rel_residual(E_p[:-1] - E_d[1:] - E_p[1:] + W[1:], top),
         E_p_check=check,
         E_p_check_label=label,
         E_p_check_max_rel_dev=None if check is None else _rel_residual(check - E_p, top),

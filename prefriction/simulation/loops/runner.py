@@ -23,6 +23,7 @@ from prefriction.signals import Constant
 from prefriction.simulation.compiled import compiled, jit_available
 from prefriction.simulation.feedback import LinearFeedback, sample_count
 from prefriction.simulation.force_scale import applied_force_scale
+from prefriction.simulation.per_thread import PerThread
 from prefriction.simulation.plant import Layout, PlantSpec
 from prefriction.simulation.result import RunStats, SimulationResult
 from prefriction.simulation.simulate import _CAL, _reversal_table
@@ -37,7 +38,7 @@ BLOCK = 256
 """Sample periods per compiled call (a structure; the last block of a run is padded)."""
 _MIN_ORDER = 2  # controllers are padded to this order: P, PD and PID loops share one Function
 _K = 2  # the plant's register length, as in prefriction.simulate
-_CACHE: dict = {}
+_CACHE = PerThread()  # one Function per structure and process, its buffers per thread
 
 
 @dataclass(frozen=True)
@@ -79,26 +80,31 @@ class LoopStats:
                 f"{100 * self.compiled_time / max(self.wall_time, 1e-300):.0f} % in compiled code")
 
 
-class _Block:
-    """The compiled block Function of a structure with persistent argument and result buffers."""
+def _function(spec: LoopSpec, jit: bool) -> tuple[ca.Function, str, float]:
+    """The block Function of ``spec`` (compiled or loaded if ``jit``), its mode and setup time [s]."""
+    start = time.perf_counter()
+    LL = LoopLayout(spec)
+    mapped = loop_function(spec)
+    S0 = ca.MX.sym("S0", LL.nS)
+    W = ca.MX.sym("W", LL.nw, spec.block)
+    par = ca.MX.sym("par", LL.npar)
+    S, R = mapped(S0, W, ca.repmat(par, 1, spec.block))
+    fun = ca.Function(mapped.name(), [S0, W, par], [S[:, -1], R])
+    mode = "interpreted"
+    if jit:
+        what = (f"{spec.plant.model_key[2]}, sampled loop, controller of order {spec.n_c}, "
+                f"{spec.block} samples per call")
+        fun, info = compiled(fun, what)
+        mode = info.mode
+    return fun, mode, time.perf_counter() - start
 
-    def __init__(self, spec: LoopSpec, jit: bool) -> None:
-        start = time.perf_counter()
+
+class _Block:
+    """The block Function of a structure with this thread's argument and result buffers."""
+
+    def __init__(self, spec: LoopSpec, fun: ca.Function) -> None:
         self.LL = LL = LoopLayout(spec)
         self.comp_fun = spec.comp.function()
-        mapped = loop_function(spec)
-        S0 = ca.MX.sym("S0", LL.nS)
-        W = ca.MX.sym("W", LL.nw, spec.block)
-        par = ca.MX.sym("par", LL.npar)
-        S, R = mapped(S0, W, ca.repmat(par, 1, spec.block))
-        fun = ca.Function(mapped.name(), [S0, W, par], [S[:, -1], R])
-        self.mode = "interpreted"
-        if jit:
-            what = (f"{spec.plant.model_key[2]}, sampled loop, controller of order {spec.n_c}, "
-                    f"{spec.block} samples per call")
-            fun, info = compiled(fun, what)
-            self.mode = info.mode
-        self.fun = fun
         self.S0 = np.zeros(LL.nS)
         self.W = np.zeros((spec.block, LL.nw))  # row j = column j of CasADi's column-major W
         self.par = np.zeros(LL.npar)
@@ -109,19 +115,17 @@ class _Block:
             self.buf.set_arg(i, memoryview(arr.reshape(-1)))
         self.buf.set_res(0, memoryview(self.S))
         self.buf.set_res(1, memoryview(self.R.reshape(-1)))
-        self.setup_time = time.perf_counter() - start
 
 
 def _block(spec: LoopSpec, jit: bool) -> tuple[_Block, float, str]:
-    """The block Function of ``spec`` (built once per process and structure), setup time, mode."""
+    """The block Function of ``spec`` (built once per process and structure) with this thread's
+    buffers, the setup time and the mode."""
     jit = jit and jit_available()
-    key = (spec, jit)
-    if key in _CACHE:
-        blk = _CACHE[key]
-        return blk, 0.0, "interpreted" if blk.mode == "interpreted" else "cached"
-    blk = _Block(spec, jit)
-    _CACHE[key] = blk
-    return blk, blk.setup_time, blk.mode
+    blk, (_, mode, setup), built = _CACHE.get(
+        (spec, jit), lambda: _function(spec, jit), lambda made: _Block(spec, made[0]))
+    if built:
+        return blk, setup, mode
+    return blk, 0.0, "interpreted" if mode == "interpreted" else "cached"
 
 
 @dataclass(frozen=True)
