@@ -19,8 +19,6 @@ import pytest
 import prefriction
 
 ROOT = Path(__file__).resolve().parents[1]
-# both tests share one wheel: under ``--dist loadgroup`` (pyproject addopts) they run on one worker
-pytestmark = pytest.mark.xdist_group("wheel")
 
 
 @pytest.fixture(scope="module")
