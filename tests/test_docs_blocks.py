@@ -17,7 +17,9 @@ from pathlib import Path
 import pytest
 
 DOCS = Path(__file__).resolve().parents[1] / "docs"
-OWN_TESTS = {"along.md", "compensation.md", "symbolic.md", "optimal.md", "export.md", "identify_motion.md"}
+# identify.md: tests/test_identify_docs.py runs every python block and compares what it prints with the page
+OWN_TESTS = {"along.md", "compensation.md", "symbolic.md", "optimal.md", "export.md", "identify_motion.md",
+             "identify.md"}
 PAGES = sorted(p for p in DOCS.glob("*.md") if p.name not in OWN_TESTS)
 
 

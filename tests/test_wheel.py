@@ -8,6 +8,7 @@ figure scripts the ``prefriction paper`` command runs (installed as ``prefrictio
 from __future__ import annotations
 
 import os
+import shutil
 import subprocess
 import sys
 import zipfile
@@ -23,7 +24,12 @@ ROOT = Path(__file__).resolve().parents[1]
 @pytest.fixture(scope="module")
 def wheel(tmp_path_factory) -> tuple[Path, list[str], Path]:
     out = tmp_path_factory.mktemp("wheel")
-    built = subprocess.run([sys.executable, "-m", "pip", "wheel", str(ROOT), "--no-deps", "-q", "-w", str(out)],
+    # built from a copy of the sources: setuptools writes build/ into the tree it builds, and a
+    # build/ left by an interrupted or concurrent build (or `pip install .`) breaks every later one
+    src = tmp_path_factory.mktemp("src") / "prefriction"
+    shutil.copytree(ROOT, src, symlinks=True, ignore=shutil.ignore_patterns(
+        ".git", "build", "dist", "*.egg-info", "__pycache__", ".pytest_cache", ".hypothesis", "*.png"))
+    built = subprocess.run([sys.executable, "-m", "pip", "wheel", str(src), "--no-deps", "-q", "-w", str(out)],
                            capture_output=True, text=True, timeout=600)
     if built.returncode != 0:
         pytest.skip(f"the wheel could not be built here (build backend unavailable offline?): {built.stderr[-300:]}")
