@@ -187,6 +187,8 @@ class Run(StateIO, Rest):
             out = self._unpack(self.L, xf[:, 0], a, n0, nstop)
             if out["tmiss"] is not None:  # a reversal pair inside one step: integrate again up to
                 # the least speed after it, where s v < 0 at the end of the last step
+                if not out["tmiss"] > self.st["t"] and self._rest_at_noise_level():
+                    continue  # inside the first step: noise of a mass at equilibrium (a hold)
                 t1 = self._retry_to(out["tmiss"])
                 xf, a = self._call(self.f1, self.L, [t1], nstop)
                 out = self._unpack(self.L, xf[:, 0], a, n0, nstop)
