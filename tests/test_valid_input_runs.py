@@ -16,6 +16,7 @@
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -208,3 +209,28 @@ def test_presliding_experiment_with_dense_samples_runs_through_the_hold() -> Non
     res = pf.simulate(stage, 0.0, t_end=t_end, dense=t, rtol=1e-11)
     ref = _lugre_forced_reference(lambda tt: float(np.interp(tt, *samples)), t[::50], t_end)
     assert np.max(np.abs(res.x[::50] - ref)) <= 1e-8 * np.max(np.abs(ref))
+
+
+# --- messages that numpy/Python passed through without the argument's name ------------------------
+
+
+@pytest.mark.parametrize("kw", [{"free": 3}, {"fixed": 3}, {"free": [1, 2]}])
+def test_fit_free_and_fixed_of_the_wrong_type_are_named(kw: dict) -> None:
+    from prefriction import identify
+
+    t = np.linspace(0.0, 1.0, 50)
+    x = 1e-4 * np.sin(2 * np.pi * t)
+    data = identify.ForceDisplacement(t, x, np.tanh(1e4 * x))
+    (arg, value), = kw.items()
+    with pytest.raises(TypeError, match=rf"{arg} must be None, a parameter name or a sequence of names .* got "
+                                        rf"{re.escape(repr(value))}"):  # was: 'int' object is not iterable
+        identify.fit(pf.Dahl(1e4, 1.0), data, **kw)
+
+
+@pytest.mark.parametrize("name, value", [("sigma", -1e4), ("Fc", float("nan"))])
+def test_a_model_with_a_bad_unit_number_is_named_before_the_run(name: str, value: float) -> None:
+    model = pf.Dahl(1e4, 1.0)
+    object.__setattr__(model, name, value)  # as a user model that does not check its numbers
+    with pytest.raises(ValueError, match=rf"friction model's {name} must be a finite number > 0 .* got "
+                                         rf"{re.escape(repr(value))}"):  # was: math domain error
+        pf.simulate(pf.Oscillator(model), 1.0, reversals=2)
