@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Optional
 
 import casadi as ca
 import numpy as np
@@ -27,6 +27,8 @@ MAX_CHECK_REVERSALS = 100_000
 """Most reversals of :func:`reference_reversals` and :func:`check_model` (one scipy run per
 reversal: about a minute at the limit)."""
 _METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
+_DIED_OUT = 1e-9  # reversal force (relative to the largest) below which a motion has died out
+_MAX_T_END = 1e12  # normalised t_end of the checks (a cycle is about 2 pi units)
 _MAX_SPEED = 1e150  # |v0| in normalised units: initial energy far inside double precision
 
 
@@ -129,7 +131,7 @@ def _contract(model: FrictionModel, rng: np.random.Generator) -> None:
 
 
 def reference_reversals(model: FrictionModel, v0: float, n: int, *, rtol: float = 1e-12,
-                        method: str = "DOP853") -> tuple[np.ndarray, np.ndarray]:
+                        method: str = "DOP853", t_end: Optional[float] = None) -> tuple[np.ndarray, np.ndarray]:
     """Reversals ``(t~, x~, F~)`` rows and the branch-energy work check of the unforced
     oscillator (unit mass) in normalised units, by scipy ``solve_ivp`` (``method``, default
     DOP853; Radau for stiff models) restarted at every reversal and every model event.
@@ -146,17 +148,33 @@ def reference_reversals(model: FrictionModel, v0: float, n: int, *, rtol: float 
         Relative tolerance of ``solve_ivp``, in ``[1e-13, 1e-2]`` (``atol = rtol / 100``).
     method : str, default "DOP853"
         A ``solve_ivp`` method: ``"RK45"``, ``"RK23"``, ``"DOP853"``, ``"Radau"``, ``"BDF"`` or ``"LSODA"``.
+    t_end : float, optional
+        Normalised end time (unit ``sqrt(m / sigma)``), ``0 < t_end <= 1e12``: stop there if
+        fewer than ``n`` reversals came (a motion that dies out). Without it a run that finds no
+        next reversal within 1e4 time units raises ``RuntimeError``.
 
     Returns
     -------
     (numpy.ndarray, numpy.ndarray)
-        Reversal rows ``(t, x, F)`` (shape ``(k, 3)``) and, per reversal, ``-int F dx`` from the
-        reversal to the next zero crossing of ``F`` (NaN where the run ended before it).
+        Reversal rows ``(t, x, F)`` (shape ``(k, 3)``, ``k <= n``; ``k = n`` without ``t_end``)
+        and, per reversal, ``-int F dx`` from the reversal to the next zero crossing of ``F``
+        (NaN where the run ended before it).
     """
+    return _reference(model, v0, n, rtol=rtol, method=method, t_end=t_end)[:2]
+
+
+def _reference(model: FrictionModel, v0: float, n: int, *, rtol: float, method: str,
+               t_end: Optional[float]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`reference_reversals` and the state ``(x, v)`` where it stopped (normalised)."""
     v0 = _check_model_and_speed(model, v0)
     n = check_count("n", n, minimum=1, maximum=MAX_CHECK_REVERSALS, why="one scipy run per reversal")
     rtol = check_interval("rtol", rtol, 1e-13, 1e-2)
     method = check_choice("method", method, _METHODS)
+    if t_end is not None:
+        t_end = check_positive("t_end", t_end)
+        if t_end > _MAX_T_END:
+            raise ValueError(f"t_end must be a normalised time <= {_MAX_T_END:g} (about {_MAX_T_END / 6.3:.1g} "
+                             f"cycles of scipy reference), got {t_end!r}")
     q = model.runtime_params().tolist()
     nz = model.n_states
     s = 1.0 if v0 > 0 else -1.0
@@ -186,9 +204,15 @@ def reference_reversals(model: FrictionModel, v0: float, n: int, *, rtol: float 
                 return model.events(y[2:2 + nz].tolist(), mm, y[1], s, q)[k]
             ev.terminal, ev.direction = True, -1.0
             evs.append(ev)
-        sol = solve_ivp(rhs, (t, t + 1e4), y, method=method, rtol=rtol, atol=rtol * 1e-2, events=evs)
+        stop = t + 1e4 if t_end is None else t_end
+        sol = solve_ivp(rhs, (t, stop), y, method=method, rtol=rtol, atol=rtol * 1e-2, events=evs)
+        if sol.status == 0 and t_end is not None:  # reached t_end before the next event
+            if pending and len(sol.t_events[1]):
+                works[-1] = float(sol.y_events[1][0][-1])
+            return np.array(rows).reshape(-1, 3), np.array(works), sol.y[:2, -1].copy()
         if sol.status != 1:
-            raise RuntimeError(f"reference integration did not reach an event: {sol.message}")
+            raise RuntimeError(f"reference integration did not reach an event: {sol.message}; give t_end "
+                               f"if the motion dies out")
         if pending and len(sol.t_events[1]):
             works[-1] = float(sol.y_events[1][0][-1])
             pending = False
@@ -206,11 +230,11 @@ def reference_reversals(model: FrictionModel, v0: float, n: int, *, rtol: float 
         else:  # a model event
             z, m = model.on_event(i - 2, zz, m, s, q)
         y[2:2 + nz] = [float(v) for v in z]
-    return np.array(rows), np.array(works)
+    return np.array(rows), np.array(works), y[:2].copy()
 
 
 def check_model(model: FrictionModel, *, v0: float = 1.5, reversals: int = 12, rtol: float = 1e-8,
-                tol_factor: float = 20.0, seed: int = 0) -> ModelCheck:
+                tol_factor: float = 20.0, seed: int = 0, t_end: Optional[float] = None) -> ModelCheck:
     """Hold ``model`` to the protocol and the generic invariants; ``AssertionError`` if it fails.
 
     1. The symbolic functions (from a symbolic ``q``; ``force``, ``rate``, ``events``,
@@ -239,6 +263,11 @@ def check_model(model: FrictionModel, *, v0: float = 1.5, reversals: int = 12, r
         Allowed error in units of ``rtol``, finite and > 0.
     seed : int, default 0
         Seed of the random states of the contract check, ``>= 0``.
+    t_end : float, optional
+        Normalised end time (unit ``sqrt(m / sigma)``), ``0 < t_end <= 1e12``: the runs stop
+        there or at ``reversals``, whichever comes first, so a model whose motion dies out
+        (e.g. an overdamped LuGre) is checked on the reversals before ``t_end`` and on the
+        position and velocity at ``t_end``. Without it the motion must reach ``reversals``.
 
     Raises
     ------
@@ -264,15 +293,19 @@ def check_model(model: FrictionModel, *, v0: float = 1.5, reversals: int = 12, r
     _contract(model, np.random.default_rng(seed))
     system = Oscillator(model, mass=1.0)
     sc = Scales.of(system)
-    ref, works = reference_reversals(model, v0, reversals)
-    sim = simulate(system, v0 * sc.v, reversals=reversals, rtol=rtol)
+    ref, works, end = _reference(model, v0, reversals, rtol=1e-12, method="DOP853", t_end=t_end)
+    if t_end is None:
+        _check_not_died_out(ref)
+    if len(ref) == reversals:
+        sim = simulate(system, v0 * sc.v, reversals=reversals, rtol=rtol)
+    else:  # stopped at t_end: the state there too (one dense sample)
+        sim = simulate(system, v0 * sc.v, t_end=t_end * sc.t, rtol=rtol, dense=[t_end * sc.t])
     tab = sim.reversals
     assert len(tab.t) == len(ref), f"simulate found {len(tab.t)} reversals, the reference {len(ref)}"
-    got = np.column_stack([tab.t / sc.t, tab.x / sc.x, tab.F / sc.F])
-    size = np.maximum(np.max(np.abs(ref), axis=0), 1e-300)
-    scale = np.maximum(np.abs(ref), size * 1e-3)
-    scale[:, 1] = size[1]  # positions relative to the largest excursion (a reversal may be near x = 0)
-    err = float(np.max(np.abs(got - ref) / scale))
+    err = _reversal_error(tab, ref, sc)
+    if len(ref) < reversals:  # relative to the initial speed and the final position
+        got_end = np.array([sim.x[-1] / sc.x, sim.v[-1] / sc.v])
+        err = max(err, float(np.max(np.abs(got_end - end)) / max(abs(v0), abs(float(end[0])))))
     assert err <= tol_factor * rtol, f"reversals differ from the reference by {err:.3g} (> {tol_factor} rtol)"
     energy_err = 0.0
     if model.rate_independent:
@@ -285,3 +318,30 @@ def check_model(model: FrictionModel, *, v0: float = 1.5, reversals: int = 12, r
         bound = 0.5 * model.Fc ** 2 / model.k_min / (sc.E)
         assert np.all(E_p[1:] <= bound * (1 + 1e-9)), "bound (2.12) violated after the first reversal"
     return ModelCheck(len(ref), err, energy_err)
+
+
+def _check_not_died_out(ref: np.ndarray) -> None:
+    """``ValueError`` if the reference's motion died out before its last reversal: reversals at
+    forces below :data:`_DIED_OUT` of the largest are round-off, not a motion to compare."""
+    F = np.abs(ref[:, 2])
+    dead = np.flatnonzero(F <= _DIED_OUT * np.max(F))
+    if dead.size:
+        k = int(dead[0])
+        raise ValueError(
+            f"the motion dies out: after {k} reversals the reference reverses at a force of "
+            f"{F[k]:.3g} Fc (t = {ref[k, 0]:.6g} time units), round-off of a mass at rest, so the "
+            f"requested reversals cannot be compared; give t_end (e.g. t_end={0.5 * ref[k, 0]:.3g}) "
+            f"or ask for at most {k} reversals"
+        )
+
+
+def _reversal_error(tab: Any, ref: np.ndarray, sc: Any) -> float:
+    """Largest relative error of the simulated reversals ``tab`` (SI) against the normalised
+    reference rows ``ref`` (times and forces relative to each row, positions to the largest)."""
+    if len(ref) == 0:
+        return 0.0
+    got = np.column_stack([tab.t / sc.t, tab.x / sc.x, tab.F / sc.F])
+    size = np.maximum(np.max(np.abs(ref), axis=0), 1e-300)
+    scale = np.maximum(np.abs(ref), size * 1e-3)
+    scale[:, 1] = size[1]  # positions relative to the largest excursion (a reversal may be near x = 0)
+    return float(np.max(np.abs(got - ref) / scale))

@@ -11,6 +11,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 from prefriction._validation import check_positive
 from prefriction.models import Oscillator
 
@@ -62,6 +64,10 @@ class Scales:
         if not isinstance(system, Oscillator):
             raise TypeError(f"system must be a prefriction.Oscillator, got {system!r} of type {type(system).__name__}")
         sigma, Fc, m = system.friction.sigma, system.friction.Fc, system.mass
+        for name, value in (("sigma", sigma), ("Fc", Fc)):  # a user model's numbers are unchecked
+            if not (isinstance(value, (int, float, np.floating, np.integer)) and 0.0 < value < math.inf):
+                raise ValueError(f"the friction model's {name} must be a finite number > 0 (the {name} of "
+                                 f"{type(system.friction).__name__} sets the normalised units), got {value!r}")
         with_units = {
             "x": Fc / sigma,
             "F": Fc,

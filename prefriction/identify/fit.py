@@ -9,7 +9,7 @@ import numpy as np
 
 from prefriction._validation import check_bool, check_count, check_positive
 from prefriction.identify.data import ForceDisplacement, ForceVelocity, Motion
-from prefriction.identify.parameters import ParameterSpace
+from prefriction.identify.parameters import ParameterSpace, name_list
 from prefriction.identify.result import FitResult
 from prefriction.identify.validation import model_name
 from prefriction.identify.statistics import (BoundWarning, ConvergenceWarning, IdentifiabilityWarning, at_bounds,
@@ -149,6 +149,7 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
     if not isinstance(data, (ForceDisplacement, Motion, ForceVelocity)):
         raise TypeError(f"data must be prefriction.identify.ForceDisplacement, Motion or ForceVelocity, got "
                         f"{type(data).__name__}")
+    free, fixed = name_list("free", free), name_list("fixed", fixed)
     if substeps is not None:
         substeps = check_count("substeps", substeps, 1)
         if substeps > 64:

@@ -257,6 +257,23 @@ def _build(model: FrictionModel, entries: list[_Entry], values: dict[str, float]
     return dataclasses.replace(model, **kwargs)
 
 
+def name_list(arg: str, value: Any) -> list[str] | None:
+    """``value`` of the option ``arg`` (``free`` or ``fixed``) as a list of names: ``None``, one
+    name or a sequence of names; ``TypeError`` naming ``arg`` for anything else."""
+    if value is None:
+        return None
+    if isinstance(value, str):
+        return [value]
+    try:
+        out = list(value)
+    except TypeError:
+        out = None
+    if out is None or not all(isinstance(n, str) for n in out):
+        raise TypeError(f"{arg} must be None, a parameter name or a sequence of names (e.g. {arg}=['sigma', 'Fc']), "
+                        f"got {value!r} of type {type(value).__name__}")
+    return out
+
+
 def _names(arg: str, value: Any, names: list[str], model: FrictionModel) -> list[str] | None:
     if value is None:
         return None

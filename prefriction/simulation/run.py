@@ -25,6 +25,7 @@ from prefriction.units import Scales
 
 N_DENSE = 16  # output times per call of the dense-output integrator
 _DIED_OUT = 1e-20  # normalised speed below which an unforced motion has died out (no reversal comes)
+_MIN_CALL = 1e-9  # relative length of a call below which a failed call is not made shorter (Run._shorten)
 
 
 class Run(StateIO, Rest):
@@ -51,6 +52,7 @@ class Run(StateIO, Rest):
         self.f1, self.setup_time, self.mode = integrator(spec, jit)
         self.calls = 0
         self.steps: Optional[int] = 0
+        self.max_chunk = math.inf  # longest next call of advance (finite after a failed call)
         self.rev = ReversalLog()  # (t~, x~, F~, W~) per reversal
         self.rev_events: list[int] = []  # model events of the half-cycle ending at each reversal
         self.st: dict = {}  # current state, normalised (set by simulate)
@@ -168,17 +170,25 @@ class Run(StateIO, Rest):
             else:  # about one small cycle (shorter at high speed: F rises over a distance ~1),
                 # doubled while no reversal comes (gross sliding)
                 chunk = 2.0 * math.pi / max(1.0, abs(self.st["v"]))
-            chunk *= grow
+            chunk = min(chunk * grow, self.max_chunk)
             t1 = min(t_target, self.st["t"] + chunk)
             t1 = min(t1, self._next_break(self.st["t"]))
             # the first call stops at the first reversal: the amplitude scales of the first
             # excursion (possibly gross sliding) do not fit the pre-sliding cycles after it
             nstop = min(len(self.rev) + (self.spec.K if self.rev else 1), n_target)
             n0 = len(self.rev)
-            xf, a = self._call(self.f1, self.L, [t1], nstop)
+            try:
+                xf, a = self._call(self.f1, self.L, [t1], nstop)
+            except SolverError:
+                if not self._shorten(t1 - self.st["t"]):
+                    raise
+                continue
+            self.max_chunk *= 2.0
             out = self._unpack(self.L, xf[:, 0], a, n0, nstop)
             if out["tmiss"] is not None:  # a reversal pair inside one step: integrate again up to
                 # the least speed after it, where s v < 0 at the end of the last step
+                if not out["tmiss"] > self.st["t"] and self._rest_at_noise_level():
+                    continue  # inside the first step: noise of a mass at equilibrium (a hold)
                 t1 = self._retry_to(out["tmiss"])
                 xf, a = self._call(self.f1, self.L, [t1], nstop)
                 out = self._unpack(self.L, xf[:, 0], a, n0, nstop)
@@ -189,6 +199,22 @@ class Run(StateIO, Rest):
                                         f"was not resolved by a second pass")
             self._accept(out, t1)
             grow = 1.0 if out["frozen"] or len(self.rev) > n0 else 2.0 * grow
+
+    def _shorten(self, length: float) -> bool:
+        """Limit the next calls of :meth:`advance` to 1/8 of the normalised ``length`` of a call
+        that failed; False if that call was already shorter than :data:`_MIN_CALL` (the failure
+        is then not the call's length).
+
+        A call longer than the integrator's step budget (``max_num_steps``) fails: e.g. a
+        growing motion of a rate-dependent model (LuGre: a bristle time constant ~ 1/|v|) over
+        a call sized by the last, slower half-cycles. The state is that of the call's start,
+        so the same interval is integrated again in shorter calls; the length recovers by
+        doubling after each call that succeeds.
+        """
+        if not length > _MIN_CALL * max(1.0, abs(self.st["t"])):
+            return False
+        self.max_chunk = 0.125 * length
+        return True
 
     def _retry_to(self, t_miss: float) -> float:
         """End of the second pass over a call that skipped a reversal pair: ``t_miss`` (the least

@@ -51,8 +51,8 @@ from prefriction.reversals import ReversalTable
 from prefriction.simulation.result import RunStats, SimulationResult
 from prefriction.units import Scales
 
-__all__ = ["MAX_AMPLITUDE", "MAX_PERIODS", "MAX_REVERSALS", "METHODS", "MIN_AMPLITUDE", "RunStats", "SimulationResult",
-           "simulate"]
+__all__ = ["MAX_AMPLITUDE", "MAX_PERIODS", "MAX_REVERSALS", "METHODS", "MIN_AMPLITUDE", "RAMP_ROUNDOFF", "RunStats",
+           "SimulationResult", "simulate"]
 
 METHODS = ("erk",)
 """Integrator plugins exposed by :func:`simulate` (each tested on the whole case set)."""
@@ -70,6 +70,10 @@ MAX_REVERSALS = 10**7
 """Most reversals of one :func:`simulate` call, requested or reached by ``t_end`` (the run holds
 its table in memory: about 100 bytes per reversal at the peak, so about 1 GB;
 ``docs/simulator.md#limits``)."""
+RAMP_ROUNDOFF = 0.3
+"""Largest force error from the round-off of the time in a ramp of the input force, in units of
+the run's error level ``eps`` times the force scale (:func:`simulate` refuses steeper ramps:
+they started spurious reversal pairs at a rest, or NaN in CasADi's event transition)."""
 MAX_PERIODS = 10**7
 """Most sample periods ``t_end / Ts`` of a sampled controller (one Python step and one sample each)."""
 _CAL = 0.1  # calibration of the run-time tolerance eps: global error over 50 reversals ~ 0.7 rtol
@@ -231,9 +235,9 @@ def simulate(
         breaks.append(np.asarray(system.u.breaks()) / sc.t)
     if fb_kind == "continuous":
         breaks.append(np.asarray(feedback.reference.breaks()) / sc.t)
-    run.breaks = np.unique(np.concatenate(breaks)) if breaks else np.zeros(0)
-    run.breaks = run.breaks[run.breaks > 0]
     t_end_n = t_end_si / sc.t
+    run.breaks = _sample_times(np.unique(np.concatenate(breaks)) if breaks else np.zeros(0))
+    _check_ramps(run, t_end_n, rtol)
 
     start = time.perf_counter()
     u_hist: list = []
@@ -286,6 +290,45 @@ def _check_amplitude(v0: float, F0: float, force_scale: float, sc: Scales) -> No
             f"hypot(v0 / (Fc/sqrt(m sigma)), F0 / Fc) must be 0 or >= {MIN_AMPLITUDE:g}, that is "
             f"|v0| >= {MIN_AMPLITUDE * sc.v:.3g} m/s or |F0| >= {MIN_AMPLITUDE * sc.F:.3g} N"
         )
+
+
+def _sample_times(breaks: np.ndarray) -> np.ndarray:
+    """The sample times after 0 (normalised) at which the run is broken: ``breaks`` without
+    repeats to round-off (the input's and the reference's own copies of one time)."""
+    b = breaks[breaks > 0]
+    keep = np.ones(b.size, dtype=bool)
+    keep[1:] = np.diff(b) > 1e-12 * np.maximum(1.0, b[1:])
+    return b[keep]
+
+
+def _check_ramps(run: Run, t_end: float, rtol: float) -> None:
+    """ValueError if a piece of a piecewise-linear input force is so steep that the round-off of
+    its time makes a force error above :data:`RAMP_ROUNDOFF` of the run's error level.
+
+    The plant evaluates a piece as ``a + b (t - t_k)`` from the normalised time ``t``, which
+    carries a round-off of about ``2^-53 t``; a slope ``b`` turns it into a force error
+    ``2^-53 |b| t``. Near a rest the net force is compared with the error level ``eps`` times the
+    force scale (:data:`prefriction.simulation.plant.EPS_REST`): a larger error started the mass
+    backwards (a spurious reversal pair), or made CasADi's event transition return NaN.
+    """
+    sig, sc = run.spec.u_sig, run.sc
+    if sig is None or sig.key != ("PiecewiseLinear",):
+        return
+    level = run.eps * max(run.force_scale, 1e-300)  # error level of the net force (normalised)
+    t = np.concatenate(([0.0], run.breaks[run.breaks < t_end], [t_end]))
+    for ta, tb in zip(t[:-1], t[1:]):
+        slope = float(sig.piece(ta * sc.t, tb * sc.t)[2]) * sc.t / sc.F  # normalised
+        err = abs(slope) * tb * 2.0 ** -53
+        if err > RAMP_ROUNDOFF * level:
+            rise = abs(slope) * (tb - ta) * sc.F
+            shortest = rise / sc.F * tb * 2.0 ** -53 / (RAMP_ROUNDOFF * level) * sc.t
+            raise ValueError(
+                f"system.u ramps by {rise:.3g} N over {(tb - ta) * sc.t:.3g} s (from t = {ta * sc.t:.12g} s): at rtol = "
+                f"{rtol:g} that is too steep to simulate, because the round-off of the time there (2^-53 t) makes a "
+                f"force error of {err * sc.F:.3g} N, more than RAMP_ROUNDOFF = {RAMP_ROUNDOFF:g} times the error "
+                f"level of the net force ({level * sc.F:.3g} N) at which a resting mass starts to move. Spread the "
+                f"ramp over at least {shortest:.3g} s, loosen rtol, or drop one of its two samples (a jump)"
+            )
 
 
 def _dense_times(dense: Any, t_end: float) -> np.ndarray:
