@@ -2,26 +2,19 @@
 
 from __future__ import annotations
 
-import contextlib
-import io
-import re
-from pathlib import Path
-
 import pytest
+from _doc_blocks import page_blocks, run_block
 
-PAGE = (Path(__file__).resolve().parent.parent / "docs" / "along.md").read_text()
-BLOCKS = re.findall(r"```(\w*)\n(.*?)```", PAGE, flags=re.S)
+BLOCKS = page_blocks("docs/along.md")
 PYTHON = [i for i, (lang, _body) in enumerate(BLOCKS) if lang == "python"]
 
 
 @pytest.mark.parametrize("i", PYTHON)
 def test_block_prints_what_the_page_shows(i, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    out = io.StringIO()
-    with contextlib.redirect_stdout(out):
-        exec(compile(BLOCKS[i][1], f"docs/along.md block {i}", "exec"), {})
+    printed = run_block(BLOCKS[i][1], f"docs/along.md block {i}")
     lang, shown = BLOCKS[i + 1]
-    assert lang == "" and out.getvalue() == shown
+    assert lang == "" and printed == shown
 
 
 def test_page_has_the_blocks():

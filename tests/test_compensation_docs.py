@@ -2,23 +2,15 @@
 
 from __future__ import annotations
 
-import contextlib
-import io
-import re
-from pathlib import Path
-
 import pytest
+from _doc_blocks import page_blocks, run_block
 
-PAGE = (Path(__file__).resolve().parent.parent / "docs" / "compensation.md").read_text()
-BLOCKS = re.findall(r"```(\w*)\n(.*?)```", PAGE, flags=re.S)
+BLOCKS = page_blocks("docs/compensation.md")
 PYTHON = [body for lang, body in BLOCKS if lang == "python"]
 
 
 def _run(code: str) -> str:
-    out = io.StringIO()
-    with contextlib.redirect_stdout(out):
-        exec(compile(code, "docs/compensation.md", "exec"), {})
-    return out.getvalue()
+    return run_block(code, "docs/compensation.md")
 
 
 def test_page_has_python_blocks():

@@ -15,8 +15,9 @@ import textwrap
 from pathlib import Path
 
 import pytest
+from _doc_blocks import ROOT, run_block
 
-DOCS = Path(__file__).resolve().parents[1] / "docs"
+DOCS = ROOT / "docs"
 # identify.md: tests/test_identify_docs.py runs every python block and compares what it prints with the page
 OWN_TESTS = {"along.md", "compensation.md", "symbolic.md", "optimal.md", "export.md", "identify_motion.md",
              "identify.md"}
@@ -34,8 +35,8 @@ def test_python_blocks_run(page: Path, tmp_path, monkeypatch) -> None:
     ns: dict = {}
     for i, code in enumerate(_blocks(page)):
         before = set(ns)
+        run_block(code, f"{page.name} python block {i + 1}", ns)
         with contextlib.redirect_stdout(io.StringIO()):
-            exec(compile(code, f"{page.name} python block {i + 1}", "exec"), ns)
             for name in sorted(set(ns) - before):
                 if name.startswith("test_") and callable(ns[name]):
                     for kwargs in _parameter_sets(ns[name]):

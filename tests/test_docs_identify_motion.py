@@ -2,13 +2,12 @@
 
 from __future__ import annotations
 
-import contextlib
-import io
 import re
 import warnings
-from pathlib import Path
 
-PAGE = (Path(__file__).resolve().parent.parent / "docs" / "identify_motion.md").read_text()
+from _doc_blocks import ROOT, run_block
+
+PAGE = (ROOT / "docs" / "identify_motion.md").read_text()
 
 
 def _shown(after: str) -> list[str]:
@@ -25,11 +24,9 @@ def test_every_python_block_runs_and_prints_what_the_page_shows():
     blocks = list(re.finditer(r"```python\n(.*?)```", PAGE, flags=re.S))
     assert len(blocks) == 5
     for b in blocks:
-        out = io.StringIO()
-        with contextlib.redirect_stdout(out), warnings.catch_warnings():
+        with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            exec(compile(b.group(1), "identify_motion.md", "exec"), namespace)
-        printed = out.getvalue().strip().splitlines()
+            printed = run_block(b.group(1), "identify_motion.md", namespace).strip().splitlines()
         shown = _shown(PAGE[b.end():])
         assert shown, "every block says what it prints"
         if len(shown) == 1 and len(printed) == 1:

@@ -3,13 +3,11 @@ the docstring examples of prefriction.symbolic, prefriction.optimal and ZeroOrde
 
 from __future__ import annotations
 
-import contextlib
 import doctest
-import io
 import re
-from pathlib import Path
 
 import pytest
+from _doc_blocks import page_blocks, run_block
 
 import prefriction.optimal.problem
 import prefriction.optimal.references
@@ -17,12 +15,9 @@ import prefriction.signals.hold
 import prefriction.symbolic.branch
 import prefriction.symbolic.plant
 
-DOCS = Path(__file__).resolve().parent.parent / "docs"
-
-
 def _blocks(page: str) -> list[tuple[str, str]]:
     """(code, shown output) of each python block followed by an output block."""
-    blocks = re.findall(r"```(\w*)\n(.*?)```", (DOCS / page).read_text(), flags=re.S)
+    blocks = page_blocks(f"docs/{page}")
     return [(body, blocks[i + 1][1]) for i, (lang, body) in enumerate(blocks)
             if lang == "python" and i + 1 < len(blocks) and blocks[i + 1][0] == ""]
 
@@ -38,10 +33,7 @@ CASES = [(page, k, code, shown) for page in ("symbolic.md", "optimal.md")
 
 @pytest.mark.parametrize(("page", "k", "code", "shown"), CASES, ids=[f"{p}-{k}" for p, k, _, _ in CASES])
 def test_doc_block_prints_what_the_page_shows(page, k, code, shown):
-    out = io.StringIO()
-    with contextlib.redirect_stdout(out):
-        exec(compile(code, f"docs/{page}", "exec"), {})
-    assert _stable(out.getvalue()) == _stable(shown)
+    assert _stable(run_block(code, f"docs/{page}")) == _stable(shown)
 
 
 def test_every_page_has_its_blocks():

@@ -6,25 +6,20 @@ Lines that name a temporary directory are compared up to it, the time per step b
 
 from __future__ import annotations
 
-import contextlib
-import io
 import re
-from pathlib import Path
 
 import pytest
+from _doc_blocks import ROOT, page_blocks, run_block
 
 from prefriction import export
 
-PAGE = (Path(__file__).resolve().parent.parent / "docs" / "export.md").read_text()
-BLOCKS = re.findall(r"```(\w*)\n(.*?)```", PAGE, flags=re.S)
+PAGE = (ROOT / "docs" / "export.md").read_text()
+BLOCKS = page_blocks("docs/export.md")
 PYTHON = [(i, body) for i, (lang, body) in enumerate(BLOCKS) if lang == "python"]
 
 
 def _run(code: str) -> str:
-    out = io.StringIO()
-    with contextlib.redirect_stdout(out):
-        exec(compile(code, "docs/export.md", "exec"), {})
-    return out.getvalue()
+    return run_block(code, "docs/export.md")
 
 
 def _same(shown: str, printed: str) -> bool:

@@ -2,22 +2,17 @@
 
 from __future__ import annotations
 
-import contextlib
-import io
 import re
 from pathlib import Path
 
 import pytest
+from _doc_blocks import page_blocks, run_block
 
-README = (Path(__file__).resolve().parent.parent / "README.md").read_text()
-BLOCKS = re.findall(r"```(\w*)\n(.*?)```", README, flags=re.S)
+BLOCKS = page_blocks("README.md")
 
 
 def _run(code: str) -> str:
-    out = io.StringIO()
-    with contextlib.redirect_stdout(out):
-        exec(compile(code, "README.md", "exec"), {})
-    return out.getvalue()
+    return run_block(code, "README.md")
 
 
 def test_top_has_exactly_two_commands_and_ci_runs_the_test_command():

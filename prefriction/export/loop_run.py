@@ -14,7 +14,7 @@ import numpy as np
 
 from prefriction._validation import check_count, check_real_array
 
-from .run import compile_and_run
+from .run import c_driver, compile_and_run
 from .source import CSource
 
 __all__ = ["LoopRun", "run_loop_c"]
@@ -22,33 +22,8 @@ __all__ = ["LoopRun", "run_loop_c"]
 MAX_SAMPLES = 10_000_000
 """Largest number of samples :func:`run_loop_c` takes."""
 
-_DRIVER = r"""
-#define _POSIX_C_SOURCE 199309L
-#include <stdio.h>
-#include <stdlib.h>
-#include <time.h>
-#include "CTRL.h"
-#include "PLANT.h"
-
-int main(int argc, char **argv) {
-  long n, i;
-  int r, rounds;
-  double *in, *out, best = 1e300, t, u;
-  struct timespec a, b;
-  FILE *f;
-  CTRL_state c;
-  PLANT_state p;
-  if (argc != 5) return 2;
-  n = (atol(argv[3]) - 5) / 3;
-  rounds = atoi(argv[4]);
-  in = malloc((3 * n + 5) * sizeof(double));
-  out = malloc(5 * n * sizeof(double));
-  if (!in || !out) return 3;
-  f = fopen(argv[1], "rb");
-  if (!f || fread(in, sizeof(double), 3 * n + 5, f) != (size_t) (3 * n + 5)) return 4;
-  fclose(f);
-  for (r = 0; r < rounds; ++r) {
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &a);
+_DRIVER = c_driver(["CTRL.h", "PLANT.h"], "  double u;\n  CTRL_state c;\n  PLANT_state p;", "(atol(argv[3]) - 5) / 3",
+                   "3 * n + 5", "5 * n", """\
     CTRL_reset(&c);
     PLANT_reset(&p, in[0], 0.0);
     for (i = 0; i < n; ++i) {
@@ -58,20 +33,7 @@ int main(int argc, char **argv) {
       u = CTRL_update(&c, p.x, in[2 + 3 * i], in[2 + 3 * i + 3], in[3 + 3 * i], in[3 + 3 * i + 3]);
       out[5 * i + 3] = u;
       out[5 * i + 4] = i + 1 < n ? PLANT_step(&p, u) : 0;
-    }
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &b);
-    t = (b.tv_sec - a.tv_sec) * 1e9 + (b.tv_nsec - a.tv_nsec);
-    if (t < best) best = t;
-  }
-  f = fopen(argv[2], "wb");
-  if (!f || fwrite(out, sizeof(double), 5 * n, f) != (size_t) (5 * n)) return 5;
-  fclose(f);
-  printf("%.6g\n", best / n);
-  free(in);
-  free(out);
-  return 0;
-}
-"""
+    }""")
 
 
 @dataclass(frozen=True)

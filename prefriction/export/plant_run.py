@@ -12,7 +12,7 @@ import numpy as np
 from prefriction._validation import check_count, check_real_array
 
 from .plant import plant_initial_state
-from .run import compile_and_run
+from .run import c_driver, compile_and_run
 from .source import CSource
 
 __all__ = ["PlantRun", "evaluate_plant", "run_plant_c"]
@@ -20,51 +20,14 @@ __all__ = ["PlantRun", "evaluate_plant", "run_plant_c"]
 MAX_PERIODS = 10_000_000
 """Largest number of periods :func:`run_plant_c` and :func:`evaluate_plant` take."""
 
-_DRIVER = r"""
-#define _POSIX_C_SOURCE 199309L
-#include <stdio.h>
-#include <stdlib.h>
-#include <time.h>
-#include "NAME.h"
-
-int main(int argc, char **argv) {
-  long n, i;
-  int r, rounds;
-  double *in, *out, best = 1e300, t;
-  struct timespec a, b;
-  FILE *f;
-  NAME_state s;
-  if (argc != 5) return 2;
-  n = atol(argv[3]) - 2;
-  rounds = atoi(argv[4]);
-  in = malloc((n + 2) * sizeof(double));
-  out = malloc(4 * n * sizeof(double));
-  if (!in || !out) return 3;
-  f = fopen(argv[1], "rb");
-  if (!f || fread(in, sizeof(double), n + 2, f) != (size_t) (n + 2)) return 4;
-  fclose(f);
-  for (r = 0; r < rounds; ++r) {
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &a);
+_DRIVER = c_driver(["NAME.h"], "  NAME_state s;", "atol(argv[3]) - 2", "n + 2", "4 * n", """\
     NAME_reset(&s, in[0], in[1]);
     for (i = 0; i < n; ++i) {
       out[4 * i + 3] = NAME_step(&s, in[2 + i]);
       out[4 * i] = s.x;
       out[4 * i + 1] = s.v;
       out[4 * i + 2] = s.F;
-    }
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &b);
-    t = (b.tv_sec - a.tv_sec) * 1e9 + (b.tv_nsec - a.tv_nsec);
-    if (t < best) best = t;
-  }
-  f = fopen(argv[2], "wb");
-  if (!f || fwrite(out, sizeof(double), 4 * n, f) != (size_t) (4 * n)) return 5;
-  fclose(f);
-  printf("%.6g\n", best / n);
-  free(in);
-  free(out);
-  return 0;
-}
-"""
+    }""")
 
 
 @dataclass(frozen=True)

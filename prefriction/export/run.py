@@ -23,7 +23,7 @@ from prefriction._validation import check_bool, check_count, check_real_array
 from .model import virgin_state
 from .source import CSource
 
-__all__ = ["CRun", "compile_and_run", "evaluate", "gcc", "run_c"]
+__all__ = ["CRun", "c_driver", "compile_and_run", "evaluate", "gcc", "run_c"]
 
 MAX_SAMPLES = 50_000_000
 """Largest number of positions :func:`run_c` takes (memory: 16 bytes each)."""
@@ -34,46 +34,67 @@ CFLAGS = ("-std=c99", "-Wall", "-Werror")
 (``optimize=True``, timings) or ``-O0`` (a quick compile: the same numbers, IEEE arithmetic
 without contraction under ``-std=c99``)."""
 
-_DRIVER = r"""
+_HARNESS = r"""
 #define _POSIX_C_SOURCE 199309L
 #include <stdio.h>
 #include <stdlib.h>
 #include <time.h>
-#include "NAME.h"
+@INCLUDES@
 
 int main(int argc, char **argv) {
   long n, i;
   int r, rounds;
-  double *x, *F, best = 1e300, t;
+  double *in, *out, best = 1e300, t;
   struct timespec a, b;
   FILE *f;
-  NAME_state s;
+@STATE@
   if (argc != 5) return 2;
-  n = atol(argv[3]);
+  n = @N@;
   rounds = atoi(argv[4]);
-  x = malloc(n * sizeof(double));
-  F = malloc(n * sizeof(double));
-  if (!x || !F) return 3;
+  in = malloc((@N_IN@) * sizeof(double));
+  out = malloc((@N_OUT@) * sizeof(double));
+  if (!in || !out) return 3;
   f = fopen(argv[1], "rb");
-  if (!f || fread(x, sizeof(double), n, f) != (size_t) n) return 4;
+  if (!f || fread(in, sizeof(double), @N_IN@, f) != (size_t) (@N_IN@)) return 4;
   fclose(f);
   for (r = 0; r < rounds; ++r) {
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &a);
-    NAME_reset(&s, x[0]);
-    for (i = 0; i < n; ++i) F[i] = NAME_force(&s, x[i]);
+@BODY@
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &b);
     t = (b.tv_sec - a.tv_sec) * 1e9 + (b.tv_nsec - a.tv_nsec);
     if (t < best) best = t;
   }
   f = fopen(argv[2], "wb");
-  if (!f || fwrite(F, sizeof(double), n, f) != (size_t) n) return 5;
+  if (!f || fwrite(out, sizeof(double), @N_OUT@, f) != (size_t) (@N_OUT@)) return 5;
   fclose(f);
   printf("%.6g\n", best / n);
-  free(x);
-  free(F);
+  free(in);
+  free(out);
   return 0;
 }
 """
+
+
+def c_driver(headers: list[str], state: str, n: str, n_in: str, n_out: str, body: str) -> str:
+    """C source of a timing driver for :func:`compile_and_run`.
+
+    The driver reads ``n_in`` doubles into ``in`` from the file ``argv[1]``, runs ``body`` (one
+    pass over the ``n`` steps, writing ``out``) ``argv[4]`` times, writes the ``n_out`` doubles
+    of ``out`` to the file ``argv[2]`` and prints the least CPU time per step [ns] over the passes.
+    ``n``, ``n_in`` and ``n_out`` are C expressions (``n`` in terms of ``atol(argv[3])``, the
+    number of input doubles; the others in terms of ``n``); ``state`` declares the variables of
+    ``body``, and ``headers`` names the headers to include.
+    """
+    text = _HARNESS
+    for key, value in (("@INCLUDES@", "\n".join(f'#include "{h}"' for h in headers)), ("@STATE@", state),
+                       ("@N_IN@", n_in), ("@N_OUT@", n_out), ("@N@", n), ("@BODY@", body)):
+        text = text.replace(key, value)
+    return text
+
+
+_DRIVER = c_driver(["NAME.h"], "  NAME_state s;", "atol(argv[3])", "n", "n", """\
+    NAME_reset(&s, in[0]);
+    for (i = 0; i < n; ++i) out[i] = NAME_force(&s, in[i]);""")
 
 
 @dataclass(frozen=True)

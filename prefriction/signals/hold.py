@@ -9,7 +9,7 @@ import numpy as np
 from prefriction._validation import check_real_array
 from prefriction.signals._checks import UNIT, number, time_end
 from prefriction.signals.base import LinearPieces
-from prefriction.signals.samples import _sample_array
+from prefriction.signals.samples import _times_values
 
 __all__ = ["ZeroOrderHold"]
 
@@ -47,18 +47,7 @@ class ZeroOrderHold(LinearPieces):
 
     def __init__(self, t: Any, u: Any, *, name: Optional[str] = None, unit: str = UNIT) -> None:
         nt, nu = (f"{name} switching times t", f"{name} values") if name else ("t", "u")
-        ts = _sample_array(nt, t, "s")
-        us = _sample_array(nu, u, unit)
-        if ts.size < 1:
-            raise ValueError(f"{nt} must have at least 1 entry, got 0")
-        if us.shape != ts.shape:
-            raise ValueError(f"{nu} must have the same length as {nt} ({ts.size}), got {us.size}")
-        steps = np.diff(ts)
-        if not np.all(steps > 0.0):
-            k = int(np.argmax(steps <= 0.0))
-            raise ValueError(
-                f"{nt} must be strictly increasing, got {nt}[{k}] = {float(ts[k])!r} >= {nt}[{k + 1}] = {float(ts[k + 1])!r}"
-            )
+        ts, us = _times_values(nt, t, nu, u, unit, 1, "entry")
         self._set(_t=ts, _u=us)
 
     @property

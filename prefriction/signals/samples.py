@@ -42,6 +42,26 @@ def _sample_array(name: str, values: Any, unit: str) -> np.ndarray:
     return arr
 
 
+def _times_values(nt: str, t: Any, nu: str, u: Any, unit: str, least: int, noun: str) -> tuple[np.ndarray, np.ndarray]:
+    """Times ``t`` [s] and values ``u`` [``unit``] as checked arrays of one length, ``t`` strictly increasing.
+
+    At least ``least`` entries (``noun`` names them in the message); messages name ``nt`` and ``nu``.
+    """
+    ts = _sample_array(nt, t, "s")
+    us = _sample_array(nu, u, unit)
+    if ts.size < least:
+        raise ValueError(f"{nt} must have at least {least} {noun}, got {ts.size}")
+    if us.shape != ts.shape:
+        raise ValueError(f"{nu} must have the same length as {nt} ({ts.size}), got {us.size}")
+    steps = np.diff(ts)
+    if not np.all(steps > 0.0):
+        k = int(np.argmax(steps <= 0.0))
+        raise ValueError(
+            f"{nt} must be strictly increasing, got {nt}[{k}] = {float(ts[k])!r} >= {nt}[{k + 1}] = {float(ts[k + 1])!r}"
+        )
+    return ts, us
+
+
 class Samples(LinearPieces):
     """Piecewise-linear signal through samples, held constant outside them (as ``numpy.interp``).
 
@@ -64,18 +84,7 @@ class Samples(LinearPieces):
 
     def __init__(self, t: Any, u: Any, *, name: Optional[str] = None, unit: str = UNIT) -> None:
         nt, nu = (f"{name} sample times t", f"{name} sample values") if name else ("t", "u")
-        ts = _sample_array(nt, t, "s")
-        us = _sample_array(nu, u, unit)
-        if ts.size < 2:
-            raise ValueError(f"{nt} must have at least 2 samples, got {ts.size}")
-        if us.shape != ts.shape:
-            raise ValueError(f"{nu} must have the same length as {nt} ({ts.size}), got {us.size}")
-        steps = np.diff(ts)
-        if not np.all(steps > 0.0):
-            k = int(np.argmax(steps <= 0.0))
-            raise ValueError(
-                f"{nt} must be strictly increasing, got {nt}[{k}] = {float(ts[k])!r} >= {nt}[{k + 1}] = {float(ts[k + 1])!r}"
-            )
+        ts, us = _times_values(nt, t, nu, u, unit, 2, "samples")
         self._set(_t=ts, _u=us)
 
     @property
