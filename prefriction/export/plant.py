@@ -23,7 +23,7 @@ from prefriction.models import Oscillator
 from prefriction.signals import Constant
 from prefriction.simulation.loops.compiled_loop import NSTOP, LoopLayout, LoopSpec, _step
 from prefriction.simulation.plant import Layout, PlantSpec
-from prefriction.simulation.rest import initial_direction
+from prefriction.simulation.loops.records import plant_state
 from prefriction.simulation.simulate import _CAL
 from prefriction.units import Scales
 
@@ -95,17 +95,7 @@ class _Period:
     def initial(self, x0: float, v0: float, F0: float) -> np.ndarray:
         """The loop state at ``t = 0`` (as the sampled loop starts it, the force at ``t = 0`` unknown:
         a mass at rest starts at rest and leaves it when the first force moves it)."""
-        LL, sc, model = self.LL, self.sc, self.model
-        s0, rest = initial_direction(v0, 0.0, F0)
-        z, m = model.initial_state(F0 / sc.F, s0)
-        S = np.zeros(LL.nS)
-        ix = LL.state
-        S[ix["x"]], S[ix["v"]], S[ix["s"]], S[ix["rest"]] = x0 / sc.x, v0 / sc.v, s0, rest
-        for i, zi in enumerate(z):
-            S[ix[f"z{i}"]] = zi
-        for i, mi in enumerate(m):
-            S[ix[f"m{i}"]] = mi
-        return S
+        return plant_state(self.model, self.sc, self.LL, x0, v0, F0, 0.0)[0]
 
 
 def plant_function(system: Oscillator, Ts: float, *, rtol: float = 1e-8,

@@ -7,7 +7,7 @@ import math
 import numpy as np
 
 from prefriction.errors import SolverError
-from prefriction.models import Oscillator
+from prefriction.models import FrictionModel, Oscillator
 from prefriction.simulation.feedback import LinearFeedback
 from prefriction.simulation.plant import PlantSpec
 from prefriction.simulation.rest import initial_direction
@@ -16,18 +16,16 @@ from prefriction.units import Scales
 
 from .compiled_loop import LoopLayout
 
-__all__ = ["collect", "failure", "finish_in_python", "initial_state"]
+__all__ = ["collect", "failure", "finish_in_python", "initial_state", "plant_state"]
 
 
-def initial_state(system: Oscillator, LL: LoopLayout, x0: float, v0: float, F0: float, xc0: np.ndarray,
-                   u0: float, comp0: np.ndarray, y0: float) -> tuple[np.ndarray, float]:
-    """Loop state at ``t = 0`` and the initial direction (as ``prefriction.simulate`` starts a
-    loop), with the force ``u0`` [N] applied at ``t = 0``, the compensator's state ``comp0`` and
-    the measurements before ``t = 0`` all ``y0`` [m]."""
-    model, sc, Fc = system.friction, Scales.of(system), system.friction.Fc
-    acc0 = (u0 - F0) / Fc
+def plant_state(model: FrictionModel, sc: Scales, LL: LoopLayout, x0: float, v0: float, F0: float,
+                acc0: float) -> tuple[np.ndarray, float]:
+    """Loop state at ``t = 0`` with the plant's entries set (position ``x0`` [m], velocity ``v0``
+    [m/s], friction force ``F0`` [N], normalised acceleration ``acc0`` deciding the first direction
+    at rest) and every other entry zero; and the initial direction."""
     s0, rest = initial_direction(v0, acc0, F0)
-    z, m = model.initial_state(F0 / Fc, s0)
+    z, m = model.initial_state(F0 / sc.F, s0)
     S = np.zeros(LL.nS)
     ix = LL.state
     S[ix["x"]], S[ix["v"]], S[ix["s"]], S[ix["rest"]] = x0 / sc.x, v0 / sc.v, s0, rest
@@ -35,6 +33,16 @@ def initial_state(system: Oscillator, LL: LoopLayout, x0: float, v0: float, F0: 
         S[ix[f"z{i}"]] = zi
     for i, mi in enumerate(m):
         S[ix[f"m{i}"]] = mi
+    return S, s0
+
+
+def initial_state(system: Oscillator, LL: LoopLayout, x0: float, v0: float, F0: float, xc0: np.ndarray,
+                   u0: float, comp0: np.ndarray, y0: float) -> tuple[np.ndarray, float]:
+    """Loop state at ``t = 0`` and the initial direction (as ``prefriction.simulate`` starts a
+    loop), with the force ``u0`` [N] applied at ``t = 0``, the compensator's state ``comp0`` and
+    the measurements before ``t = 0`` all ``y0`` [m]."""
+    S, s0 = plant_state(system.friction, Scales.of(system), LL, x0, v0, F0, (u0 - F0) / system.friction.Fc)
+    ix = LL.state
     S[ix["xc0"]: ix["xc0"] + len(xc0)] = xc0
     for i, ci in enumerate(comp0):
         S[ix[f"c{i}"]] = ci
