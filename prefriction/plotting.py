@@ -21,6 +21,16 @@ PathLike = Union[str, Path]
 COLORS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b")
 
 
+def length_unit(values: np.ndarray) -> tuple[float, str]:
+    """Factor and label that bring lengths [m] of the size of ``values`` to mm, µm or nm.
+
+    >>> length_unit(np.array([0.0, 7e-3]))
+    (1000.0, 'mm')
+    """
+    peak = float(np.max(np.abs(values))) if np.size(values) else 0.0
+    return (1e3, "mm") if peak >= 1e-3 else (1e6, "µm") if peak >= 1e-6 else (1e9, "nm")
+
+
 def new_figure(
     nrows: int = 1,
     ncols: int = 1,

@@ -91,12 +91,11 @@ class AlongResult:
         Path
             The file written.
         """
-        from prefriction.plotting import new_figure
+        from prefriction.plotting import length_unit, new_figure
 
         fig, axes = new_figure(1, 2, size=(9.0, 3.8))
         ax1, ax2 = axes[0]
-        mm = np.ptp(self.x) >= 1e-3
-        scale, unit = (1e3, "mm") if mm else (1e6, "µm")
+        scale, unit = length_unit(self.x)
         ax1.plot(self.x * scale, self.F, lw=1.0, color="C0")
         ax1.set_xlabel(f"position x [{unit}]")
         ax1.set_ylabel("friction force F [N]")

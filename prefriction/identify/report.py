@@ -85,6 +85,8 @@ def plot_fit(res: "FitResult", path: str | Path, show: bool) -> Path:
     """
     import matplotlib.pyplot as plt
 
+    from prefriction.plotting import length_unit
+
     check_directory(path)
     d = res.data
     fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7.0, 6.5), height_ratios=[2.2, 1.0], layout="constrained")
@@ -101,25 +103,29 @@ def plot_fit(res: "FitResult", path: str | Path, show: bool) -> Path:
         for ax in (ax1, ax2):  # the Stribeck region lives at small speeds
             ax.set_xscale("symlog", linthresh=small)
     elif isinstance(d, ForceDisplacement):
-        ax1.plot(d.x * 1e6, d.F, ".", ms=3, color="0.55", label="data")
-        ax1.plot(d.x * 1e6, res.fitted, "-", lw=1.2, color="C0", label=f"fitted {name}")
-        ax1.set_xlabel("displacement x [µm]")
+        k, unit = length_unit(d.x)
+        ax1.plot(d.x * k, d.F, ".", ms=3, color="0.55", label="data")
+        ax1.plot(d.x * k, res.fitted, "-", lw=1.2, color="C0", label=f"fitted {name}")
+        ax1.set_xlabel(f"displacement x [{unit}]")
         ax1.set_ylabel("friction force F [N]")
         ax2.set_ylabel("residual F - fit [N]")
         ax2.plot(d.t, res.residuals, ".", ms=3, color="C3")
     else:
-        ax1.plot(d.t, d.x * 1e6, ".", ms=3, color="0.55", label="data")
-        ax1.plot(d.t, res.fitted * 1e6, "-", lw=1.2, color="C0", label=f"fitted {name}")
+        k, unit = length_unit(d.x)
+        kr, unit_r = length_unit(res.residuals)
+        ax1.plot(d.t, d.x * k, ".", ms=3, color="0.55", label="data")
+        ax1.plot(d.t, res.fitted * k, "-", lw=1.2, color="C0", label=f"fitted {name}")
         ax1.set_xlabel("time t [s]")
-        ax1.set_ylabel("position x [µm]")
-        ax2.set_ylabel("residual x - fit [µm]")
-        ax2.plot(d.t, res.residuals * 1e6, ".", ms=3, color="C3")
+        ax1.set_ylabel(f"position x [{unit}]")
+        ax2.set_ylabel(f"residual x - fit [{unit_r}]")
+        ax2.plot(d.t, res.residuals * kr, ".", ms=3, color="C3")
     ax1.legend(loc="best", frameon=True)
     ax1.grid(alpha=0.3)
     ax2.axhline(0.0, color="0.3", lw=0.8)
     ax2.set_xlabel("velocity v [m/s]" if isinstance(d, ForceVelocity) else "time t [s]")
     ax2.grid(alpha=0.3)
-    est = ", ".join(f"{n} = {v:.4g}" for n, v in zip(res.names, res.estimates))
+    est = ", ".join(f"{n} = {v:.4g}" + ("" if u in ("", "-") else f" {u}")  # dimensionless: no unit
+                     for n, v, u in zip(res.names, res.estimates, res.units))
     ax1.set_title("\n".join(textwrap.wrap(f"{name} fit: {est}", 100)), fontsize=9)  # long sums wrap
     out = Path(path)
     fig.savefig(out, dpi=120)

@@ -234,9 +234,10 @@ class Validation:
         """
         import matplotlib.pyplot as plt
 
+        from prefriction.plotting import length_unit
+
         check_directory(path)
-        k = 1e6 if self.unit == "m" else 1.0
-        unit = "µm" if self.unit == "m" else "N"
+        k, unit = length_unit(self.measured) if self.unit == "m" else (1.0, "N")
         what = "position x" if self.unit == "m" else "friction force F"
         fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7.5, 5.5), sharex=True, height_ratios=[2.0, 1.0],
                                        layout="constrained")
