@@ -208,6 +208,13 @@ class FrictionModel(ABC):
             return NotImplemented
         return Parallel.of(self, other)
 
+    @property
+    def has_free_branch(self) -> bool:
+        """True if :meth:`free_branch` may give closed-form branches for this instance (default:
+        if the class overrides it); the unforced simulation then keeps the compact CasADi loop,
+        which takes them, instead of the native driver (``docs/simulator.md#native``)."""
+        return type(self).free_branch is not FrictionModel.free_branch
+
     def free_branch(self, z: Sequence[float], m: Sequence[float], v: float, s: float, q: Any,
                     horizon: float) -> Optional[tuple[float, float, list[float], list[float], float, int]]:
         """Closed-form unforced motion on the current branch, if the model has one (floats).

@@ -207,6 +207,11 @@ class Dahl(FrictionModel):
         a = xi * exp(-k * z[0])
         return [z[0] + a * log1p_ratio(k * a)], []
 
+    @property
+    def has_free_branch(self) -> bool:  # type: ignore[override]
+        """Closed-form branches exist for gamma = 0 only (:meth:`free_branch`)."""
+        return self.gamma == 0.0
+
     def free_branch(self, z: Sequence[float], m: Sequence[float], v: float, s: float, q: Any,
                     horizon: float) -> Optional[tuple[float, float, list[float], list[float], float, int]]:
         """gamma = 0 below saturation: the linear oscillator, in closed form (see

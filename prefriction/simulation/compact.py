@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING
 
 from prefriction.models.base import FrictionModel
 from prefriction.simulation.integrator import INTEGRATOR_FAILED
+from prefriction.simulation.plant import EPS_DIED
 
 if TYPE_CHECKING:
     from prefriction.simulation.run import Run
@@ -86,6 +87,8 @@ def advance_compact(self: "Run", t_target: float, n_target: float) -> bool:
             chunk = 2.0 * math.pi / max(1.0, abs(v)) * grow
         t1 = min(t_target, t + chunk)
         A = max(math.hypot(v, F), 1e-300)
+        if grow == 1.0:  # the first call of a branch
+            A0 = A
         Ax = max(A, 0.5 * A * A, min(abs(x), 1.0)) * eps
         AF = min(A, 1.0) * eps
         Av = A * eps
@@ -134,6 +137,14 @@ def advance_compact(self: "Run", t_target: float, n_target: float) -> bool:
         else:  # vh eps = -s (1 + tau) at a reversal: record it, start the branch of direction -s
             t = t + (t1 - t) * (-sv - 1.0)  # t0 + dur tau, as the integrator's time
             v = 0.0
+            zr, mr = reverse(z, m, -s, q, snap)
+            if not abs(float(force(zr, mr, 0.0, -s, q))) > EPS_DIED * eps * A0:  # at rest (plant.EPS_DIED)
+                if t_target < math.inf:
+                    t = t_target
+                    break
+                self.calls += calls
+                st.update(x=x, v=v, z=z, m=m, s=s, t=t, F=float(force(z, m, v, s, q)), ne=ne)
+                raise self._failure("its velocity crosses zero only at the level of the integration error")
             n += 1
             s, z, m = reversal(t, x, z, m, s, ne)
             ne = 0

@@ -23,12 +23,13 @@ import tempfile
 import time
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any, Callable, Optional
 
 import casadi as ca
 
 from prefriction.simulation import library_store as store
 
-__all__ = ["CompileInfo", "cache_dir", "compile_timeout", "compiled", "compiled_seconds", "jit_available"]
+__all__ = ["CompileInfo", "cache_dir", "compile_timeout", "compiled", "compiled_seconds", "jit_available", "library"]
 
 _SPENT = [0.0]  # wall time spent generating and compiling code in this process [s]
 
@@ -114,10 +115,6 @@ def compiled(fun: ca.Function, what: str = "") -> tuple[ca.Function, CompileInfo
     """
     if os.environ.get("PREFRICTION_NO_JIT", "") not in ("", "0"):
         return fun, CompileInfo("interpreted", 0.0, reason="PREFRICTION_NO_JIT is set")
-    cc = _compiler()
-    if cc is None:
-        return fun, CompileInfo("interpreted", 0.0, reason="no C compiler found (gcc or $CC)")
-    start = time.perf_counter()
     name = fun.name()
     with tempfile.TemporaryDirectory(prefix="prefriction-") as tmp:
         src = Path(tmp) / f"{name}.c"
@@ -127,42 +124,63 @@ def compiled(fun: ca.Function, what: str = "") -> tuple[ca.Function, CompileInfo
             cg.generate(tmp + os.sep)
         except RuntimeError as exc:  # the Function cannot be code-generated
             return fun, CompileInfo("interpreted", 0.0, reason=f"code generation failed: {exc}")
-        key = hashlib.sha256(src.read_bytes() + cc.encode() + ca.__version__.encode()).hexdigest()[:24]
-        directory = cache_dir()
-        lib = directory / f"{name}_{key}.so"
-        ext, problem = store.load(fun, lib, key)
-        if ext is not None:
-            return ext, CompileInfo("cached", 0.0, str(lib))
-        earlier = store.failure_note(lib)
-        if earlier:
-            _say(f"{name}: {earlier}; using the interpreted Function (same results, slower)")
-            return fun, CompileInfo("interpreted", 0.0, reason=earlier)
-        blocked = store.unwritable(directory, lib)
-        dest = store.private_dir() / lib.name if blocked else lib
-        where = (f"{blocked}: compiled code kept for this process only, in {dest.parent}" if blocked
-                 else f"cached in {directory}")
-        _say(f"compiling {name} ({what or 'plant'}) once per structure; "
-             + (f"replacing a bad library: {problem}; " if problem else "") + where)
+        ext, info = library(name, src.read_text(), what or "plant", lambda lib, key: store.load(fun, lib, key))
+    return (fun if ext is None else ext), info
+
+
+def library(name: str, source: str, what: str,
+            load: Callable[[Path, str], tuple[Optional[Any], str]]) -> tuple[Optional[Any], CompileInfo]:
+    """The shared library of the C ``source`` from the cache, or compiled into it, loaded by ``load``.
+
+    ``load(path, key)`` returns the loaded object or ``None`` and what is wrong with the file
+    (``""`` if there is none yet). Returns ``(None, info)`` when no compiler is available or
+    compiling fails (``info.reason`` says why; the caller falls back to interpreted code).
+    """
+    if os.environ.get("PREFRICTION_NO_JIT", "") not in ("", "0"):
+        return None, CompileInfo("interpreted", 0.0, reason="PREFRICTION_NO_JIT is set")
+    cc = _compiler()
+    if cc is None:
+        return None, CompileInfo("interpreted", 0.0, reason="no C compiler found (gcc or $CC)")
+    start = time.perf_counter()
+    key = hashlib.sha256(source.encode() + cc.encode() + ca.__version__.encode()).hexdigest()[:24]
+    directory = cache_dir()
+    lib = directory / f"{name}_{key}.so"
+    ext, problem = load(lib, key)
+    if ext is not None:
+        return ext, CompileInfo("cached", 0.0, str(lib))
+    earlier = store.failure_note(lib)
+    if earlier:
+        _say(f"{name}: {earlier}; using the interpreted Function (same results, slower)")
+        return None, CompileInfo("interpreted", 0.0, reason=earlier)
+    blocked = store.unwritable(directory, lib)
+    dest = store.private_dir() / lib.name if blocked else lib
+    where = (f"{blocked}: compiled code kept for this process only, in {dest.parent}" if blocked
+             else f"cached in {directory}")
+    _say(f"compiling {name} ({what}) once per structure; "
+         + (f"replacing a bad library: {problem}; " if problem else "") + where)
+    with tempfile.TemporaryDirectory(prefix="prefriction-") as tmp:
+        src = Path(tmp) / f"{name}.c"
+        src.write_text(source)
         part = Path(tmp) / lib.name
         try:
             _run_compiler([cc, "-O2", "-shared", "-fPIC", str(src), "-o", str(part), "-lm"])
         except subprocess.TimeoutExpired:
             why = f"compiling {name} with {cc} took longer than {compile_timeout():g} s (PREFRICTION_COMPILE_TIMEOUT)"
-            return _interpreted(fun, lib, why)
+            return _interpreted(lib, why)
         except subprocess.CalledProcessError as exc:
             detail = exc.stderr.decode(errors="replace").strip().splitlines()[-1:] or [f"exit status {exc.returncode}"]
-            return _interpreted(fun, lib, f"compiling {name} with {cc} failed: {detail[0]}")
+            return _interpreted(lib, f"compiling {name} with {cc} failed: {detail[0]}")
         except OSError as exc:
-            return _interpreted(fun, lib, f"running the compiler {cc} failed: {exc}", record=False)
+            return _interpreted(lib, f"running the compiler {cc} failed: {exc}", record=False)
         try:
             store.publish(part, dest, key)
         except OSError as exc:  # the cache changed under us: keep the library for this process
             dest = store.private_dir() / lib.name
             store.publish(part, dest, key)
             _say(f"{lib} could not be written ({exc.strerror or exc}); compiled code kept in {dest.parent}")
-        ext, problem = store.load(fun, dest, key)
-        if ext is None:
-            return _interpreted(fun, lib, f"the freshly compiled library could not be used: {problem}", record=False)
+    ext, problem = load(dest, key)
+    if ext is None:
+        return _interpreted(lib, f"the freshly compiled library could not be used: {problem}", record=False)
     seconds = time.perf_counter() - start
     _SPENT[0] += seconds
     return ext, CompileInfo("compiled", seconds, str(dest))
@@ -181,9 +199,10 @@ def _run_compiler(cmd: list[str]) -> None:
         raise subprocess.CalledProcessError(proc.returncode, cmd, out, err)
 
 
-def _interpreted(fun: ca.Function, lib: Path, why: str, record: bool = True) -> tuple[ca.Function, CompileInfo]:
-    """Fall back to the interpreted ``fun`` with one line on stderr; note a compiler failure beside ``lib``."""
+def _interpreted(lib: Path, why: str, record: bool = True) -> tuple[None, CompileInfo]:
+    """No library: one line on stderr (the caller falls back to interpreted code); note a
+    compiler failure beside ``lib``."""
     if record:
         store.record_failure(lib, why)
     _say(f"{why}; using the interpreted Function (same results, slower)")
-    return fun, CompileInfo("interpreted", 0.0, reason=why)
+    return None, CompileInfo("interpreted", 0.0, reason=why)

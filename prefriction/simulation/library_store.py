@@ -23,7 +23,7 @@ from typing import Optional
 
 import casadi as ca
 
-__all__ = ["failure_note", "load", "private_dir", "publish", "record_failure", "unwritable"]
+__all__ = ["failure_note", "load", "private_dir", "publish", "record_failure", "unwritable", "verify"]
 
 _PRIVATE: list[Path] = []
 
@@ -48,27 +48,36 @@ def _same_signature(a: ca.Function, b: ca.Function) -> bool:
             and all(a.sparsity_out(i) == b.sparsity_out(i) for i in range(a.n_out())))
 
 
+def verify(lib: Path, key: str) -> str:
+    """What is wrong with the stored library ``lib`` of ``key`` (``""`` if it can be loaded,
+    ``"missing"`` if there is none yet)."""
+    if not os.path.lexists(lib):
+        return "missing"
+    if lib.is_dir():
+        return f"{lib} is a directory, not a library"
+    try:
+        stored = _sidecar(lib).read_text().split()
+    except OSError:
+        return f"{lib} has no readable checksum beside it (written by an older version or damaged)"
+    try:
+        actual = _digest(lib)
+    except OSError as exc:
+        return f"{lib} cannot be read ({exc.strerror or exc})"
+    if stored[1:2] != [key]:
+        return f"{lib} belongs to another structure (its checksum file names another key)"
+    if stored[:1] != [actual]:
+        return f"{lib} does not match its checksum (truncated, damaged or replaced)"
+    return ""
+
+
 def load(fun: ca.Function, lib: Path, key: str) -> tuple[Optional[ca.Function], str]:
     """The verified library ``lib`` of ``fun`` loaded, or ``None`` and what is wrong with it.
 
     The problem is ``""`` when there is no library yet (nothing to report).
     """
-    if not os.path.lexists(lib):
-        return None, ""
-    if lib.is_dir():
-        return None, f"{lib} is a directory, not a library"
-    try:
-        stored = _sidecar(lib).read_text().split()
-    except OSError:
-        return None, f"{lib} has no readable checksum beside it (written by an older version or damaged)"
-    try:
-        actual = _digest(lib)
-    except OSError as exc:
-        return None, f"{lib} cannot be read ({exc.strerror or exc})"
-    if stored[1:2] != [key]:
-        return None, f"{lib} belongs to another structure (its checksum file names another key)"
-    if stored[:1] != [actual]:
-        return None, f"{lib} does not match its checksum (truncated, damaged or replaced)"
+    problem = verify(lib, key)
+    if problem:
+        return None, "" if problem == "missing" else problem
     try:
         ext = ca.external(fun.name(), str(lib))
     except RuntimeError as exc:

@@ -90,7 +90,7 @@ import casadi as ca
 
 from prefriction.models.base import FrictionModel
 
-__all__ = ["EPS_TOUCH", "EPS_REST", "Layout", "PlantSpec", "build_integrator"]
+__all__ = ["EPS_DIED", "EPS_TOUCH", "EPS_REST", "Layout", "PlantSpec", "build_integrator"]
 
 EPS_TOUCH = 1.0
 """Net force, in units of the call's velocity scale ``Av = eps A`` (the tolerance times the
@@ -102,6 +102,10 @@ EPS_START = 1e-13
 """Offset of the forced reversal indicator ``s v / Av + EPS_START``: a branch that starts at
 ``v = 0`` starts with a positive indicator, so a velocity that turns against ``s`` before it
 has grown (the net force reverses within the first step) still fires the reversal event."""
+EPS_DIED = 10.0
+"""Unforced runs: a reversal whose force is below ``EPS_DIED eps A0`` (``A0`` the amplitude at the
+start of its branch) is the creep of a mass to rest crossing ``v = 0`` at the level of the
+integration error, not a reversal: the run ends at rest (``docs/simulator.md#native``)."""
 
 
 @dataclass(frozen=True)

@@ -42,6 +42,13 @@ class ReversalLog:
         for row in rows:
             self.append(row)
 
+    def extend_columns(self, t: np.ndarray, x: np.ndarray, F: np.ndarray) -> None:
+        """Add reversals from columns of times, positions and forces (``W~ = 0``: unforced runs)."""
+        self.t.frombytes(np.ascontiguousarray(t, dtype=float).tobytes())
+        self.x.frombytes(np.ascontiguousarray(x, dtype=float).tobytes())
+        self.F.frombytes(np.ascontiguousarray(F, dtype=float).tobytes())
+        self.W.frombytes(np.zeros(len(t)).tobytes())
+
     def __len__(self) -> int:
         return len(self.t)
 

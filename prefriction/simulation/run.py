@@ -15,6 +15,8 @@ import numpy as np
 from prefriction.simulation.compact import advance_compact
 from prefriction.simulation.integrator import INTEGRATOR_FAILED, BufferedIntegrator, integrator
 from prefriction.simulation.feedback import LinearFeedback
+from prefriction.simulation.native.advance import advance_native
+from prefriction.simulation.native.library import native_driver
 from prefriction.simulation.plant import Layout, PlantSpec
 from prefriction.simulation.rest import Rest
 from prefriction.simulation.reversal_log import ReversalLog
@@ -49,7 +51,13 @@ class Run(StateIO, Rest):
         # a sampled controller on a plant without a hold control: its force joins the input piece
         self.hold_in_piece = fb is not None and fb.sampled and spec.fb == "none"
         # one plant: a dense run makes its single-output calls on the dense plant, padded
-        self.f1, self.setup_time, self.mode = integrator(spec, jit)
+        # the compact unforced model runs on the native driver where it exists (docs/simulator.md#native)
+        self.native, setup = native_driver(self.model) if spec.stops_at_reversal and jit else (None, 0.0)
+        if self.native is not None:
+            self.f1, self.setup_time = None, setup
+            self.mode = self.native.info.mode if setup else "cached"
+        else:
+            self.f1, self.setup_time, self.mode = integrator(spec, jit)
         self.calls = 0
         self.steps: Optional[int] = 0
         self.max_chunk = math.inf  # longest next call of advance (finite after a failed call)
@@ -122,12 +130,13 @@ class Run(StateIO, Rest):
         """The SolverError of a failed call: time, state, reversals so far and what to try."""
         sc, st = self.sc, self.st
         if not self.spec.forced and abs(st["v"]) < _DIED_OUT and abs(st["F"]) < _DIED_OUT ** 0.5:
+            n = len(self.rev)
             return SolverError(
-                f"simulate stopped at t = {st['t'] * sc.t:.9g} s: the motion has died out after {len(self.rev)} "
-                f"reversals (v = {st['v'] * sc.v:.3g} m/s, F = {st['F'] * sc.F:.3g} N, x = {st['x'] * sc.x:.6g} m), "
-                f"so it will not reverse again and the requested reversals cannot come (the integrator then "
-                f"failed: {why}). Give t_end to simulate up to a time instead, or ask for at most "
-                f"{len(self.rev)} reversals."
+                f"simulate stopped at t = {st['t'] * sc.t:.9g} s: the motion has died out after {n} "
+                f"reversal{'' if n == 1 else 's'} (v = {st['v'] * sc.v:.3g} m/s, F = {st['F'] * sc.F:.3g} N, "
+                f"x = {st['x'] * sc.x:.6g} m), so it will not reverse again and the requested reversals cannot "
+                f"come ({why}). Give t_end to simulate up to a time instead, or ask for at most {n} "
+                f"reversal{'' if n == 1 else 's'}."
             )
         return SolverError(
             f"simulate failed after t = {st['t'] * sc.t:.9g} s (state there: x = {st['x'] * sc.x:.6g} m, "
@@ -153,6 +162,8 @@ class Run(StateIO, Rest):
     # --- loops --------------------------------------------------------------------------
     def advance(self, t_target: float, n_target: float) -> bool:
         """Integrate to normalised time ``t_target`` or ``n_target`` reversals; True if the latter."""
+        if self.native is not None:
+            return advance_native(self, t_target, n_target)
         if self.spec.stops_at_reversal:
             return advance_compact(self, t_target, n_target)
         grow = 1.0

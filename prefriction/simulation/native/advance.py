@@ -1,0 +1,65 @@
+"""The loop of an unforced run on the native driver: blocks of reversals per C call.
+
+:meth:`prefriction.simulation.run.Run.advance` calls :func:`advance_native` for the compact
+unforced model when the structure's native driver exists (:func:`~prefriction.simulation.native.library.native_driver`).
+One C call runs up to :data:`BLOCK` reversals (or to ``t_target``); the reversals come back in
+four arrays and join the run's :class:`~prefriction.simulation.reversal_log.ReversalLog`.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from prefriction.simulation.native.library import HEAD
+
+if TYPE_CHECKING:
+    from prefriction.simulation.run import Run
+
+__all__ = ["BLOCK", "advance_native"]
+
+BLOCK = 1 << 16  # reversals per C call (4 x 512 kB of output buffers)
+_WHY = {
+    2: "its velocity crosses zero only at the level of the integration error",
+    3: "the right-hand side became non-finite",
+    4: "more than 1e6 steps without a reversal",
+    5: "the step size fell below round-off of the time",
+}
+
+
+def advance_native(run: "Run", t_target: float, n_target: float) -> bool:
+    """:meth:`Run.advance` on the native driver: integrate to normalised time ``t_target`` or
+    ``n_target`` reversals (True if the latter), appending the reversals to ``run.rev`` and their
+    half-cycles' model events to ``run.rev_events``; ``SolverError`` if the driver stops early."""
+    drv, st, model = run.native, run.st, run.model
+    times = run.rev.t
+    state = np.empty(drv.width)
+    state[:HEAD] = (st["t"], st["x"], st["v"], st["s"], st.get("ne", 0),
+                    times[-1] if len(times) else math.nan, times[-2] if len(times) > 1 else math.nan, 1.0)
+    state[HEAD:HEAD + drv.nz] = st["z"]
+    state[HEAD + drv.nz:] = st["m"]
+    q = np.ascontiguousarray(run.q, dtype=float)
+    done, steps = np.zeros(1, np.int64), np.zeros(1, np.int64)
+    n = len(run.rev)
+    code = 0
+    while n < n_target:
+        want = int(min(n_target - n, BLOCK))
+        out = np.empty((4, want))
+        code = drv.run(q, run.eps, run.snap, state, t_target, want, out[0], out[1], out[2], out[3], done, steps)
+        run.calls += 1
+        k = int(done[0])
+        run.rev.extend_columns(out[0, :k], out[1, :k], out[2, :k])
+        run.rev_events.extend(out[3, :k].astype(int).tolist())
+        n += k
+        if code != 0:
+            break
+    run.steps = (run.steps or 0) + int(steps[0])
+    t, x, v, s, ne = state[:5]
+    z, m = state[HEAD:HEAD + drv.nz].tolist(), state[HEAD + drv.nz:].tolist()
+    st.update(t=float(t), x=float(x), v=float(v), s=float(s), z=z, m=m, ne=int(ne),
+              F=float(model.force(z, m, float(v), float(s), run.q.tolist())))
+    if code > 1:
+        raise run._failure(_WHY[code])
+    return n >= n_target
