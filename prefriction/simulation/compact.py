@@ -87,8 +87,7 @@ def advance_compact(self: "Run", t_target: float, n_target: float) -> bool:
             chunk = 2.0 * math.pi / max(1.0, abs(v)) * grow
         t1 = min(t_target, t + chunk)
         A = max(math.hypot(v, F), 1e-300)
-        if grow == 1.0:  # the first call of a branch
-            A0 = A
+        Fmax = abs(F) if grow == 1.0 else max(Fmax, abs(F))  # the largest force of the branch (call starts)
         Ax = max(A, 0.5 * A * A, min(abs(x), 1.0)) * eps
         AF = min(A, 1.0) * eps
         Av = A * eps
@@ -138,7 +137,7 @@ def advance_compact(self: "Run", t_target: float, n_target: float) -> bool:
             t = t + (t1 - t) * (-sv - 1.0)  # t0 + dur tau, as the integrator's time
             v = 0.0
             zr, mr = reverse(z, m, -s, q, snap)
-            if not abs(float(force(zr, mr, 0.0, -s, q))) > EPS_DIED * eps * A0:  # at rest (plant.EPS_DIED)
+            if not abs(float(force(zr, mr, 0.0, -s, q))) > EPS_DIED * eps * Fmax:  # at rest (plant.EPS_DIED)
                 if t_target < math.inf:
                     t = t_target
                     break

@@ -128,13 +128,14 @@ def compiled(fun: ca.Function, what: str = "") -> tuple[ca.Function, CompileInfo
     return (fun if ext is None else ext), info
 
 
-def library(name: str, source: str, what: str,
-            load: Callable[[Path, str], tuple[Optional[Any], str]]) -> tuple[Optional[Any], CompileInfo]:
+def library(name: str, source: str, what: str, load: Callable[[Path, str], tuple[Optional[Any], str]],
+            fallback: str = "the interpreted Function") -> tuple[Optional[Any], CompileInfo]:
     """The shared library of the C ``source`` from the cache, or compiled into it, loaded by ``load``.
 
     ``load(path, key)`` returns the loaded object or ``None`` and what is wrong with the file
     (``""`` if there is none yet). Returns ``(None, info)`` when no compiler is available or
-    compiling fails (``info.reason`` says why; the caller falls back to interpreted code).
+    compiling fails (``info.reason`` says why): the caller then uses ``fallback``, which the
+    line printed to stderr names.
     """
     if os.environ.get("PREFRICTION_NO_JIT", "") not in ("", "0"):
         return None, CompileInfo("interpreted", 0.0, reason="PREFRICTION_NO_JIT is set")
@@ -150,7 +151,7 @@ def library(name: str, source: str, what: str,
         return ext, CompileInfo("cached", 0.0, str(lib))
     earlier = store.failure_note(lib)
     if earlier:
-        _say(f"{name}: {earlier}; using the interpreted Function (same results, slower)")
+        _say(f"{name}: {earlier}; using {fallback} (same results, slower)")
         return None, CompileInfo("interpreted", 0.0, reason=earlier)
     blocked = store.unwritable(directory, lib)
     dest = store.private_dir() / lib.name if blocked else lib
@@ -166,12 +167,12 @@ def library(name: str, source: str, what: str,
             _run_compiler([cc, "-O2", "-shared", "-fPIC", str(src), "-o", str(part), "-lm"])
         except subprocess.TimeoutExpired:
             why = f"compiling {name} with {cc} took longer than {compile_timeout():g} s (PREFRICTION_COMPILE_TIMEOUT)"
-            return _interpreted(lib, why)
+            return _interpreted(lib, why, fallback)
         except subprocess.CalledProcessError as exc:
             detail = exc.stderr.decode(errors="replace").strip().splitlines()[-1:] or [f"exit status {exc.returncode}"]
-            return _interpreted(lib, f"compiling {name} with {cc} failed: {detail[0]}")
+            return _interpreted(lib, f"compiling {name} with {cc} failed: {detail[0]}", fallback)
         except OSError as exc:
-            return _interpreted(lib, f"running the compiler {cc} failed: {exc}", record=False)
+            return _interpreted(lib, f"running the compiler {cc} failed: {exc}", fallback, record=False)
         try:
             store.publish(part, dest, key)
         except OSError as exc:  # the cache changed under us: keep the library for this process
@@ -180,7 +181,7 @@ def library(name: str, source: str, what: str,
             _say(f"{lib} could not be written ({exc.strerror or exc}); compiled code kept in {dest.parent}")
     ext, problem = load(dest, key)
     if ext is None:
-        return _interpreted(lib, f"the freshly compiled library could not be used: {problem}", record=False)
+        return _interpreted(lib, f"the freshly compiled library could not be used: {problem}", fallback, record=False)
     seconds = time.perf_counter() - start
     _SPENT[0] += seconds
     return ext, CompileInfo("compiled", seconds, str(dest))
@@ -199,10 +200,10 @@ def _run_compiler(cmd: list[str]) -> None:
         raise subprocess.CalledProcessError(proc.returncode, cmd, out, err)
 
 
-def _interpreted(lib: Path, why: str, record: bool = True) -> tuple[None, CompileInfo]:
+def _interpreted(lib: Path, why: str, fallback: str, record: bool = True) -> tuple[None, CompileInfo]:
     """No library: one line on stderr (the caller falls back to interpreted code); note a
     compiler failure beside ``lib``."""
     if record:
         store.record_failure(lib, why)
-    _say(f"{why}; using the interpreted Function (same results, slower)")
+    _say(f"{why}; using {fallback} (same results, slower)")
     return None, CompileInfo("interpreted", 0.0, reason=why)

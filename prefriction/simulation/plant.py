@@ -103,8 +103,8 @@ EPS_START = 1e-13
 ``v = 0`` starts with a positive indicator, so a velocity that turns against ``s`` before it
 has grown (the net force reverses within the first step) still fires the reversal event."""
 EPS_DIED = 10.0
-"""Unforced runs: a reversal whose force is below ``EPS_DIED eps A0`` (``A0`` the amplitude at the
-start of its branch) is the creep of a mass to rest crossing ``v = 0`` at the level of the
+"""Unforced runs: a reversal whose force is below ``EPS_DIED eps Fmax`` (``Fmax`` the largest force
+on its branch) is the creep of a mass to rest crossing ``v = 0`` at the level of the
 integration error, not a reversal: the run ends at rest (``docs/simulator.md#native``)."""
 
 

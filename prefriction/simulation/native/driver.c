@@ -151,7 +151,7 @@ static double pf_locate(pf_ctx* c, const double U[7][PF_NY], const double* y0, i
 typedef struct {
   double sc[PF_NY]; /* error scale of each component (amplitude times eps) */
   double Eb;        /* v^2/2 + potential of the branch (speed at model events) */
-  double A0;        /* the amplitude hypot(v, F) at the start of the branch */
+  double Fmax;      /* the largest |F| on the branch so far (at the ends of its steps) */
   double chunk_end, grow;
 } pf_scales;
 
@@ -215,9 +215,9 @@ int pf_run(const double* q, double eps, double snap, double* st, double t_end, l
   do {                                             \
     dur = PF_DURATION();                           \
     pf_rescale(&c, &S, y, eps);                    \
-    S.A0 = S.sc[1] / eps;                          \
     S.chunk_end = t + dur;                         \
     pf_f(&c, y, f0);                               \
+    S.Fmax = fabs(f0[1]);                          \
     fsal = 1;                                      \
     h = pf_first_step(&c, &S, y, f0, dur);         \
     pf_g(&c, y, g0);                               \
@@ -281,7 +281,7 @@ int pf_run(const double* q, double eps, double snap, double* st, double t_end, l
       c.res[1] = mn;
       c.res[2] = &F;
       pf_reverse(c.arg, c.res, c.iw, c.w, 0);
-      if (!(fabs(F) > PF_NOISE * eps * S.A0)) { /* a reversal at the level of the integration error */
+      if (!(fabs(F) > PF_NOISE * eps * S.Fmax)) { /* a reversal at the level of the integration error */
         if (isfinite(t_end)) { t = t_end; y[1] = 0.0; code = PF_T_END; } /* the mass has come to rest */
         else code = PF_DIED_OUT;
         break;
@@ -329,6 +329,7 @@ int pf_run(const double* q, double eps, double snap, double* st, double t_end, l
     }
     /* no event: take the step, choose the next */
     for (i = 0; i < PF_NY; ++i) { y[i] = ys[i]; f0[i] = U[6][i] / h; }
+    S.Fmax = fmax(S.Fmax, fabs(f0[1])); /* v' = -F */
     for (i = 0; i < PF_NE; ++i) g0[i] = g1[i];
     t = last ? t_end : t + h;
     err = fmax(err, 1e-10);
@@ -358,21 +359,4 @@ int pf_run(const double* q, double eps, double snap, double* st, double t_end, l
   for (i = 0; i < PF_NM; ++i) st[PF_HEAD + PF_NZ + i] = c.m[i];
   *n_done = n;
   return code;
-}
-
-/* pf_run over n_sys systems of this structure, one after the other: q (n_sys x PF_NQ), st
- * (n_sys x (PF_HEAD + PF_NZ + PF_NM)), n_max reversals each, written to rows of width n_max of
- * the outputs; codes[i] and n_done[i] per system. Returns the number of systems that failed. */
-long pf_run_batch(long n_sys, const double* q, double eps, double snap, double* st, double t_end, long n_max,
-                  double* t_out, double* x_out, double* F_out, double* ev_out, long* n_done, long* steps,
-                  int* codes) {
-  long i, failed = 0;
-  const long width = PF_HEAD + PF_NZ + PF_NM;
-  for (i = 0; i < n_sys; ++i) {
-    steps[i] = 0;
-    codes[i] = pf_run(q + i * PF_NQ, eps, snap, st + i * width, t_end, n_max, t_out + i * n_max,
-                      x_out + i * n_max, F_out + i * n_max, ev_out + i * n_max, n_done + i, steps + i);
-    failed += codes[i] > PF_T_END;
-  }
-  return failed;
 }

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import ctypes
 import threading
+import time
 from pathlib import Path
 from typing import Hashable, Optional
 
@@ -28,13 +29,12 @@ HEAD = 8  # run-state entries before z and m (driver.c: st[])
 _DRIVER = (Path(__file__).parent / "driver.c").read_text()
 _D = np.ctypeslib.ndpointer(dtype=np.float64, flags="C_CONTIGUOUS")
 _L = np.ctypeslib.ndpointer(dtype=np.int64, flags="C_CONTIGUOUS")
-_I = np.ctypeslib.ndpointer(dtype=np.int32, flags="C_CONTIGUOUS")
 _CACHE: dict = {}
 _LOCK = threading.Lock()
 
 
 class NativeDriver:
-    """The ``pf_run`` and ``pf_run_batch`` entry points of one structure's library (driver.c)."""
+    """The ``pf_run`` entry point of one structure's library (driver.c)."""
 
     def __init__(self, lib: ctypes.CDLL, model: FrictionModel, info: CompileInfo) -> None:
         self.lib, self.info = lib, info
@@ -44,10 +44,6 @@ class NativeDriver:
         self.run.restype = ctypes.c_int
         self.run.argtypes = [_D, ctypes.c_double, ctypes.c_double, _D, ctypes.c_double, ctypes.c_long,
                              _D, _D, _D, _D, _L, _L]
-        self.batch = lib.pf_run_batch
-        self.batch.restype = ctypes.c_long
-        self.batch.argtypes = [ctypes.c_long, _D, ctypes.c_double, ctypes.c_double, _D, ctypes.c_double,
-                               ctypes.c_long, _D, _D, _D, _D, _L, _L, _I]
 
 
 def _load(lib: Path, key: str) -> tuple[Optional[ctypes.CDLL], str]:
@@ -57,7 +53,7 @@ def _load(lib: Path, key: str) -> tuple[Optional[ctypes.CDLL], str]:
         return None, "" if problem == "missing" else problem
     try:
         handle = ctypes.CDLL(str(lib))
-        handle.pf_run, handle.pf_run_batch
+        handle.pf_run
     except (OSError, AttributeError) as exc:
         return None, f"{lib} could not be loaded ({exc})"
     return handle, ""
@@ -74,12 +70,10 @@ def native_driver(model: FrictionModel) -> tuple[Optional[NativeDriver], float]:
     with _LOCK:
         if key in _CACHE:
             return _CACHE[key], 0.0
-        import time
-
         start = time.perf_counter()
         check_sizes(model)
         handle, info = library(f"native_{type(model).__name__.lower()}", model_source(model) + _DRIVER,
-                               "unforced runs in C", _load)
+                               "unforced runs in C", _load, "the CasADi integrator loop")
         driver = None if handle is None else NativeDriver(handle, model, info)
         _CACHE[key] = driver
         return driver, time.perf_counter() - start
