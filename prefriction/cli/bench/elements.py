@@ -1,8 +1,8 @@
 """``prefriction bench --elements``: compile time and cost per reversal against the element count.
 
 For Maxwell-slip and GMS with ``N`` elements (3, 10, 30, 100; ``--quick``: 3 and 10) it
-measures, in this process: the time to build and compile the plant of the structure into an
-empty compiled-code cache (a temporary ``$PREFRICTION_CACHE``), and the warm time per reversal
+measures, in this process: the time to build and compile the structure's native driver
+(``docs/simulator.md#native``) into an empty compiled-code cache (a temporary ``$PREFRICTION_CACHE``), and the warm time per reversal
 of an unforced run of 50 reversals (``rtol = 1e-8``, the least of 3 interleaved rounds). The
 elements: stiffnesses ``k_i`` spread over [1, 2] x 1e4 / N N/m and slip forces over [1, 3] / N
 (Maxwell-slip; GMS: the fractions ``alpha_i`` the same, ``Fc = 1`` N, ``Fs = 1.5`` N,
