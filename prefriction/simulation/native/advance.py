@@ -22,7 +22,8 @@ __all__ = ["BLOCK", "advance_native"]
 
 BLOCK = 1 << 16  # reversals per C call (4 x 512 kB of output buffers)
 _WHY = {
-    2: "its velocity crosses zero only at the level of the integration error",
+    2: "its amplitude fell below 1e-250 normalised units, or its velocity crosses zero only at the level of "
+       "the integration error",
     3: "the right-hand side became non-finite",
     4: "more than 1e6 steps without a reversal",
     5: "the step size fell below round-off of the time",

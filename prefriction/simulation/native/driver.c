@@ -162,13 +162,18 @@ static double pf_norm(const pf_scales* S, const double* e) {
   return sqrt(acc / (PF_NY - (PF_NORM_X ? 0 : 1)));
 }
 
-/* scales from the amplitude A = hypot(v, F) of the state (as the compact CasADi model) */
-static void pf_rescale(pf_ctx* c, pf_scales* S, const double* y, double eps) {
-  double F = pf_F(c, y), A = fmax(hypot(y[1], F), 1e-300);
+/* error scales from the amplitude A = hypot(v, F) of the state y (as the compact CasADi model) */
+static void pf_scale(pf_scales* S, const double* y, double F, double eps) {
+  double A = fmax(hypot(y[1], F), 1e-300);
   int i;
   S->sc[0] = fmax(fmax(A, 0.5 * A * A), fmin(fabs(y[0]), 1.0)) * eps;
   S->sc[1] = A * eps;
   for (i = 2; i < PF_NY; ++i) S->sc[i] = fmin(A, 1.0) * eps;
+}
+
+/* the scales and the branch energy at the state y */
+static void pf_rescale(pf_ctx* c, pf_scales* S, const double* y, double eps) {
+  pf_scale(S, y, pf_F(c, y), eps);
   S->Eb = 0.5 * y[1] * y[1] + pf_potential(c, y);
 }
 
@@ -230,7 +235,11 @@ int pf_run(const double* q, double eps, double snap, double* st, double t_end, l
     double th_ev = 2.0, sv;
     if (n >= n_max) { code = PF_REVERSALS; break; }
     if (!(t < t_end)) { code = PF_T_END; break; }
-    if (S.sc[1] < 1e-250 * eps) { code = PF_DIED_OUT; break; }
+    if (S.sc[1] < 1e-250 * eps) { /* the motion has decayed below the double range: at rest */
+      if (isfinite(t_end)) { t = t_end; y[1] = 0.0; code = PF_T_END; }
+      else code = PF_DIED_OUT;
+      break;
+    }
     if (++branch_steps > PF_BRANCH_STEPS) { code = PF_TOO_MANY_STEPS; break; }
     if (t + h >= t_end) { h = t_end - t; last = 1; }
     if (!(h > 1e-15 * fmax(fabs(t), 1e-300))) { code = PF_STEP_UNDERFLOW; break; }
@@ -330,6 +339,10 @@ int pf_run(const double* q, double eps, double snap, double* st, double t_end, l
     /* no event: take the step, choose the next */
     for (i = 0; i < PF_NY; ++i) { y[i] = ys[i]; f0[i] = U[6][i] / h; }
     S.Fmax = fmax(S.Fmax, fabs(f0[1])); /* v' = -F */
+    /* rate-dependent models decay within a branch (damping): their errors are held to the
+     * amplitude at the start of each step, so that a reversal force far below the branch's
+     * starting amplitude keeps its relative accuracy */
+    if (!PF_RATE_INDEPENDENT) pf_scale(&S, y, -f0[1], eps);
     for (i = 0; i < PF_NE; ++i) g0[i] = g1[i];
     t = last ? t_end : t + h;
     err = fmax(err, 1e-10);
