@@ -5,7 +5,9 @@ with the system C compiler (``gcc -O2 -shared``) into a shared library named by 
 the generated code, and loads it with ``casadi.external``. The library is kept in the cache
 directory (``$PREFRICTION_CACHE``, else ``~/.cache/prefriction``), so a second process with the
 same Function loads it without compiling; :mod:`prefriction.simulation.library_store` writes
-libraries atomically and verifies a checksum before loading one. Without a compiler, with
+libraries atomically and verifies a checksum before loading one. Processes that need the same
+library at once (e.g. pytest-xdist workers) compile it once: one holds a lock beside the library
+while it compiles and publishes it, the others wait and load it. Without a compiler, with
 ``PREFRICTION_NO_JIT=1``, or if compiling fails, the interpreted Function is returned: same
 results, slower calls.
 """
@@ -97,7 +99,9 @@ def compiled(fun: ca.Function, what: str = "") -> tuple[ca.Function, CompileInfo
     writable, a directory in its place), the library is built in a directory of this process and
     the line says so. A compiler that runs longer than :func:`compile_timeout` is stopped, the
     interpreted Function is used, and later processes use it at once (the line names the file
-    to delete to try again).
+    to delete to try again). While another process compiles the same library, this one waits
+    (one line on stderr; at most :func:`compile_timeout` + 10 s, then it compiles it itself) and
+    loads the library that process published (``CompileInfo.mode == "cached"``).
 
     Parameters
     ----------
@@ -130,39 +134,65 @@ def compiled(fun: ca.Function, what: str = "") -> tuple[ca.Function, CompileInfo
         key = hashlib.sha256(src.read_bytes() + cc.encode() + ca.__version__.encode()).hexdigest()[:24]
         directory = cache_dir()
         lib = directory / f"{name}_{key}.so"
-        ext, problem = store.load(fun, lib, key)
-        if ext is not None:
-            return ext, CompileInfo("cached", 0.0, str(lib))
-        earlier = store.failure_note(lib)
-        if earlier:
-            _say(f"{name}: {earlier}; using the interpreted Function (same results, slower)")
-            return fun, CompileInfo("interpreted", 0.0, reason=earlier)
+        found, problem = _from_cache(fun, lib, key)
+        if found is not None:
+            return found
         blocked = store.unwritable(directory, lib)
-        dest = store.private_dir() / lib.name if blocked else lib
-        where = (f"{blocked}: compiled code kept for this process only, in {dest.parent}" if blocked
-                 else f"cached in {directory}")
-        _say(f"compiling {name} ({what or 'plant'}) once per structure; "
-             + (f"replacing a bad library: {problem}; " if problem else "") + where)
-        part = Path(tmp) / lib.name
-        try:
-            _run_compiler([cc, "-O2", "-shared", "-fPIC", str(src), "-o", str(part), "-lm"])
-        except subprocess.TimeoutExpired:
-            why = f"compiling {name} with {cc} took longer than {compile_timeout():g} s (PREFRICTION_COMPILE_TIMEOUT)"
-            return _interpreted(fun, lib, why)
-        except subprocess.CalledProcessError as exc:
-            detail = exc.stderr.decode(errors="replace").strip().splitlines()[-1:] or [f"exit status {exc.returncode}"]
-            return _interpreted(fun, lib, f"compiling {name} with {cc} failed: {detail[0]}")
-        except OSError as exc:
-            return _interpreted(fun, lib, f"running the compiler {cc} failed: {exc}", record=False)
-        try:
-            store.publish(part, dest, key)
-        except OSError as exc:  # the cache changed under us: keep the library for this process
-            dest = store.private_dir() / lib.name
-            store.publish(part, dest, key)
-            _say(f"{lib} could not be written ({exc.strerror or exc}); compiled code kept in {dest.parent}")
-        ext, problem = store.load(fun, dest, key)
-        if ext is None:
-            return _interpreted(fun, lib, f"the freshly compiled library could not be used: {problem}", record=False)
+        if blocked:
+            return _build(fun, what, cc, src, lib, key, problem, blocked, start)
+        patience = compile_timeout() + 10.0  # the holder's compiler is stopped after compile_timeout()
+        with store.build_lock(lib, patience, lambda path: _say(
+                f"{name}: waiting for another process that is compiling it (lock {path})")):
+            found, problem = _from_cache(fun, lib, key)  # published while this process waited
+            if found is not None:
+                return found
+            return _build(fun, what, cc, src, lib, key, problem, "", start)
+
+
+def _from_cache(fun: ca.Function, lib: Path, key: str) -> tuple[tuple[ca.Function, CompileInfo] | None, str]:
+    """``fun`` from the verified library ``lib``, or interpreted after an earlier failed build of it;
+    else ``None`` and what is wrong with the library there (``""`` if there is none)."""
+    ext, problem = store.load(fun, lib, key)
+    if ext is not None:
+        return (ext, CompileInfo("cached", 0.0, str(lib))), ""
+    earlier = store.failure_note(lib)
+    if earlier:
+        _say(f"{fun.name()}: {earlier}; using the interpreted Function (same results, slower)")
+        return (fun, CompileInfo("interpreted", 0.0, reason=earlier)), ""
+    return None, problem
+
+
+def _build(fun: ca.Function, what: str, cc: str, src: Path, lib: Path, key: str, problem: str, blocked: str,
+           start: float) -> tuple[ca.Function, CompileInfo]:
+    """Compile the generated ``src`` into ``lib`` (or a directory of this process if ``blocked``
+    says why the cache cannot hold it), publish it and load it; ``problem`` is what was wrong
+    with the library found there, ``start`` when :func:`compiled` began [s]."""
+    name = fun.name()
+    dest = store.private_dir() / lib.name if blocked else lib
+    where = (f"{blocked}: compiled code kept for this process only, in {dest.parent}" if blocked
+             else f"cached in {lib.parent}")
+    _say(f"compiling {name} ({what or 'plant'}) once per structure; "
+         + (f"replacing a bad library: {problem}; " if problem else "") + where)
+    part = src.with_name(lib.name)
+    try:
+        _run_compiler([cc, "-O2", "-shared", "-fPIC", str(src), "-o", str(part), "-lm"])
+    except subprocess.TimeoutExpired:
+        why = f"compiling {name} with {cc} took longer than {compile_timeout():g} s (PREFRICTION_COMPILE_TIMEOUT)"
+        return _interpreted(fun, lib, why)
+    except subprocess.CalledProcessError as exc:
+        detail = exc.stderr.decode(errors="replace").strip().splitlines()[-1:] or [f"exit status {exc.returncode}"]
+        return _interpreted(fun, lib, f"compiling {name} with {cc} failed: {detail[0]}")
+    except OSError as exc:
+        return _interpreted(fun, lib, f"running the compiler {cc} failed: {exc}", record=False)
+    try:
+        store.publish(part, dest, key)
+    except OSError as exc:  # the cache changed under us: keep the library for this process
+        dest = store.private_dir() / lib.name
+        store.publish(part, dest, key)
+        _say(f"{lib} could not be written ({exc.strerror or exc}); compiled code kept in {dest.parent}")
+    ext, problem = store.load(fun, dest, key)
+    if ext is None:
+        return _interpreted(fun, lib, f"the freshly compiled library could not be used: {problem}", record=False)
     seconds = time.perf_counter() - start
     _SPENT[0] += seconds
     return ext, CompileInfo("compiled", seconds, str(dest))
