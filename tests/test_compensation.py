@@ -289,6 +289,7 @@ def test_mismatch_scales_the_compensators_model(pid):
     assert res.compensator.model.sigma == pytest.approx(1.2 * SIGMA) and res.compensator.model.Fc == pytest.approx(0.8)
 
 
+@pytest.mark.slow  # an example script end to end: .ci/run's second command (-m slow)
 def test_example_script(tmp_path):
     """examples/compensation.py (quick): the figure exists; the exact-model feedforward leaves under
     1e-3 of PID alone's reversal spike, and a 20 % wrong model still cuts it (the bench's targets)."""

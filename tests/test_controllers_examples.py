@@ -38,6 +38,7 @@ def check_png(path):
     assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 20_000
 
 
+@pytest.mark.slow  # an example script end to end: .ci/run's second command (-m slow)
 def test_stage_pd_example(tmp_path):
     out = load("stage_pd").main(tmp_path)
     check_png(out["path"])
@@ -61,6 +62,7 @@ def test_stage_pd_example(tmp_path):
     assert f"kp = {out['kp']:.4g} N/m" in text and "step 10 nm: residual error" in text
 
 
+@pytest.mark.slow  # an example script end to end: .ci/run's second command (-m slow)
 def test_stage_pid_example(tmp_path):
     out = load("stage_pid").main(tmp_path)
     check_png(out["path"])
@@ -74,6 +76,7 @@ def test_stage_pid_example(tmp_path):
     assert "ki = " in report(out)
 
 
+@pytest.mark.slow  # an example script end to end: .ci/run's second command (-m slow)
 def test_stage_antiwindup_example(tmp_path):
     out = load("stage_antiwindup").main(tmp_path)
     check_png(out["path"])

@@ -19,6 +19,8 @@ import pytest
 
 from prefriction.cli.paper import FIGURES, load_example, write_report
 
+pytestmark = pytest.mark.slow  # every figure script end to end: .ci/run's second command (-m slow)
+
 mp.mp.dps = 30
 
 

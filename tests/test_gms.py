@@ -389,6 +389,7 @@ def test_simulate_loop_in_the_linear_regime_is_the_linear_loop():
 
 
 # ------------------------------------------------------------------ the figure script
+@pytest.mark.slow  # an example script end to end: .ci/run's second command (-m slow)
 def test_memory_figure_inner_loops_close(tmp_path):
     """``examples/gms_memory.py``: the inner loops close where they began.
 

@@ -44,6 +44,7 @@ def within(res: identify.FitResult, truth: np.ndarray, k: float = 3.0) -> None:
     assert np.all(z <= k), (z, res.report())
 
 
+@pytest.mark.slow  # an example script end to end: .ci/run's second command (-m slow)
 def test_fit_dahl_loops_example(tmp_path):
     ex = example("fit_dahl_loops")
     r = ex.main(tmp_path, quick=True)
@@ -77,6 +78,7 @@ def test_maxwell_slip_data_follow_the_virgin_curve_and_masing_branch():
     assert x[r] > 4e-6 and masing.sum() > 10 and (~masing).sum() > 5  # element 0 slips at the peak
 
 
+@pytest.mark.slow  # an example script end to end: .ci/run's second command (-m slow)
 def test_fit_maxwell_slip_example(tmp_path):
     ex = example("fit_maxwell_slip")
     r = ex.main(tmp_path, quick=True)
@@ -104,6 +106,7 @@ def test_lugre_reference_matches_the_closed_form_at_constant_velocity():
     np.testing.assert_allclose(F, exact, rtol=1e-7, atol=1e-9)
 
 
+@pytest.mark.slow  # an example script end to end: .ci/run's second command (-m slow)
 def test_fit_lugre_example(tmp_path):
     ex = example("fit_lugre")
     r = ex.main(tmp_path, quick=True)

@@ -319,6 +319,7 @@ def test_hunting_against_reference(ex):
     assert min(abs(p) for p in plateaus) > 0.05
 
 
+@pytest.mark.slow  # an example script end to end: .ci/run's second command (-m slow)
 def test_example_writes_its_figures(ex, tmp_path):
     out = ex.main(tmp_path, quick=True)
     assert len(out["pngs"]) == 5 and all(p.stat().st_size > 20_000 for p in out["pngs"])

@@ -405,6 +405,7 @@ def test_sweep_over_instances_of_one_structure():
         assert rel_err(r.reversals, maxwell_slip_reversals(s, v, 6)) <= 1e-9
 
 
+@pytest.mark.slow  # an example script end to end: .ci/run's second command (-m slow)
 def test_figure_script_draws_both_figures(tmp_path):
     import matplotlib
 

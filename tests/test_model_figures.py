@@ -14,6 +14,8 @@ import pytest
 import prefriction as pf
 from prefriction.cli.paper import load_example
 
+pytestmark = pytest.mark.slow  # an example script end to end: .ci/run's second command (-m slow)
+
 
 def test_model_figures(tmp_path):
     ex = load_example("model_figures")

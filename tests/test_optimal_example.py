@@ -6,8 +6,11 @@ import importlib.util
 from pathlib import Path
 
 import matplotlib
+import pytest
 
 matplotlib.use("Agg")
+
+pytestmark = pytest.mark.slow  # an example script end to end: .ci/run's second command (-m slow)
 
 EXAMPLE = Path(__file__).resolve().parent.parent / "examples" / "optimal_move.py"
 

@@ -16,6 +16,7 @@ from prefriction.cli import paper
 from prefriction.cli.paper import FIGURES, examples_dir
 
 
+@pytest.mark.slow  # an example script end to end: .ci/run's second command (-m slow)
 def test_paper_command_runs_the_scripts_prints_progress_and_writes_the_report(tmp_path, capsys, monkeypatch):
     # the command's plumbing on two cheap scripts; every script and the full report are
     # checked in tests/test_examples.py, which runs each figure once

@@ -18,6 +18,8 @@ import pytest
 
 import prefriction
 
+pytestmark = pytest.mark.slow  # builds and installs a wheel: .ci/run's second command (-m slow)
+
 ROOT = Path(__file__).resolve().parents[1]
 
 

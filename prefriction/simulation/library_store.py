@@ -8,22 +8,35 @@ inputs and outputs of the one it stands for, before the library is used: a trunc
 or foreign library (another structure's under this name), a directory in its place or a file
 that cannot be read is reported as a problem (a string) instead of being loaded, which could
 kill the process (SIGBUS, SIGILL). ``NAME_KEY.failed`` records a compilation that timed out,
-so later processes do not wait for the compiler again.
+so later processes do not wait for the compiler again. ``NAME_KEY.so.lock`` is the lock that one
+process holds (``fcntl.flock``) while it builds and publishes the library: a second process that
+needs the same library waits for it (:func:`build_lock`) and then loads the published library
+instead of compiling it again. The kernel releases the lock when its holder exits, so a killed
+process leaves no stale lock; without ``fcntl`` (Windows) there is no lock and two processes may
+both compile (each publishes the same bytes atomically).
 """
 
 from __future__ import annotations
 
 import atexit
+import contextlib
 import hashlib
 import os
 import shutil
 import tempfile
+import time
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Optional
 
 import casadi as ca
 
-__all__ = ["failure_note", "load", "private_dir", "publish", "record_failure", "unwritable", "verify"]
+try:
+    import fcntl
+except ImportError:  # Windows: no advisory file locks; concurrent builds stay correct, only duplicated
+    fcntl = None  # type: ignore[assignment]
+
+__all__ = ["build_lock", "failure_note", "load", "private_dir", "publish", "record_failure", "unwritable", "verify"]
 
 _PRIVATE: list[Path] = []
 
@@ -149,3 +162,47 @@ def failure_note(lib: Path) -> str:
     except OSError:
         return ""
     return f"{why} in an earlier process; delete {marker} to try again"
+
+
+@contextlib.contextmanager
+def build_lock(lib: Path, patience: float, waiting: Callable[[Path], None]) -> Iterator[bool]:
+    """Hold the lock beside ``lib`` while building it; yields True if the lock is held.
+
+    If another process holds it, ``waiting(lock_path)`` is called once and the lock is polled
+    until it is free or ``patience`` seconds [s] have passed; then (and where there is no
+    ``fcntl`` or the lock file cannot be opened) it yields False and the caller builds without
+    the lock, as it would with no other process: the publish is atomic either way.
+    """
+    if fcntl is None:
+        yield False
+        return
+    path = lib.with_name(lib.name + ".lock")
+    try:
+        fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+    except OSError:
+        yield False
+        return
+    try:
+        yield _acquire(fd, path, patience, waiting)
+    finally:
+        os.close(fd)  # closing the descriptor releases the lock
+
+
+def _acquire(fd: int, path: Path, patience: float, waiting: Callable[[Path], None]) -> bool:
+    """Take the exclusive lock on ``fd``, waiting at most ``patience`` [s]; True if taken."""
+    deadline = time.monotonic() + patience
+    told = False
+    while True:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            return True
+        except BlockingIOError:
+            pass
+        except OSError:  # a file system without locks
+            return False
+        if not told:
+            waiting(path)
+            told = True
+        if time.monotonic() >= deadline:
+            return False
+        time.sleep(0.02)
