@@ -74,7 +74,7 @@ def c_section(cmp: CComparison) -> str:
     """The lines printed by ``prefriction bench`` for :func:`c_comparison`."""
     return (f"\nPlain-C reference (headline, {N_REV} reversals, rtol {RTOL:g}; same Runge-Kutta 5(4) tableau, "
             f"states, scaling and step control as simulate, Newton on the dense output; gcc -O2, ctypes):\n"
-            f"  simulate {cmp.simulate_s * 1e3:.3f} ms end to end ({cmp.calls} integrator calls), error "
+            f"  simulate {cmp.simulate_s * 1e3:.3f} ms end to end ({cmp.calls} compiled call{'' if cmp.calls == 1 else 's'}), error "
             f"{cmp.simulate_error:.2e}\n"
             f"  plain C  {cmp.c_s * 1e3:.3f} ms ({cmp.c_steps} steps, {cmp.c_s / cmp.c_steps * 1e9:.0f} ns per step), "
             f"error {cmp.c_error:.2e}\n"
