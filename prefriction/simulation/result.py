@@ -23,9 +23,11 @@ class RunStats:
     setup_time : float
         Wall time spent building, compiling or loading the integrator [s] (0 when reused).
     calls : int
-        Number of integrator calls.
+        Number of calls into compiled code (the native driver of unforced runs: one per 65,536
+        reversals; a CasADi integrator: one per reversal or output interval).
     steps : int or None
-        Number of accepted integrator steps (None for compiled code, which keeps no statistics).
+        Number of accepted Runge-Kutta steps (None for compiled CasADi integrators, which keep
+        no statistics; counted by the native driver and by interpreted integrators).
     jit : str
         ``"compiled"``, ``"cached"`` (compiled code loaded from disk or memory) or ``"interpreted"``.
     events : int or None
