@@ -7,7 +7,11 @@ random generator seed 0) are swept serially, on ``ProcessPoolExecutor(2)`` and o
 ``LocalCluster`` of 2 worker processes with 1 thread each, at each size (1,000 and 10,000;
 ``--quick``: 200 and 1,000). The pool and the cluster are started and warmed (each worker has
 imported prefriction and run the structure) before the clock starts, as a user's long-lived pool
-would be; each time is the end-to-end :func:`prefriction.sweep` call.
+would be; each time is the end-to-end :func:`prefriction.sweep` call. For dask a line per size
+splits the two cores' time during the sweep (2 x wall) into the runs (the serial sweep's CPU
+time), the workers' other CPU time (unpickling, packing, dask's threads), the parent's CPU time
+(the scheduler of the ``LocalCluster``, the client, the sweep's own bookkeeping) and the rest
+(cores idle, or taken by other processes).
 """
 
 from __future__ import annotations
@@ -47,6 +51,9 @@ class ScaleRow:
     sample_sweep_s: float = math.nan
     single_s: float = math.nan
     c_s: float = math.nan
+    serial_cpu_s: float = math.nan
+    dask_parent_cpu_s: float = math.nan
+    dask_worker_cpu_s: float = math.nan
 
     @property
     def pool_speedup(self) -> float:
@@ -62,6 +69,19 @@ class ScaleRow:
     def dask_speedup(self) -> float:
         """Serial time over dask's (NaN without dask)."""
         return self.serial_s / self.dask_s
+
+    def dask_breakdown(self) -> str:
+        """The cores' time during the dask sweep, ``WORKERS x wall``, in shares: the runs (serial
+        CPU), the workers' other CPU, the parent's CPU and the rest (idle or other processes)."""
+        cores = WORKERS * self.dask_s
+        runs, parent = self.serial_cpu_s, self.dask_parent_cpu_s
+        extra = self.dask_worker_cpu_s - runs
+        rest = cores - runs - extra - parent
+        shares = [f"runs {100 * runs / cores:.0f}%"] + [
+            f"{name} {100 * part / cores:.0f}% ({1e3 * part / self.n:.3f} ms/system)"
+            for name, part in (("workers' other CPU", extra), ("parent CPU (scheduler, client, sweep)", parent),
+                               ("idle or other processes", rest))]
+        return f"dask at {self.n:,}, {WORKERS} x {self.dask_s:.2f} s of cores: " + ", ".join(shares)
 
 
 def scale_systems(n: int) -> list[Oscillator]:
@@ -91,6 +111,16 @@ def _timed(systems: list, executor: Any) -> tuple[float, int]:
     start = time.perf_counter()
     res = sweep(systems, 1.0, reversals=N_REV, executor=executor, progress=False)
     return time.perf_counter() - start, len(res.failed)
+
+
+def _timed_dask(systems: list, client: Any) -> tuple[float, int, float, float]:
+    """:func:`_timed` on dask, with the CPU time [s] of this process (scheduler, client, sweep) and
+    of the worker processes during the sweep."""
+    before = sum(client.run(time.process_time).values())
+    cpu = time.process_time()
+    seconds, failed = _timed(systems, client)
+    cpu = time.process_time() - cpu
+    return seconds, failed, cpu, sum(client.run(time.process_time).values()) - before
 
 
 def _dask_client(stack: ExitStack) -> Optional[Any]:
@@ -158,15 +188,18 @@ def measure_scaling(sizes: tuple[int, ...]) -> list[ScaleRow]:
             systems = scale_systems(n)
             load = os.getloadavg()[0]
             progress(f"scaling: {n:,} systems serially")
+            serial_cpu = time.process_time()
             serial, failed = _timed(systems, None)
+            serial_cpu = time.process_time() - serial_cpu
             progress(f"scaling: {n:,} systems on ProcessPoolExecutor({WORKERS}) (serial {serial:.1f} s)")
             pool_s, f_pool = _timed(systems, pool)
-            dask_s, f_dask = math.nan, 0
+            dask_s, f_dask, parent_cpu, worker_cpu = math.nan, 0, math.nan, math.nan
             if client is not None:
                 progress(f"scaling: {n:,} systems on dask LocalCluster({WORKERS} x 1) (pool {pool_s:.1f} s)")
-                dask_s, f_dask = _timed(systems, client)
+                dask_s, f_dask, parent_cpu, worker_cpu = _timed_dask(systems, client)
             progress(f"scaling: {N_SAMPLE} of the {n:,} systems: sweep, one by one and plain C, interleaved")
-            rows.append(ScaleRow(n, load, serial, pool_s, dask_s, failed + f_pool + f_dask, *single_runs(systems)))
+            rows.append(ScaleRow(n, load, serial, pool_s, dask_s, failed + f_pool + f_dask, *single_runs(systems),
+                                 serial_cpu, parent_cpu, worker_cpu))
     return rows
 
 
@@ -180,6 +213,7 @@ def format_scaling(rows: list[ScaleRow]) -> str:
     for r in rows:
         lines.append(f"{r.n:>8,} {r.load:>5.1f} {r.serial_s:>9.2f} {r.serial_s / r.n * 1e3:>9.3f} {r.pool_s:>10.2f} "
                      f"{r.pool_speedup:>7.2f}x {r.dask_s:>11.2f} {r.dask_speedup:>7.2f}x {r.failed:>6}")
+    lines.extend(r.dask_breakdown() for r in rows if not math.isnan(r.dask_parent_cpu_s))
     lines.append(f"Per system, on {N_SAMPLE} of the systems in 5 interleaved rounds (least of each): a serial sweep of "
                  f"them, simulate one by one, the plain-C reference one by one (docs/bench.md#plain-c)")
     lines.append(f"{'systems':>8} {'sweep ms':>9} {'simulate ms':>11} {'ratio':>6} {'plain C ms':>10} {'ratio':>6}")
