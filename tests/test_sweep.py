@@ -214,8 +214,8 @@ def test_dask_in_process_cluster_with_a_failing_run(serial: SweepResult) -> None
 def test_chunk_sizes() -> None:
     from prefriction.simulation.chunks import MAX_CHUNK, chunk_size
 
-    assert chunk_size(1, 2) == 1 and chunk_size(16, 2) == 1 and chunk_size(17, 2) == 2
-    assert chunk_size(10_000, 2) == 500 == MAX_CHUNK and chunk_size(1000, 2) == 63
+    assert chunk_size(1, 2) == 1 and chunk_size(8, 2) == 1 and chunk_size(9, 2) == 2  # n / (4 workers)
+    assert chunk_size(10_000, 2) == 500 == MAX_CHUNK and chunk_size(1000, 2) == 125
     with pytest.raises(ValueError, match=r"chunksize must be an integer >= 1, got 0"):
         sweep(SYSTEMS, 1.0, reversals=N_REV, chunksize=0)
     with pytest.raises(TypeError, match=r"chunksize must be an integer"):

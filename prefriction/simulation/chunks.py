@@ -31,7 +31,7 @@ __all__ = ["MAX_CHUNK", "Runs", "chunk_size", "chunk_sizes", "run_chunk", "run_c
 
 MAX_CHUNK = 500
 """Most systems per chunk of the automatic chunk size (progress and memory per task stay small)."""
-_CHUNKS_PER_WORKER = 8  # automatic chunk size: about this many chunks per worker (load balance)
+_CHUNKS_PER_WORKER = 4  # automatic chunk size: about this many full chunks per worker (a dask task costs ~5 ms of CPU)
 _TAIL_PER_WORKER = 2  # automatic sizes shrink once fewer than this many full chunks per worker remain
 _SMALLEST = 4  # ... down to a quarter of the full size
 _IN_FLIGHT_PER_WORKER = 3  # chunks submitted ahead per worker: none waits for the parent
