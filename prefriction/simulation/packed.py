@@ -67,16 +67,14 @@ class Packed:
         """
         count = len(self.positions)
         values = {name: _decode(col, count) for name, col in self.columns.items()}
-        parts = {}
         for part in ("reversals", "stats"):
-            names = _FIELDS[part]
-            parts[part] = [_rebuild(_PARTS[part], dict(zip(names, row)))
-                           for row in zip(*(values[f"{part}.{name}"] for name in names))]
-        rows = zip(parts["reversals"], parts["stats"], *(values[name] for name in _OWN))
+            values[part] = _rebuild(_PARTS[part], _FIELDS[part], [values[f"{part}.{name}"] for name in _FIELDS[part]])
+        results = _rebuild(SimulationResult, _FIELDS[""], [values[name] for name in _FIELDS[""]])
+        if not self.others:
+            return results
         out: list[Any] = [None] * self.n
-        for k, (tab, stats, *own) in zip(self.positions.tolist(), rows):
-            fields = dict(zip(_OWN, own), reversals=tab, stats=stats)
-            out[k] = _rebuild(SimulationResult, fields)
+        for k, result in zip(self.positions.tolist(), results):
+            out[k] = result
         for k, outcome in self.others:
             out[k] = outcome
         return out
@@ -117,12 +115,16 @@ def _plain(outcome: Any) -> bool:
             and type(outcome.stats) is RunStats and outcome.stats.__dict__.keys() == _KEYS["stats"])
 
 
-def _rebuild(cls: type, fields: dict) -> Any:
-    """An instance of the dataclass ``cls`` with ``fields``, made as unpickling makes it (no
-    ``__init__``: the fields were checked when the worker built the original)."""
-    obj = object.__new__(cls)
-    obj.__dict__.update(fields)
-    return obj
+def _rebuild(cls: type, names: tuple, columns: list) -> list:
+    """Instances of the dataclass ``cls``, one per row of ``columns`` (one per field of ``names``),
+    made as unpickling makes them (no ``__init__``: the worker built and checked the originals)."""
+    new, set_dict = object.__new__, object.__setattr__
+    out = []
+    for row in zip(*columns):
+        obj = new(cls)
+        set_dict(obj, "__dict__", dict(zip(names, row)))
+        out.append(obj)
+    return out
 
 
 def _encode(values: list) -> tuple:
@@ -152,8 +154,8 @@ def _uniform(arrays: list) -> bool:
 
 
 def _decode(col: tuple, count: int) -> list:
-    """The ``count`` values of a column made by :func:`_encode`; arrays are views into one
-    writable copy of the column's data (so a kept array holds at most its column of the chunk)."""
+    """The ``count`` values of a column made by :func:`_encode`; arrays are views into the
+    column's data (made writable), so a kept array holds at most its column of the chunk."""
     kind = col[0]
     if kind == "none":
         return [None] * count
@@ -161,7 +163,7 @@ def _decode(col: tuple, count: int) -> list:
         return col[1].tolist()
     if kind == "list":
         return col[1]
-    data, shapes = col[1].copy(), col[2]
+    data, shapes = col[1] if col[1].flags.writeable else col[1].copy(), col[2]  # dask's arrive read-only
     if shapes.shape[1] == 1 and count and (shapes[:, 0] == shapes[0, 0]).all() and shapes[0, 0] >= 0:
         return list(data.reshape(count, int(shapes[0, 0])))  # one length (the usual case): the rows
     sizes = np.where(shapes[:, 0] < 0, 0, np.prod(shapes, axis=1))
