@@ -7,7 +7,8 @@ random generator seed 0) are swept serially, on ``ProcessPoolExecutor(2)`` and o
 ``LocalCluster`` of 2 worker processes with 1 thread each, at each size (1,000 and 10,000;
 ``--quick``: 200 and 1,000). The pool and the cluster are started and warmed (each worker has
 imported prefriction and run the structure) before the clock starts, as a user's long-lived pool
-would be; each time is the end-to-end :func:`prefriction.sweep` call. For dask a line per size
+would be; each time is the end-to-end :func:`prefriction.sweep` call, the least of
+:data:`ROUNDS` interleaved rounds (serial, pool, dask; ``--quick``: one). For dask a line per size
 splits the two cores' time during the sweep (2 x wall) into the runs (the serial sweep's CPU
 time), the workers' other CPU time (unpickling, packing, dask's threads), the parent's CPU time
 (the scheduler of the ``LocalCluster``, the client, the sweep's own bookkeeping) and the rest
@@ -30,6 +31,7 @@ from prefriction.cli.bench.timing import progress
 from prefriction.models import Dahl, Oscillator
 
 SIZES, QUICK_SIZES = (1_000, 10_000), (200, 1_000)
+ROUNDS = 2  # interleaved rounds of serial, pool and dask per size (least of each): load bursts of other processes
 WORKERS = 2
 N_REV = 50
 POOL_TARGET, DASK_TARGET = 1.6, 1.4  # least speed-up over serial: pool at every size, dask at the largest
@@ -162,18 +164,28 @@ def single_runs(systems: list, rounds: int = 5) -> tuple[float, float, float]:
     return best[0] / len(sample), best[1] / len(sample), best[2] / len(sample) if has_c else math.nan
 
 
-def measure_scaling(sizes: tuple[int, ...]) -> list[ScaleRow]:
-    """Sweep ``scale_systems(n)`` serially, on the pool and on dask for each ``n`` of ``sizes``.
+def _keep(best: dict, key: str, timing: tuple) -> None:
+    """Keep in ``best[key]`` the faster of it and ``timing`` (wall time first)."""
+    if key not in best or timing[0] < best[key][0]:
+        best[key] = timing
+
+
+def measure_scaling(sizes: tuple[int, ...], rounds: int = ROUNDS) -> list[ScaleRow]:
+    """Sweep ``scale_systems(n)`` serially, on the pool and on dask for each ``n`` of ``sizes``,
+    in ``rounds`` interleaved rounds (serial, pool, dask); each time is the least of its rounds.
 
     Parameters
     ----------
     sizes : tuple of int
         Numbers of systems.
+    rounds : int, optional
+        Rounds per size (default :data:`ROUNDS`).
 
     Returns
     -------
     list of ScaleRow
-        One row per size (``dask_s`` NaN if dask.distributed is not installed).
+        One row per size (``dask_s`` NaN if dask.distributed is not installed); ``load`` is the
+        highest 1-minute load average at the start of a round, ``failed`` counts every round.
     """
     rows = []
     with ExitStack() as stack:
@@ -186,19 +198,29 @@ def measure_scaling(sizes: tuple[int, ...]) -> list[ScaleRow]:
             _timed(warm, client)
         for n in sizes:
             systems = scale_systems(n)
-            load = os.getloadavg()[0]
-            progress(f"scaling: {n:,} systems serially")
-            serial_cpu = time.process_time()
-            serial, failed = _timed(systems, None)
-            serial_cpu = time.process_time() - serial_cpu
-            progress(f"scaling: {n:,} systems on ProcessPoolExecutor({WORKERS}) (serial {serial:.1f} s)")
-            pool_s, f_pool = _timed(systems, pool)
-            dask_s, f_dask, parent_cpu, worker_cpu = math.nan, 0, math.nan, math.nan
-            if client is not None:
-                progress(f"scaling: {n:,} systems on dask LocalCluster({WORKERS} x 1) (pool {pool_s:.1f} s)")
-                dask_s, f_dask, parent_cpu, worker_cpu = _timed_dask(systems, client)
+            best: dict[str, tuple] = {}  # the fastest round of each: (wall, CPU times ...)
+            loads, failed = [], 0
+            for k in range(rounds):
+                loads.append(os.getloadavg()[0])
+                tag = f"{n:,} systems [{k + 1}/{rounds}]"
+                progress(f"scaling: {tag} serially")
+                cpu = time.process_time()
+                seconds, f = _timed(systems, None)
+                failed += f
+                _keep(best, "serial", (seconds, time.process_time() - cpu))
+                progress(f"scaling: {tag} on ProcessPoolExecutor({WORKERS}) (serial {seconds:.1f} s)")
+                seconds, f = _timed(systems, pool)
+                failed += f
+                _keep(best, "pool", (seconds,))
+                if client is not None:
+                    progress(f"scaling: {tag} on dask LocalCluster({WORKERS} x 1) (pool {seconds:.1f} s)")
+                    seconds, f, parent_cpu, worker_cpu = _timed_dask(systems, client)
+                    failed += f
+                    _keep(best, "dask", (seconds, parent_cpu, worker_cpu))
             progress(f"scaling: {N_SAMPLE} of the {n:,} systems: sweep, one by one and plain C, interleaved")
-            rows.append(ScaleRow(n, load, serial, pool_s, dask_s, failed + f_pool + f_dask, *single_runs(systems),
+            (serial, serial_cpu), (pool_s,) = best["serial"], best["pool"]
+            dask_s, parent_cpu, worker_cpu = best.get("dask", (math.nan,) * 3)
+            rows.append(ScaleRow(n, max(loads), serial, pool_s, dask_s, failed, *single_runs(systems),
                                  serial_cpu, parent_cpu, worker_cpu))
     return rows
 
@@ -206,8 +228,9 @@ def measure_scaling(sizes: tuple[int, ...]) -> list[ScaleRow]:
 def format_scaling(rows: list[ScaleRow]) -> str:
     """The table of the scaling section."""
     lines = [f"Scaling: unforced Dahl, gamma in [1, 3], sigma in [1e3, 1e5] N/m, {N_REV} reversals, rtol 1e-8; "
-             f"end-to-end sweep time, pool and cluster started and warm; load: the machine's 1-minute load "
-             f"average before the size (another process on a core halves a {WORKERS}-worker speed-up)",
+             f"end-to-end sweep time, least of the interleaved rounds, pool and cluster started and warm; load: "
+             f"the machine's highest 1-minute load average at the start of a round (another process on a core "
+             f"halves a {WORKERS}-worker speed-up)",
              f"{'systems':>8} {'load':>5} {'serial s':>9} {'ms/system':>9} {'pool(2) s':>10} {'speed-up':>8} "
              f"{'dask(2x1) s':>11} {'speed-up':>8} {'failed':>6}"]
     for r in rows:
