@@ -134,6 +134,13 @@ def test_scaling_targets_and_table() -> None:
     assert "PASS" in scaling_targets(no_dask, False)[0] and "not installed" in scaling_targets(no_dask, False)[0]
     table = format_scaling(good)
     assert "10,000" in table and "1.67x" in table and "1.43x" in table and "  1.05 " in table and "  2.22" in table
+    assert "dask at" not in table  # no CPU times: no breakdown line
+    timed = ScaleRow(10_000, 0.5, 20.0, 12.0, 14.0, 0, serial_cpu_s=19.6, dask_parent_cpu_s=0.5, dask_worker_cpu_s=20.4)
+    # 2 x 14 s = 28 s of cores: runs 19.6 s, workers' other 0.8 s, parent 0.5 s, rest 7.1 s
+    assert timed.dask_breakdown() == ("dask at 10,000, 2 x 14.00 s of cores: runs 70%, workers' other CPU 3% "
+                                      "(0.080 ms/system), parent CPU (scheduler, client, sweep) 2% (0.050 ms/system), "
+                                      "idle or other processes 25% (0.710 ms/system)")
+    assert timed.dask_breakdown() in format_scaling([timed])
     a, b = scale_systems(3), scale_systems(3)
     assert [s.friction.gamma for s in a] == [s.friction.gamma for s in b]
     assert all(1.0 <= s.friction.gamma <= 3.0 and 1e3 <= s.friction.sigma <= 1e5 for s in a)

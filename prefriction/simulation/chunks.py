@@ -8,6 +8,10 @@ is bounded, so a sweep of 10,000 systems costs no more bookkeeping per system th
 (one future per system cost ``wait(FIRST_COMPLETED)`` 3.3 ms per call at 10,000 pending ones:
 quadratic in the systems, 2.2x slower than serial on two processes).
 
+On an executor that pickles (processes, dask) a chunk's task is :func:`run_packed`: its
+results come back packed in a few arrays (:mod:`prefriction.simulation.packed`) and are rebuilt
+here; a thread pool's chunks run :func:`run_chunk` and return the results themselves.
+
 A run that raises leaves its exception in its place; a chunk whose task fails as a whole (a
 worker that died, a result that cannot be pickled) leaves that exception in each of its places.
 """
@@ -15,17 +19,21 @@ worker that died, a result that cannot be pickled) leaves that exception in each
 from __future__ import annotations
 
 import concurrent.futures as cf
+import itertools
 import math
 from typing import Any, Callable, Optional
 
 from prefriction.models import Oscillator
+from prefriction.simulation.packed import Packed, pack
 from prefriction.simulation.simulate import simulate
 
-__all__ = ["MAX_CHUNK", "chunk_size", "run_chunk", "run_chunks", "worker_count"]
+__all__ = ["MAX_CHUNK", "Runs", "chunk_size", "chunk_sizes", "run_chunk", "run_chunks", "run_packed", "worker_count"]
 
 MAX_CHUNK = 500
 """Most systems per chunk of the automatic chunk size (progress and memory per task stay small)."""
-_CHUNKS_PER_WORKER = 8  # automatic chunk size: about this many chunks per worker (load balance)
+_CHUNKS_PER_WORKER = 4  # automatic chunk size: about this many full chunks per worker (a dask task costs ~5 ms of CPU)
+_TAIL_PER_WORKER = 2  # automatic sizes shrink once fewer than this many full chunks per worker remain
+_SMALLEST = 4  # ... down to a quarter of the full size
 _IN_FLIGHT_PER_WORKER = 3  # chunks submitted ahead per worker: none waits for the parent
 _WAIT = 0.5  # longest wait for a chunk before the progress line is refreshed [s]
 
@@ -42,6 +50,26 @@ def run_chunk(systems: list, v0s: list, kwargs: dict) -> list:
     """The runs of one chunk, in order: each a result or the exception it raised (module level,
     so that executors can pickle it)."""
     return [run_caught(system, v0, kwargs) for system, v0 in zip(systems, v0s)]
+
+
+class Runs:
+    """The systems and initial velocities of one chunk as one argument: dask walks a task's list
+    arguments element by element looking for futures (7 µs per system in the parent); an object
+    of its own it pickles whole."""
+
+    __slots__ = ("systems", "v0s")
+
+    def __init__(self, systems: list, v0s: list) -> None:
+        self.systems, self.v0s = systems, v0s
+
+    def __reduce__(self) -> tuple:
+        return Runs, (self.systems, self.v0s)
+
+
+def run_packed(runs: Runs, kwargs: dict) -> Packed:
+    """:func:`run_chunk` of ``runs``, its outcomes packed for the trip back
+    (:func:`prefriction.simulation.packed.pack`): the task of executors that pickle."""
+    return pack(run_chunk(runs.systems, runs.v0s, kwargs))
 
 
 def worker_count(executor: cf.Executor) -> int:
@@ -65,10 +93,29 @@ def chunk_size(n: int, workers: int) -> int:
     return max(1, min(MAX_CHUNK, math.ceil(n / (workers * _CHUNKS_PER_WORKER))))
 
 
+def chunk_sizes(n: int, workers: int, size: Optional[int] = None) -> list[int]:
+    """Sizes of the consecutive chunks of ``n`` runs: ``size`` each (the last one the rest), or
+    automatic (``size=None``): :func:`chunk_size` each, and once fewer than
+    :data:`_TAIL_PER_WORKER` such chunks per worker remain, ``remaining / (2 workers)`` each, down
+    to a quarter of the full size, so that the workers finish within a small chunk of each other.
+    """
+    if size is not None:
+        return [size] * (n // size) + ([n % size] if n % size else [])
+    full = chunk_size(n, workers)
+    least = math.ceil(full / _SMALLEST)
+    sizes = []
+    left = n
+    while left > 0:
+        k = min(full, max(least, math.ceil(left / (_TAIL_PER_WORKER * workers))), left)
+        sizes.append(k)
+        left -= k
+    return sizes
+
+
 def run_chunks(executor: cf.Executor, items: list, systems: list, v0s: list, kwargs: dict, results: list,
                size: Optional[int], update: Callable[[int], None]) -> None:
     """Run the systems ``items`` (indices into ``systems``) on ``executor`` in chunks of ``size``
-    (None: :func:`chunk_size`) and write each result (or exception) into ``results[i]``.
+    (None: :func:`chunk_sizes`) and write each result (or exception) into ``results[i]``.
 
     At most :data:`_IN_FLIGHT_PER_WORKER` chunks per worker are in flight; ``update(k)`` is
     called with the number of runs finished so far after each chunk, and at least every 0.5 s.
@@ -76,9 +123,10 @@ def run_chunks(executor: cf.Executor, items: list, systems: list, v0s: list, kwa
     cancelled and it propagates.
     """
     workers = worker_count(executor)
-    size = size or chunk_size(len(items), workers)
-    chunks = [items[k:k + size] for k in range(0, len(items), size)]
+    sizes = chunk_sizes(len(items), workers, size)
+    chunks = [items[end - k:end] for k, end in zip(sizes, itertools.accumulate(sizes))]
     window = max(2, _IN_FLIGHT_PER_WORKER * workers)
+    threads = isinstance(executor, cf.ThreadPoolExecutor)  # nothing to pickle: plain lists, results as they are
     pending: dict = {}
     done = 0
     next_chunk = 0
@@ -86,7 +134,9 @@ def run_chunks(executor: cf.Executor, items: list, systems: list, v0s: list, kwa
         while next_chunk < len(chunks) or pending:
             while next_chunk < len(chunks) and len(pending) < window:
                 idx = chunks[next_chunk]
-                future = executor.submit(run_chunk, [systems[i] for i in idx], [v0s[i] for i in idx], kwargs)
+                chunk = ([systems[i] for i in idx], [v0s[i] for i in idx])
+                future = executor.submit(run_chunk, *chunk, kwargs) if threads else \
+                    executor.submit(run_packed, Runs(*chunk), kwargs)
                 pending[future] = idx
                 next_chunk += 1
             finished = _wait_some(pending)
@@ -114,14 +164,16 @@ def _wait_some(pending: dict) -> list:
 
 
 def _outcome(future: Any, n: int) -> list:
-    """The ``n`` outcomes of a finished chunk: its list of results, or its task's exception ``n``
-    times (a cancelled chunk gives ``CancelledError``)."""
+    """The ``n`` outcomes of a finished chunk: its list of results (unpacked), or its task's
+    exception ``n`` times (a cancelled chunk gives ``CancelledError``)."""
     try:
         out = future.result()
     except BaseException as exc:  # noqa: BLE001 - a failed chunk is a result of the sweep
         if isinstance(exc, (KeyboardInterrupt, SystemExit)):
             raise
         return [exc] * n
+    if isinstance(out, Packed) and len(out) == n:
+        out = out.unpack()
     if not isinstance(out, list) or len(out) != n:
         exc = RuntimeError(f"a chunk of {n} runs returned {type(out).__name__} instead of {n} results")
         return [exc] * n

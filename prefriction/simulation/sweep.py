@@ -132,7 +132,9 @@ def sweep(
         turns, since they share compiled integrators), or dask.distributed's
         ``client.get_executor()`` (a ``Client`` itself is accepted and converted). The systems
         go to the executor in chunks (one task per chunk, a few chunks per worker in flight;
-        see ``chunksize``), so the bookkeeping is linear in the number of systems. The first
+        see ``chunksize``), so the bookkeeping is linear in the number of systems; on an
+        executor that pickles, a chunk's results come back packed in a few arrays and are
+        rebuilt here (:mod:`prefriction.simulation.packed`). The first
         system of each structure group runs in the calling process first, so that the compiled
         code is in the disk cache before the workers start (workers on other machines need the
         cache directory ``$PREFRICTION_CACHE`` on a shared file system, or compile once each).
@@ -145,10 +147,11 @@ def sweep(
         stderr, updated in place every 0.5 s, once the sweep has run for 1 s (short sweeps print
         nothing). ``True``: always print it; ``False``: never.
     chunksize : int, optional
-        Systems per task on an executor (ignored without one). ``None`` (default): about 8
-        chunks per worker, at most 500 systems each
-        (:func:`prefriction.simulation.chunks.chunk_size`). A larger chunk costs less per
-        system to ship; a smaller one balances the load and updates the progress more often.
+        Systems per task on an executor (ignored without one). ``None`` (default): chunks of
+        about ``n / (4 workers)`` systems, at most 500, smaller over the last two per worker so
+        that the workers finish together (:func:`prefriction.simulation.chunks.chunk_sizes`).
+        A larger chunk costs less per system to ship; a smaller one balances the load and
+        updates the progress more often.
     **simulate_kwargs
         Keyword arguments of :func:`prefriction.simulate` for every run, passed unchanged
         (``reversals``, ``t_end``, ``rtol``, ``x0``, ``F0``, ``dense``, ``feedback``, ...).

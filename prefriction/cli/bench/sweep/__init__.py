@@ -104,7 +104,7 @@ def main(argv: Optional[list[str]] = None) -> int:
     for note in match_notes(rows):
         print(note)
     print()
-    scale = measure_scaling(QUICK_SIZES if args.quick else SIZES)
+    scale = measure_scaling(QUICK_SIZES, rounds=1) if args.quick else measure_scaling(SIZES)
     print()
     print(format_scaling(scale))
     print()

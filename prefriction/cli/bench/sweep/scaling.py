@@ -7,7 +7,12 @@ random generator seed 0) are swept serially, on ``ProcessPoolExecutor(2)`` and o
 ``LocalCluster`` of 2 worker processes with 1 thread each, at each size (1,000 and 10,000;
 ``--quick``: 200 and 1,000). The pool and the cluster are started and warmed (each worker has
 imported prefriction and run the structure) before the clock starts, as a user's long-lived pool
-would be; each time is the end-to-end :func:`prefriction.sweep` call.
+would be; each time is the end-to-end :func:`prefriction.sweep` call, the least of
+:data:`ROUNDS` interleaved rounds (serial, pool, dask; ``--quick``: one). For dask a line per size
+splits the two cores' time during the sweep (2 x wall) into the runs (the serial sweep's CPU
+time), the workers' other CPU time (unpickling, packing, dask's threads), the parent's CPU time
+(the scheduler of the ``LocalCluster``, the client, the sweep's own bookkeeping) and the rest
+(cores idle, or taken by other processes).
 """
 
 from __future__ import annotations
@@ -26,6 +31,7 @@ from prefriction.cli.bench.timing import progress
 from prefriction.models import Dahl, Oscillator
 
 SIZES, QUICK_SIZES = (1_000, 10_000), (200, 1_000)
+ROUNDS = 2  # interleaved rounds of serial, pool and dask per size (least of each): load bursts of other processes
 WORKERS = 2
 N_REV = 50
 POOL_TARGET, DASK_TARGET = 1.6, 1.4  # least speed-up over serial: pool at every size, dask at the largest
@@ -47,6 +53,9 @@ class ScaleRow:
     sample_sweep_s: float = math.nan
     single_s: float = math.nan
     c_s: float = math.nan
+    serial_cpu_s: float = math.nan
+    dask_parent_cpu_s: float = math.nan
+    dask_worker_cpu_s: float = math.nan
 
     @property
     def pool_speedup(self) -> float:
@@ -62,6 +71,19 @@ class ScaleRow:
     def dask_speedup(self) -> float:
         """Serial time over dask's (NaN without dask)."""
         return self.serial_s / self.dask_s
+
+    def dask_breakdown(self) -> str:
+        """The cores' time during the dask sweep, ``WORKERS x wall``, in shares: the runs (serial
+        CPU), the workers' other CPU, the parent's CPU and the rest (idle or other processes)."""
+        cores = WORKERS * self.dask_s
+        runs, parent = self.serial_cpu_s, self.dask_parent_cpu_s
+        extra = self.dask_worker_cpu_s - runs
+        rest = cores - runs - extra - parent
+        shares = [f"runs {100 * runs / cores:.0f}%"] + [
+            f"{name} {100 * part / cores:.0f}% ({1e3 * part / self.n:.3f} ms/system)"
+            for name, part in (("workers' other CPU", extra), ("parent CPU (scheduler, client, sweep)", parent),
+                               ("idle or other processes", rest))]
+        return f"dask at {self.n:,}, {WORKERS} x {self.dask_s:.2f} s of cores: " + ", ".join(shares)
 
 
 def scale_systems(n: int) -> list[Oscillator]:
@@ -91,6 +113,16 @@ def _timed(systems: list, executor: Any) -> tuple[float, int]:
     start = time.perf_counter()
     res = sweep(systems, 1.0, reversals=N_REV, executor=executor, progress=False)
     return time.perf_counter() - start, len(res.failed)
+
+
+def _timed_dask(systems: list, client: Any) -> tuple[float, int, float, float]:
+    """:func:`_timed` on dask, with the CPU time [s] of this process (scheduler, client, sweep) and
+    of the worker processes during the sweep."""
+    before = sum(client.run(time.process_time).values())
+    cpu = time.process_time()
+    seconds, failed = _timed(systems, client)
+    cpu = time.process_time() - cpu
+    return seconds, failed, cpu, sum(client.run(time.process_time).values()) - before
 
 
 def _dask_client(stack: ExitStack) -> Optional[Any]:
@@ -132,18 +164,28 @@ def single_runs(systems: list, rounds: int = 5) -> tuple[float, float, float]:
     return best[0] / len(sample), best[1] / len(sample), best[2] / len(sample) if has_c else math.nan
 
 
-def measure_scaling(sizes: tuple[int, ...]) -> list[ScaleRow]:
-    """Sweep ``scale_systems(n)`` serially, on the pool and on dask for each ``n`` of ``sizes``.
+def _keep(best: dict, key: str, timing: tuple) -> None:
+    """Keep in ``best[key]`` the faster of it and ``timing`` (wall time first)."""
+    if key not in best or timing[0] < best[key][0]:
+        best[key] = timing
+
+
+def measure_scaling(sizes: tuple[int, ...], rounds: int = ROUNDS) -> list[ScaleRow]:
+    """Sweep ``scale_systems(n)`` serially, on the pool and on dask for each ``n`` of ``sizes``,
+    in ``rounds`` interleaved rounds (serial, pool, dask); each time is the least of its rounds.
 
     Parameters
     ----------
     sizes : tuple of int
         Numbers of systems.
+    rounds : int, optional
+        Rounds per size (default :data:`ROUNDS`).
 
     Returns
     -------
     list of ScaleRow
-        One row per size (``dask_s`` NaN if dask.distributed is not installed).
+        One row per size (``dask_s`` NaN if dask.distributed is not installed); ``load`` is the
+        highest 1-minute load average at the start of a round, ``failed`` counts every round.
     """
     rows = []
     with ExitStack() as stack:
@@ -156,30 +198,45 @@ def measure_scaling(sizes: tuple[int, ...]) -> list[ScaleRow]:
             _timed(warm, client)
         for n in sizes:
             systems = scale_systems(n)
-            load = os.getloadavg()[0]
-            progress(f"scaling: {n:,} systems serially")
-            serial, failed = _timed(systems, None)
-            progress(f"scaling: {n:,} systems on ProcessPoolExecutor({WORKERS}) (serial {serial:.1f} s)")
-            pool_s, f_pool = _timed(systems, pool)
-            dask_s, f_dask = math.nan, 0
-            if client is not None:
-                progress(f"scaling: {n:,} systems on dask LocalCluster({WORKERS} x 1) (pool {pool_s:.1f} s)")
-                dask_s, f_dask = _timed(systems, client)
+            best: dict[str, tuple] = {}  # the fastest round of each: (wall, CPU times ...)
+            loads, failed = [], 0
+            for k in range(rounds):
+                loads.append(os.getloadavg()[0])
+                tag = f"{n:,} systems [{k + 1}/{rounds}]"
+                progress(f"scaling: {tag} serially")
+                cpu = time.process_time()
+                seconds, f = _timed(systems, None)
+                failed += f
+                _keep(best, "serial", (seconds, time.process_time() - cpu))
+                progress(f"scaling: {tag} on ProcessPoolExecutor({WORKERS}) (serial {seconds:.1f} s)")
+                seconds, f = _timed(systems, pool)
+                failed += f
+                _keep(best, "pool", (seconds,))
+                if client is not None:
+                    progress(f"scaling: {tag} on dask LocalCluster({WORKERS} x 1) (pool {seconds:.1f} s)")
+                    seconds, f, parent_cpu, worker_cpu = _timed_dask(systems, client)
+                    failed += f
+                    _keep(best, "dask", (seconds, parent_cpu, worker_cpu))
             progress(f"scaling: {N_SAMPLE} of the {n:,} systems: sweep, one by one and plain C, interleaved")
-            rows.append(ScaleRow(n, load, serial, pool_s, dask_s, failed + f_pool + f_dask, *single_runs(systems)))
+            (serial, serial_cpu), (pool_s,) = best["serial"], best["pool"]
+            dask_s, parent_cpu, worker_cpu = best.get("dask", (math.nan,) * 3)
+            rows.append(ScaleRow(n, max(loads), serial, pool_s, dask_s, failed, *single_runs(systems),
+                                 serial_cpu, parent_cpu, worker_cpu))
     return rows
 
 
 def format_scaling(rows: list[ScaleRow]) -> str:
     """The table of the scaling section."""
     lines = [f"Scaling: unforced Dahl, gamma in [1, 3], sigma in [1e3, 1e5] N/m, {N_REV} reversals, rtol 1e-8; "
-             f"end-to-end sweep time, pool and cluster started and warm; load: the machine's 1-minute load "
-             f"average before the size (another process on a core halves a {WORKERS}-worker speed-up)",
+             f"end-to-end sweep time, least of the interleaved rounds, pool and cluster started and warm; load: "
+             f"the machine's highest 1-minute load average at the start of a round (another process on a core "
+             f"halves a {WORKERS}-worker speed-up)",
              f"{'systems':>8} {'load':>5} {'serial s':>9} {'ms/system':>9} {'pool(2) s':>10} {'speed-up':>8} "
              f"{'dask(2x1) s':>11} {'speed-up':>8} {'failed':>6}"]
     for r in rows:
         lines.append(f"{r.n:>8,} {r.load:>5.1f} {r.serial_s:>9.2f} {r.serial_s / r.n * 1e3:>9.3f} {r.pool_s:>10.2f} "
                      f"{r.pool_speedup:>7.2f}x {r.dask_s:>11.2f} {r.dask_speedup:>7.2f}x {r.failed:>6}")
+    lines.extend(r.dask_breakdown() for r in rows if not math.isnan(r.dask_parent_cpu_s))
     lines.append(f"Per system, on {N_SAMPLE} of the systems in 5 interleaved rounds (least of each): a serial sweep of "
                  f"them, simulate one by one, the plain-C reference one by one (docs/bench.md#plain-c)")
     lines.append(f"{'systems':>8} {'sweep ms':>9} {'simulate ms':>11} {'ratio':>6} {'plain C ms':>10} {'ratio':>6}")
