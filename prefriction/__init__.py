@@ -81,7 +81,7 @@ __all__ = [
     "sweep",
     "symbolic",
 ]
-__version__ = "0.2.0"
+__version__ = "0.3.0"
 del annotations  # bound by the __future__ import; not part of the API
 
 

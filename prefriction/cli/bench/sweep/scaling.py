@@ -17,6 +17,7 @@ time), the workers' other CPU time (unpickling, packing, dask's threads), the pa
 
 from __future__ import annotations
 
+import logging
 import math
 import os
 import time
@@ -131,8 +132,9 @@ def _dask_client(stack: ExitStack) -> Optional[Any]:
         from dask.distributed import Client, LocalCluster
     except ImportError:
         return None
+    # silence_logs: a worker whose heartbeat meets the closing scheduler logs a traceback at ERROR
     cluster = stack.enter_context(LocalCluster(n_workers=WORKERS, threads_per_worker=1, processes=True,
-                                               dashboard_address=None))
+                                               dashboard_address=None, silence_logs=logging.CRITICAL))
     return stack.enter_context(Client(cluster))
 
 
