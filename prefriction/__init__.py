@@ -26,24 +26,29 @@ Public API, re-exported from private modules:
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, Any as _Any
+
 import casadi as _casadi
 
 from prefriction._requirements import check_casadi as _check_casadi
 
 _check_casadi(_casadi.__version__)
 
-from prefriction.errors import PrefrictionError, SolverError
-from prefriction.along import AlongResult, FrictionStream, friction_along
-from prefriction.models import GMS, Dahl, FrictionModel, LuGre, MaxwellSlip, Oscillator, Parallel, Parameter, Viscous
-from prefriction.reversals import ReversalTable
-from prefriction.units import Scales
-from prefriction.simulation.simulate import SimulationResult, simulate
-from prefriction.simulation.sweep import SweepResult, sweep
-from prefriction.simulation.feedback import LinearFeedback
-from prefriction.analysis import dahl, energy
-from prefriction import optimal, sensitivity, signals, symbolic
-from prefriction.sensitivity import sensitivities
-from prefriction.analysis.exact import exact_reversals
+if TYPE_CHECKING:  # the names below, imported on first use (module __getattr__)
+    from prefriction.errors import PrefrictionError, SolverError
+    from prefriction.along import AlongResult, FrictionStream, friction_along
+    from prefriction.models import (GMS, Dahl, FrictionModel, LuGre, MaxwellSlip, Oscillator, Parallel, Parameter,
+                                    Viscous)
+    from prefriction.reversals import ReversalTable
+    from prefriction.units import Scales
+    from prefriction.simulation.simulate import SimulationResult, simulate
+    from prefriction.simulation.sweep import SweepResult, sweep
+    from prefriction.simulation.feedback import LinearFeedback
+    from prefriction.analysis import dahl, energy
+    from prefriction import (controllers, data, describing, export, identify, optimal, sensitivity, signals,
+                             symbolic)
+    from prefriction.sensitivity import sensitivities
+    from prefriction.analysis.exact import exact_reversals
 
 __all__ = [
     "AlongResult",
@@ -82,16 +87,42 @@ __all__ = [
     "symbolic",
 ]
 __version__ = "0.3.0"
-del annotations  # bound by the __future__ import; not part of the API
+del annotations, TYPE_CHECKING  # bound by the imports above; not part of the API
+
+# where each public name lives: a module (None) or an attribute of a module. Importing the
+# package imports CasADi only (0.3 s, for the version check); scipy, python-control and the
+# rest load on first use of a name that needs them (0.8 s for everything).
+_WHERE = {
+    **dict.fromkeys(["PrefrictionError", "SolverError"], "prefriction.errors"),
+    **dict.fromkeys(["AlongResult", "FrictionStream", "friction_along"], "prefriction.along"),
+    **dict.fromkeys(["GMS", "Dahl", "FrictionModel", "LuGre", "MaxwellSlip", "Oscillator", "Parallel", "Parameter",
+                     "Viscous"], "prefriction.models"),
+    "ReversalTable": "prefriction.reversals",
+    "Scales": "prefriction.units",
+    **dict.fromkeys(["SimulationResult", "simulate"], "prefriction.simulation.simulate"),
+    **dict.fromkeys(["SweepResult", "sweep"], "prefriction.simulation.sweep"),
+    "LinearFeedback": "prefriction.simulation.feedback",
+    "sensitivities": "prefriction.sensitivity",
+    "exact_reversals": "prefriction.analysis.exact",
+}
+_MODULES = {"dahl": "prefriction.analysis.dahl", "energy": "prefriction.analysis.energy",
+            **{name: f"prefriction.{name}" for name in ("controllers", "data", "describing", "export", "identify",
+                                                         "optimal", "sensitivity", "signals", "symbolic")}}
 
 
-_LAZY = ("controllers", "data", "describing", "export", "identify")  # python-control (1.6 s) and scipy.stats (0.6 s) on first use
+def __getattr__(name: str) -> _Any:
+    """Import a public name on first use (and keep it: later lookups are plain attributes)."""
+    import importlib
+
+    if name in _MODULES:
+        value = importlib.import_module(_MODULES[name])
+    elif name in _WHERE:
+        value = getattr(importlib.import_module(_WHERE[name]), name)
+    else:
+        raise AttributeError(f"module 'prefriction' has no attribute {name!r}")
+    globals()[name] = value
+    return value
 
 
-def __getattr__(name: str):
-    """Import :mod:`prefriction.describing` and :mod:`prefriction.identify` on first use."""
-    if name in _LAZY:
-        import importlib
-
-        return importlib.import_module(f"prefriction.{name}")
-    raise AttributeError(f"module 'prefriction' has no attribute {name!r}")
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))
