@@ -84,3 +84,19 @@ def test_threads_run_the_driver_at_once_with_serial_results() -> None:
         th.join()
     for a, b in zip(out, serial):
         np.testing.assert_array_equal(a, b)
+
+
+def test_a_model_that_returns_nan_is_a_solver_error_naming_it() -> None:
+    """A user model whose force turns NaN past half of Fc: a SolverError at the time the state
+    gets there (F = 0.39 N, the last good step), saying the right-hand side became non-finite."""
+    import casadi as ca
+
+    class NaNDahl(pf.Dahl):
+        def force(self, z, m, v, s, q):  # type: ignore[no-untyped-def]
+            F = super().force(z, m, v, s, q)
+            if isinstance(z[0], ca.SX):
+                return F + ca.if_else(z[0] > 0.5, ca.SX(math.nan), 0.0)
+            return F + (math.nan if z[0] > 0.5 else 0.0)
+
+    with pytest.raises(pf.SolverError, match=r"failed after t = .* s .*right-hand side became non-finite"):
+        pf.simulate(pf.Oscillator(NaNDahl(1e4, 1.0, 1.0)), 1.0, reversals=5)

@@ -205,7 +205,7 @@ int pf_run(const double* q, double eps, double snap, double* st, double t_end, l
   double y[PF_NY], y0[PF_NY], ys[PF_NY], f0[PF_NY], e[PF_NY], U[7][PF_NY], g0[PF_NEA], g1[PF_NEA];
   double t = st[0], ne = st[4], t_last = st[5], t_prev = st[6], h, err, err_prev = 1.0, fac, dur;
   long n = 0, branch_steps = 0;
-  int i, j, rejected = 0, fsal = 0, code = PF_T_END;
+  int i, j, rejected = 0, fsal = 0, nonfinite = 0, code = PF_T_END;
   memset(&c, 0, sizeof c);
   c.q = q;
   c.snap = snap;
@@ -242,7 +242,7 @@ int pf_run(const double* q, double eps, double snap, double* st, double t_end, l
     }
     if (++branch_steps > PF_BRANCH_STEPS) { code = PF_TOO_MANY_STEPS; break; }
     if (t + h >= t_end) { h = t_end - t; last = 1; }
-    if (!(h > 1e-15 * fmax(fabs(t), 1e-300))) { code = PF_STEP_UNDERFLOW; break; }
+    if (!(h > 1e-15 * fmax(fabs(t), 1e-300))) { code = nonfinite ? PF_NONFINITE : PF_STEP_UNDERFLOW; break; }
     if (!fsal) { pf_f(&c, y, f0); fsal = 1; }
     for (i = 0; i < PF_NY; ++i) { y0[i] = y[i]; U[0][i] = h * f0[i]; }
     for (j = 1; j < 7; ++j) {
@@ -262,12 +262,14 @@ int pf_run(const double* q, double eps, double snap, double* st, double t_end, l
     }
     err = pf_norm(&S, e);
     if (!(err <= 1.0)) {
-      fac = isfinite(err) ? fmax(0.2, 0.9 * pow(err, -0.2)) : 0.25;
+      nonfinite = !isfinite(err); /* a step that overflowed (shrinks) or a NaN the model returns (stays) */
+      fac = nonfinite ? 0.25 : fmax(0.2, 0.9 * pow(err, -0.2));
       h *= fac;
       rejected = 1;
       continue;
     }
     ++*steps;
+    nonfinite = 0;
     /* events of the step: the reversal (s v < 0 at its end) and the model's indicators */
     sv = c.s * ys[1];
     if (sv < 0.0) { k_ev = -1; th_ev = pf_locate(&c, U, y0, -1, c.s * y0[1], sv); }
