@@ -66,7 +66,8 @@ def native_driver(model: FrictionModel) -> tuple[Optional[NativeDriver], float]:
     the compact CasADi loop) or a failed compilation."""
     if not jit_available() or model.has_free_branch:
         return None, 0.0
-    key: Hashable = model.structure_key()
+    # the class too: a subclass that changes the dynamics may keep its parent's structure_key
+    key: Hashable = (type(model).__module__, type(model).__qualname__, model.structure_key())
     with _LOCK:
         if key in _CACHE:
             return _CACHE[key], 0.0
