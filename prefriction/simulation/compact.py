@@ -12,7 +12,6 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
-from prefriction.models.base import FrictionModel
 from prefriction.simulation.integrator import INTEGRATOR_FAILED
 from prefriction.simulation.plant import EPS_DIED
 
@@ -52,18 +51,15 @@ def advance_compact(self: "Run", t_target: float, n_target: float) -> bool:
     t_stop = t_target * (1 - 1e-15) if t_target < math.inf else math.inf
     n = len(rev)
     # a model with closed-form branches (free_branch: e.g. Dahl gamma = 0 below saturation)
-    free = model.free_branch if type(model).free_branch is not FrictionModel.free_branch else None
+    free = model.free_branch if model.has_free_branch else None
 
-    def reversal(t: float, x: float, z: list, m: list, s: float, ne: int) -> tuple:
-        """Record the reversal at ``(t, x)`` with its events; the new direction and reset state.
+    def reset(z: list, m: list, s: float) -> tuple:
+        """The direction, state and force just after a reversal of the branch ``s``.
 
         The force is the one after the model's reset: an event within ``snap`` of the reversal
         is taken as coinciding with it (the reset puts its state on the switching surface)."""
-        s = -s
-        z, m = reverse(z, m, s, q, snap)
-        rev.append((t, x, float(force(z, m, 0.0, s, q)), 0.0))
-        rev_events.append(ne)
-        return s, z, m
+        z, m = reverse(z, m, -s, q, snap)
+        return -s, z, m, float(force(z, m, 0.0, -s, q))
 
     while n < n_target and t < t_stop:
         exact = free(z, m, v, s, q, t_target - t) if free is not None else None
@@ -74,7 +70,9 @@ def advance_compact(self: "Run", t_target: float, n_target: float) -> bool:
             if dt < t_target - t:  # a reversal
                 t += dt
                 n += 1
-                s, z, m = reversal(t, x, z, m, s, ne)
+                s, z, m, F = reset(z, m, s)
+                rev.append((t, x, F, 0.0))
+                rev_events.append(ne)
                 ne = 0
             else:
                 t = t_target
@@ -136,8 +134,8 @@ def advance_compact(self: "Run", t_target: float, n_target: float) -> bool:
         else:  # vh eps = -s (1 + tau) at a reversal: record it, start the branch of direction -s
             t = t + (t1 - t) * (-sv - 1.0)  # t0 + dur tau, as the integrator's time
             v = 0.0
-            zr, mr = reverse(z, m, -s, q, snap)
-            if not abs(float(force(zr, mr, 0.0, -s, q))) > EPS_DIED * eps * Fmax:  # at rest (plant.EPS_DIED)
+            sr, zr, mr, F = reset(z, m, s)
+            if not abs(F) > EPS_DIED * eps * Fmax:  # at rest (plant.EPS_DIED)
                 if t_target < math.inf:
                     t = t_target
                     break
@@ -145,7 +143,9 @@ def advance_compact(self: "Run", t_target: float, n_target: float) -> bool:
                 st.update(x=x, v=v, z=z, m=m, s=s, t=t, F=float(force(z, m, v, s, q)), ne=ne)
                 raise self._failure("its velocity crosses zero only at the level of the integration error")
             n += 1
-            s, z, m = reversal(t, x, z, m, s, ne)
+            s, z, m = sr, zr, mr
+            rev.append((t, x, F, 0.0))
+            rev_events.append(ne)
             ne = 0
             grow = 1.0
     self.calls += calls
