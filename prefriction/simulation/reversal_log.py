@@ -44,10 +44,8 @@ class ReversalLog:
 
     def extend_columns(self, t: np.ndarray, x: np.ndarray, F: np.ndarray) -> None:
         """Add reversals from columns of times, positions and forces (``W~ = 0``: unforced runs)."""
-        self.t.frombytes(np.ascontiguousarray(t, dtype=float).tobytes())
-        self.x.frombytes(np.ascontiguousarray(x, dtype=float).tobytes())
-        self.F.frombytes(np.ascontiguousarray(F, dtype=float).tobytes())
-        self.W.frombytes(np.zeros(len(t)).tobytes())
+        for col, values in ((self.t, t), (self.x, x), (self.F, F), (self.W, np.zeros(len(t)))):
+            col.frombytes(memoryview(np.ascontiguousarray(values, dtype=float)).cast("B"))  # no bytes copy
 
     def __len__(self) -> int:
         return len(self.t)

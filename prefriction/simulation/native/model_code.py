@@ -34,17 +34,9 @@ from pathlib import Path
 import casadi as ca
 
 from prefriction.models.base import FrictionModel
-from prefriction.simulation.plant import EPS_DIED, has_potential, model_event, _event_indices
+from prefriction.simulation.plant import EPS_DIED, _event_indices, _select, has_potential, model_event
 
 __all__ = ["model_functions", "model_source"]
-
-
-def _select(k: ca.SX, posts: list[ca.SX]) -> ca.SX:
-    """``posts[k]`` for the symbolic index ``k`` (the last one for any larger ``k``)."""
-    post = posts[-1]
-    for i in range(len(posts) - 2, -1, -1):
-        post = ca.if_else(k == i, posts[i], post)
-    return post
 
 
 def model_functions(model: FrictionModel) -> list[ca.Function]:
@@ -64,7 +56,7 @@ def model_functions(model: FrictionModel) -> list[ca.Function]:
         for kk in _event_indices(model, k):
             zn, mn = model_event(model, kk, z, mm, s, q)
             posts.append(ca.vertcat(*zn, *mn))
-        event = _select(k, posts) if posts else ca.SX.zeros(nz + nm)
+        event = _select(k, [], posts, model.n_events, []) if posts else ca.SX.zeros(nz + nm)
         snap = ca.SX.sym("snap")
         zr, mr = model.reverse(z, mm, -s, q, snap)
         F_rev = model.force(zr, mr, 0.0, -s, q)
