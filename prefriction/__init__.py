@@ -50,47 +50,11 @@ if TYPE_CHECKING:  # the names below, imported on first use (module __getattr__)
     from prefriction.sensitivity import sensitivities
     from prefriction.analysis.exact import exact_reversals
 
-__all__ = [
-    "AlongResult",
-    "Dahl",
-    "FrictionModel",
-    "FrictionStream",
-    "GMS",
-    "LinearFeedback",
-    "LuGre",
-    "MaxwellSlip",
-    "Oscillator",
-    "Parallel",
-    "Parameter",
-    "PrefrictionError",
-    "ReversalTable",
-    "Scales",
-    "SimulationResult",
-    "SolverError",
-    "SweepResult",
-    "Viscous",
-    "controllers",
-    "dahl",
-    "energy",
-    "exact_reversals",
-    "export",
-    "friction_along",
-    "describing",
-    "identify",
-    "optimal",
-    "data",
-    "sensitivities",
-    "sensitivity",
-    "signals",
-    "simulate",
-    "sweep",
-    "symbolic",
-]
 __version__ = "0.3.0"
 del annotations, TYPE_CHECKING  # bound by the imports above; not part of the API
 
-# where each public name lives: a module (None) or an attribute of a module. Importing the
-# package imports CasADi only (0.3 s, for the version check); scipy, python-control and the
+# where each public name lives: _WHERE, the module it is an attribute of; _MODULES, the public
+# names that are modules themselves. Importing the package imports CasADi only (0.3 s, for the version check); scipy, python-control and the
 # rest load on first use of a name that needs them (0.8 s for everything).
 _WHERE = {
     **dict.fromkeys(["PrefrictionError", "SolverError"], "prefriction.errors"),
@@ -108,6 +72,7 @@ _WHERE = {
 _MODULES = {"dahl": "prefriction.analysis.dahl", "energy": "prefriction.analysis.energy",
             **{name: f"prefriction.{name}" for name in ("controllers", "data", "describing", "export", "identify",
                                                          "optimal", "sensitivity", "signals", "symbolic")}}
+__all__ = sorted([*_WHERE, *_MODULES])
 
 
 def __getattr__(name: str) -> _Any:
