@@ -7,7 +7,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from prefriction._validation import check_bool, check_count, check_positive
+from prefriction._validation import check_bool, check_count, check_finite, check_positive
 from prefriction.identify.data import ForceDisplacement, ForceVelocity, Motion
 from prefriction.identify.parameters import ParameterSpace, name_list
 from prefriction.identify.result import FitResult
@@ -27,7 +27,7 @@ MAX_ITER = 100_000
 
 def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequence[str] | None = None,
         fixed: Sequence[str] | None = None, bounds: dict[str, tuple[float, float]] | None = None,
-        offset: bool = False, structures: str = "both", mass0: float | None = None,
+        offset: bool = False, structures: str = "both", mass0: float | None = None, offset0: float | None = None,
         reversals: Sequence[float] | None = None, substeps: int | None = None, max_iter: int = 200,
         tol: float = 1e-10, identifiability_limit: float = 0.5) -> FitResult:
     """Fit a friction model's parameters to measured data.
@@ -169,13 +169,17 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
         return fit_static(model, data, free=free, fixed=fixed, bounds=bounds, offset=offset, max_iter=max_iter,
                           tol=tol, limit=limit)
     if isinstance(data, Motion):
-        return _fit_motion(model, data, free, fixed, bounds, mass0, reversals, substeps, max_iter, tol, limit, offset)
+        return _fit_motion(model, data, free, fixed, bounds, mass0, offset0, reversals, substeps, max_iter, tol, limit,
+                           offset)
     if reversals is not None:
         raise ValueError("reversals is for Motion data; force-displacement data have their directions from dx "
                          "(allowed: reversals=None)")
     if mass0 is not None:
         raise ValueError(f"mass0 = {mass0!r} is for Motion data with a free mass; force-displacement data "
                          f"involve no mass (allowed: mass0=None)")
+    if offset0 is not None:
+        raise ValueError(f"offset0 = {offset0!r} is for Motion data; a force-displacement offset starts at 0 "
+                         f"(allowed: offset0=None)")
     from prefriction.identify.structures import fit_structures, gamma_entry
 
     scale = float(np.std(data.F)) if offset else None
@@ -200,50 +204,56 @@ def _fit_prescribed(model: FrictionModel, data: ForceDisplacement, free: Any, fi
     sol = fit_prescribed(model, data, space, n_sub=substeps, max_iter=max_iter, tol=tol)
     values = space.values(sol.w[:-1])
     est = np.array([values[n] for n in space.free])
-    stats = gauss_newton(sol.jacobian, sol.residuals, space.free, est, space.scale, limit=limit)
+    J, scale = space.physical_jacobian(sol.jacobian)
+    stats = gauss_newton(J, sol.residuals, space.free, est, scale, limit=limit)
     nuisance = {"initial force F0 [N]": float(sol.prediction[0])}
     return _finish(space, values, est, stats, -sol.residuals, sol.prediction, data, None, nuisance, sol.message,
                    sol.success, level=6)
 
 
-def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bounds: Any, mass0: Any, reversals: Any,
-                substeps: int | None, max_iter: int, tol: float, limit: float, offset: bool) -> FitResult:
+def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bounds: Any, mass0: Any, offset0: Any,
+                reversals: Any, substeps: int | None, max_iter: int, tol: float, limit: float,
+                offset: bool) -> FitResult:
     from prefriction.identify.motion_start import start_values
     from prefriction.identify.shooting import fit_motion
 
     if data.mass is None:
-        if mass0 is None:
-            raise ValueError("mass0 must be given when data.mass is None (the mass is fitted and needs a start "
-                             "value [kg], 0 < mass0 < inf)")
-        mass0 = check_positive("mass0", mass0)
+        if mass0 is not None:
+            mass0 = check_positive("mass0", mass0)
     elif mass0 is not None:
         raise ValueError(f"mass0 = {mass0!r} is only for a free mass, but data.mass = {data.mass!r} is known "
                          f"(allowed: mass0=None)")
     if offset and data.free_decay:
         raise ValueError("offset=True needs an applied force: in a free decay (u = 0) a force offset cannot be told "
                          "from the rest position (allowed: offset=False)")
-    model, mass0, offset0, scale = start_values(model, data, mass0, free, fixed, bounds)
-    space = ParameterSpace(model, free, fixed, bounds, mass=mass0, offset=scale if offset else None)
-    sol = fit_motion(model, data, space, n_sub=substeps, max_iter=max_iter, tol=tol, reversals=reversals,
-                     offset0=offset0)
+    if offset0 is not None:
+        if not offset:
+            raise ValueError(f"offset0 = {offset0!r} is the start of a fitted offset: give offset=True "
+                             f"(allowed without it: offset0=None)")
+        offset0 = check_finite("offset0", offset0)
+    start = start_values(model, data, mass0, offset0, offset)
+    scale = max(abs(float(model.Fc)), abs(start.offset))
+    space = ParameterSpace(model, free, fixed, bounds, mass=start.mass if data.mass is None else None,
+                           offset=scale if offset else None, offset0=start.offset)
+    sol = fit_motion(model, data, space, n_sub=substeps, max_iter=max_iter, tol=tol, reversals=reversals)
     values = space.values(sol.w[: space.n_free])
     est = np.array([values[n] for n in space.free])
-    stats = gauss_newton(sol.jacobian, sol.residuals, space.free, est, space.scale,
-                         constraints=sol.constraints, limit=limit)
+    J, scale = space.physical_jacobian(sol.jacobian)
+    stats = gauss_newton(J, sol.residuals, space.free, est, scale, constraints=sol.constraints, limit=limit)
     mass = values["mass"] if data.mass is None else data.mass
     return _finish(space, values, est, stats, -sol.residuals, sol.prediction, data, mass, sol.nuisance, sol.message,
-                   getattr(sol, "success", True))
+                   sol.success, start=start.steps + sol.steps)
 
 
 def _finish(space: ParameterSpace, values: dict, est: np.ndarray, stats: Any, residuals: np.ndarray,
             fitted: np.ndarray, data: Any, mass: float | None, nuisance: dict, message: str,
-            success: bool = True, level: int = 4) -> FitResult:
+            success: bool = True, level: int = 4, start: tuple[str, ...] = ()) -> FitResult:
     fitted_model = space.build(values)
     for name, why in stats.unidentifiable:
         warnings.warn(f"the data cannot identify {name}: {why}; its interval is meaningless. Fix it (fixed=[{name!r}]) "
                       f"or record data that excite it (docs/identify.md#identifiability)",
                       IdentifiabilityWarning, stacklevel=level)
-    low, high, flags = at_bounds(space.free, est, stats.low, stats.high, space.scale, space.low, space.high,
+    low, high, flags = at_bounds(space.free, est, stats.low, stats.high, space.scale, *space.limits(values),
                                  space.why_low, space.why_high)
     for name, value, flag in zip(space.free, est, flags):
         if flag.startswith("on its"):
@@ -256,4 +266,4 @@ def _finish(space: ParameterSpace, values: dict, est: np.ndarray, stats: Any, re
                       stacklevel=level)
     return FitResult(fitted_model, mass, tuple(space.free), tuple(space.units[n] for n in space.free), est,
                      stats.stderr, low, high, stats.correlation, residuals, fitted, data, stats,
-                     nuisance, message, success=success, flags=flags)
+                     nuisance, message, success=success, flags=flags, start=start)

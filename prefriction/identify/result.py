@@ -57,6 +57,9 @@ class FitResult:
         interval was cut.
     notes : tuple of str
         What the fit compared (both Dahl structures) and other remarks.
+    start : tuple of str
+        What the start pipeline of a :class:`Motion` fit did, one line per step: what was set and
+        from what (the user's value, a static least-squares estimate, a continuation stage).
     """
 
     model: FrictionModel
@@ -77,6 +80,7 @@ class FitResult:
     success: bool = True
     flags: tuple[str, ...] = ()
     notes: tuple[str, ...] = ()
+    start: tuple[str, ...] = ()
 
     @property
     def unidentifiable(self) -> tuple[str, ...]:
