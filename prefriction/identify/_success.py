@@ -27,7 +27,7 @@ from prefriction.models.dahl import Dahl
 from prefriction.models.lugre import LuGre
 from prefriction.models.viscous import Viscous
 
-__all__ = ["STAGES", "Stage", "SuccessRow", "stage_record", "success_table"]
+__all__ = ["STAGES", "Stage", "SuccessRow", "stage_record", "start_model", "success_table", "table_text"]
 
 TOLERANCE = 0.05
 """Largest relative error of every estimate for a fit to count as a success."""
@@ -266,7 +266,7 @@ def success_table(stages: tuple = STAGES, distances: tuple = (1.25, 1.5, 2.0), *
                     worst = f"{name} off {err:.0%}" + (f" ({msg[:80]})" if msg else "")
                 if progress is not None:
                     progress(f"{stage.name} d={d:g} fit {j + 1}/{fits}: {'ok' if good else 'FAIL'} "
-                             f"max error {err:.2%} in {times[-1]:.1f} s")
+                             f"max error {err:.2%} in {times[-1]:.1f} s" + (f" ({msg})" if msg else ""))
             rows.append(SuccessRow(stage.name, d, samples, fits, ok, conv, float(np.median(times)),
                                    float(np.max(times)), worst))
     return rows

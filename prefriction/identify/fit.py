@@ -47,8 +47,9 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
         reflective, Jacobian by CasADi). :class:`Motion`: positions of a mass under a known
         force ``u`` (a free decay for ``u = 0``), held or linear between samples as
         ``data.hold`` says; fitted by multiple shooting over segments of 50 samples with
-        constrained Gauss-Newton (``docs/identify_motion.md``: time and memory grow linearly
-        with the samples).
+        scipy's trust-region least squares in an augmented Lagrangian, records of more than 4,000
+        samples after a fit of their first 2,000 (``docs/identify_motion.md``: time and memory
+        grow linearly with the samples).
     free : sequence of str, optional
         Parameters to fit (names of ``type(model).parameters``; ``"stiffness[0]"`` for an
         array entry; ``"mass"``). Default: every parameter not in ``fixed``.
@@ -70,11 +71,14 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
         the smaller residual, and says in ``FitResult.notes`` what it compared; ``"given"`` fits
         the start model's structure only.
     mass0 : float, optional
-        Start value of the mass [kg] when ``data.mass`` is ``None`` (the mass is then fitted). For
-        a forced record (``u`` not zero) the static least-squares fit of the force balance
-        (``docs/identify_motion.md#start-values``) gives the start values of the mass, of the
-        force level ``Fc`` (and ``Fs`` in proportion), of the viscous coefficient and of the
-        offset where they are free and come out positive; ``mass0`` is the fallback.
+        Start value of the mass [kg] when ``data.mass`` is ``None`` (the mass is then fitted).
+        Default: the static least-squares fit of the force balance of a forced record
+        (``docs/identify_motion.md#start-values``). The start values the user gives (``mass0``,
+        ``offset0``, the start model's parameters) are the ones the fit uses; the static
+        estimates fill in only what is not given, and :attr:`FitResult.start` says what set each.
+    offset0 : float, optional
+        Start value of the offset [N] of a :class:`Motion` fit with ``offset=True``; default: the
+        static least-squares estimate (0 for a record that slides one way only).
     reversals : sequence of float, optional
         Approximate velocity reversal times [s] of :class:`Motion` data: the direction of
         motion at each shooting node is taken from them; default: the sign of a smoothed
@@ -105,9 +109,12 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
         has the wrong type (unknown keyword arguments included).
     ValueError
         For unknown parameter names, bounds outside the declared range, a missing ``mass0``
-        when the mass is free, or a model the data type cannot fit (the message says why).
+        when the mass is free and the record gives no static estimate, or a model the data type
+        cannot fit (the message says why).
     prefriction.SolverError
-        If the solver fails; the message names where and what to try.
+        If the model's motion or force is not finite at the start values; the message names
+        where and what to try. A solver that stops without converging returns the last
+        estimates with ``success = False`` and a :class:`ConvergenceWarning`.
 
     Warns
     -----
@@ -115,7 +122,8 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
         Naming every estimate that ends on a bound (the declared range, a user bound, or a
         structure boundary such as Dahl's ``gamma = 1``); its interval starts at the bound.
     ConvergenceWarning
-        If the solver stops at ``max_iter`` without converging.
+        If the solver stops without converging (``max_iter``, or a Motion fit that cannot
+        close the continuity of its segments); the result holds the last estimates.
     IdentifiabilityWarning
         Naming every parameter the data cannot identify: a relative standard error above
         ``identifiability_limit`` (e.g. ``Fc`` from loops that never leave pre-sliding), or a
