@@ -91,10 +91,10 @@ def test_offset0_needs_offset():
 
 
 def test_dahl_open_loop_fits_from_factor_two_starts():
-    """Three starts drawn log-uniformly within a factor 2 of every parameter (mass and offset
-    included) all land within 5 % of the truth (400 samples, 1 nm encoder, scipy record)."""
-    rows = success_table((DAHL_OPEN,), (2.0,), fits=3, samples=400, seed=1)
-    assert rows[0].successes == 3, table_text(rows)
+    """Two starts drawn log-uniformly within a factor 2 of every parameter (mass and offset
+    included) both land within 5 % of the truth (300 samples, 1 nm encoder, scipy record)."""
+    rows = success_table((DAHL_OPEN,), (2.0,), fits=2, samples=300, seed=1)
+    assert rows[0].successes == 2, table_text(rows)
 
 
 def _lugre_loops(Fc: float, Fs: float) -> identify.ForceDisplacement:
