@@ -97,14 +97,14 @@ STAGES = (
     Stage("Dahl+b open 0.3 kg 10 kHz 1 nm", Dahl(sigma=5e5, Fc=0.5, gamma=1.0), 0.3, 2.0, 0.05, 10_000.0, 1e-9,
           2.0, False, ("sigma", "Fc", "b")),
     Stage("LuGre closed 2.5 kg 5 kHz 10 nm", LuGre(sigma0=2e6, sigma1=50.0, sigma2=10.0, Fc=3.0, Fs=3.0, vs=1e-3),
-          2.5, 0.0, 0.2, 5_000.0, 1e-8, 1e-3, True, ("sigma0", "sigma2", "Fc")),
+          2.5, 0.0, 0.2, 5_000.0, 1e-8, 1e-3, True, ("sigma0", "sigma2", "Fc", "Fs")),
     Stage("Dahl+b closed 2.5 kg 2 kHz 10 nm", Dahl(sigma=2e6, Fc=3.0, gamma=2.0), 2.5, 8.0, -0.3, 2_000.0, 1e-8,
           2e-3, True, ("sigma", "Fc", "gamma", "b")),
     Stage("LuGre closed 95 kg 1 kHz 50 nm", LuGre(sigma0=2e5, sigma1=300.0, sigma2=203.5, Fc=20.39, Fs=20.39,
                                                   vs=0.01), 95.1, 0.0, -3.16, 1_000.0, 5e-8, 0.05, True,
-          ("sigma0", "sigma2", "Fc")),
+          ("sigma0", "sigma2", "Fc", "Fs")),
     Stage("LuGre open 10 kg 2 kHz 20 nm", LuGre(sigma0=1e6, sigma1=100.0, sigma2=40.0, Fc=5.0, Fs=5.0, vs=1e-3),
-          10.0, 0.0, 0.4, 2_000.0, 2e-8, 2.0, False, ("sigma0", "sigma2", "Fc")),
+          10.0, 0.0, 0.4, 2_000.0, 2e-8, 2.0, False, ("sigma0", "sigma2", "Fc", "Fs")),
 )
 """The stages of the harness: 0.3 to 95 kg, 1 to 10 kHz, 1 to 50 nm, Dahl and LuGre, offset,
 closed and open loop."""
@@ -185,8 +185,8 @@ class SuccessRow:
 
 def start_model(stage: Stage, rng: np.random.Generator, distance: float) -> tuple[FrictionModel, float, float]:
     """Start model, start mass [kg] and start offset [N]: every free parameter at the truth times
-    ``exp(U(-ln d, ln d))`` (``gamma`` kept at 1 or above), the offset at the truth plus
-    ``U(-ln d, ln d) Fc``."""
+    ``exp(U(-ln d, ln d))`` (``gamma`` kept at 1 or above; LuGre's ``Fs`` at the start ``Fc``
+    times the true ratio ``Fs / Fc``), the offset at the truth plus ``U(-ln d, ln d) Fc``."""
     import dataclasses
 
     def factor() -> float:
@@ -195,11 +195,11 @@ def start_model(stage: Stage, rng: np.random.Generator, distance: float) -> tupl
     fr = stage.friction
     new = {}
     for name in stage.free:
-        if hasattr(fr, name):
+        if hasattr(fr, name) and name != "Fs":
             value = getattr(fr, name) * factor()
             new[name] = max(value, 1.0) if name == "gamma" else value
-    if "Fs" in new or isinstance(fr, LuGre):
-        new["Fs"] = max(new.get("Fs", fr.Fs), new.get("Fc", fr.Fc))  # a fixed Fs = Fc follows Fc
+    if isinstance(fr, LuGre):  # Fs - Fc started at the truth's ratio (0 for Fs = Fc: no Stribeck peak)
+        new["Fs"] = new.get("Fc", fr.Fc) * fr.Fs / fr.Fc
     start = dataclasses.replace(fr, **new)
     if isinstance(fr, Dahl):
         start = start + Viscous(stage.b * factor())

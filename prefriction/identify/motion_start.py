@@ -22,6 +22,8 @@ from prefriction.models.base import FrictionModel
 
 __all__ = ["Start", "StaticStart", "derivatives", "start_values", "static_start", "stiffness_from_reversals"]
 
+_RESOLVED = 8
+"""Fewest samples in the first third of a reversal transient for a stiffness estimate."""
 _WINDOW = 21
 """Samples of the Savitzky-Golay window (cubic) of the velocity and acceleration estimates."""
 
@@ -156,7 +158,7 @@ def start_values(model: FrictionModel, data: Motion, mass0: float | None, offset
             checks.append(f"viscous {b:.4g} N s/m (static: {fit.b:.4g} N s/m)")
     k = stiffness_from_reversals(data, mass0 if data.mass is None else data.mass, offset0 or 0.0)
     if k is not None:
-        checks.append(f"stiffness {model.sigma:.4g} N/m (from {k[1]} reversal transients: {k[0]:.4g} N/m)")
+        checks.append(f"stiffness {model.sigma:.4g} N/m (rough check from {k[1]} reversal transients: {k[0]:.4g} N/m)")
     steps.append("friction parameters as given by the start model" + (": " + ", ".join(checks) if checks else ""))
     return Start(mass0, float(offset0 or 0.0), tuple(steps))
 
@@ -173,7 +175,8 @@ def stiffness_from_reversals(data: Motion, mass: float, offset: float) -> tuple[
     positions) moves from one sliding level to the other; its slope against the position over
     the first third of that change is the pre-sliding stiffness (``dF/dx = sigma`` at a reversal
     of Dahl (3.2) and LuGre). The median over the reversals is returned; ``None`` for a free
-    decay or when no transient spans enough encoder counts.
+    decay or when no transient spans :data:`_RESOLVED` samples (at 1 kHz a stage's transient
+    lasts a few samples and the smoothing spans it: the slope came out 50 times too stiff).
     """
     if data.free_decay:
         return None
@@ -192,7 +195,7 @@ def stiffness_from_reversals(data: Motion, mass: float, offset: float) -> tuple[
             continue
         span = float(np.ptp(Fs))
         near = np.abs(Fs - Fs[0]) <= span / 3.0
-        if np.count_nonzero(near) < 3 or np.ptp(xseg[near]) <= 0.0:
+        if np.count_nonzero(near) < _RESOLVED or np.ptp(xseg[near]) <= 0.0:
             continue
         slope = np.polyfit(xseg[near], Fs[near], 1)[0] * s
         if slope > 0.0:
