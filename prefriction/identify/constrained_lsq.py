@@ -74,7 +74,8 @@ class _Cache:
 
 def solve(full: Callable, plain: Callable, w0: np.ndarray, lo: np.ndarray, hi: np.ndarray, *, max_iter: int,
           tol: float, gtol: float = 1e-9, weight: float = _MU0,
-          restart: Callable[[np.ndarray], np.ndarray] | None = None, progress: Callable[[str], None] | None = None) -> LsqOutcome:
+          restart: Callable[[np.ndarray], np.ndarray] | None = None,
+          progress: Callable[[str], None] | None = None) -> LsqOutcome:
     """Constrained least squares from ``w0`` by the method of multipliers (1).
 
     Parameters
@@ -143,7 +144,8 @@ def solve(full: Callable, plain: Callable, w0: np.ndarray, lo: np.ndarray, hi: n
             message = f"max_iter = {max_iter} Jacobian evaluations reached"
             break
         final = outer > 1 and gmax_prev <= 10.0 * gtol
-        sol = least_squares(fun, w, jac=jac, bounds=(lower, upper), method="trf", tr_solver="exact" if dense else "lsmr",
+        sol = least_squares(fun, w, jac=jac, bounds=(lower, upper), method="trf",
+                            tr_solver="exact" if dense else "lsmr",
                             x_scale="jac", xtol=tol if final else max(tol, 1e-8), ftol=tol if final else 1e-8,
                             gtol=1e-12, max_nfev=max(min(budget, _INNER) * 2, 2))
         stalled = np.array_equal(sol.x, w) or sol.nfev <= 1

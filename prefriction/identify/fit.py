@@ -88,7 +88,8 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
         the start values (1 for Maxwell-slip on force-displacement data, where one step is the
         exact stop operator).
     max_iter : int, default 200
-        Most solver iterations (function evaluations for force-displacement data), 1 to 100 000.
+        Most solver iterations (Jacobian evaluations of a :class:`Motion` fit, function
+        evaluations for force-displacement data), 1 to 100 000.
         A fit that stops there returns with ``success = False`` and a :class:`ConvergenceWarning`.
     tol : float, default 1e-10
         Solver tolerance (relative), ``1e-14 <= tol <= 1e-6``: looser tolerances stop before the
