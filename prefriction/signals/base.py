@@ -9,6 +9,7 @@ from abc import ABC, abstractmethod
 from collections.abc import Hashable
 from typing import Any, Optional, Union
 
+import casadi
 import numpy as np
 
 from prefriction._validation import check_real_array
@@ -155,6 +156,40 @@ class Signal(ABC):
         if isinstance(t, float) and self.n_piece == 0 and math.isfinite(t):  # one time: no numpy (~30 us)
             return float(self._expr(t, self.params().tolist(), (), MathOps))
         return self.expr(check_real_array("t", t, "s"), self.params())
+
+    def velocity(self, t: Any) -> Union[float, np.ndarray]:
+        """Time derivative of the signal [signal units / s] at the time(s) ``t`` [s], vectorised.
+
+        Exact: CasADi's derivative of :meth:`expr` for the analytic kinds, the slope of the
+        current line for piecewise-linear ones (:meth:`linear_piece`). At a kink (a break, the
+        end of a ramp) the slope just after ``t``; a jump (:class:`Step`, :class:`ZeroOrderHold`)
+        counts 0. A position reference's velocity [m/s], e.g. for a compensator or exported code.
+
+        Parameters
+        ----------
+        t : float or array_like
+            Time(s) [s].
+
+        Returns
+        -------
+        float or numpy.ndarray
+            The derivative(s), shaped like ``t`` (a float for a scalar ``t``).
+        """
+        tt = np.asarray(check_real_array("t", t, "s"), dtype=float)
+        if self.n_piece == 0:
+            ts, th = casadi.SX.sym("t"), casadi.SX.sym("theta", self.n_params)
+            d = casadi.Function("velocity", [ts, th], [casadi.jacobian(self.expr(ts, th), ts)])
+            flat = tt.reshape(-1)
+            value = np.array(d.map(flat.size)(flat, self.params()), dtype=float).reshape(tt.shape) \
+                if flat.size else np.zeros(tt.shape)
+        else:
+            breaks = self.breaks()
+            value = np.empty(tt.shape)
+            for i, ti in np.ndenumerate(tt):
+                later = breaks[breaks > ti]
+                piece = self.linear_piece(float(ti), float(later[0]) if later.size else float(ti) + 1.0)
+                value[i] = 0.0 if piece is None else piece[1]
+        return float(value) if value.ndim == 0 else value
 
     def breaks(self) -> np.ndarray:
         """Times at which the signal or its first derivative jumps.
