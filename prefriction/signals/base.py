@@ -176,19 +176,22 @@ class Signal(ABC):
             The derivative(s), shaped like ``t`` (a float for a scalar ``t``).
         """
         tt = np.asarray(check_real_array("t", t, "s"), dtype=float)
-        if self.n_piece == 0:
+        breaks = self.breaks()
+        value = np.full(tt.shape, np.nan)
+        for i, ti in np.ndenumerate(tt):  # piecewise-linear kinds: the slope of the line after ti
+            later = breaks[breaks > ti]
+            piece = self.linear_piece(float(ti), float(later[0]) if later.size else float(ti) + 1.0)
+            if piece is None:
+                break
+            value[i] = piece[1]
+        rest = np.isnan(value)
+        if rest.any() and self.n_piece > 0:  # a kind with per-interval numbers is piecewise linear
+            value[rest] = 0.0
+        elif rest.any():  # analytic: CasADi's derivative of the expression
             ts, th = casadi.SX.sym("t"), casadi.SX.sym("theta", self.n_params)
             d = casadi.Function("velocity", [ts, th], [casadi.jacobian(self.expr(ts, th), ts)])
-            flat = tt.reshape(-1)
-            value = np.array(d.map(flat.size)(flat, self.params()), dtype=float).reshape(tt.shape) \
-                if flat.size else np.zeros(tt.shape)
-        else:
-            breaks = self.breaks()
-            value = np.empty(tt.shape)
-            for i, ti in np.ndenumerate(tt):
-                later = breaks[breaks > ti]
-                piece = self.linear_piece(float(ti), float(later[0]) if later.size else float(ti) + 1.0)
-                value[i] = 0.0 if piece is None else piece[1]
+            flat = tt[rest]
+            value[rest] = np.array(d.map(flat.size)(flat.reshape(1, -1), self.params()), dtype=float).ravel()
         return float(value) if value.ndim == 0 else value
 
     def breaks(self) -> np.ndarray:
