@@ -89,3 +89,13 @@ def _only_instrumental(text: str) -> bool:
     """``used to`` only as in 'the model used to design' (a purpose, not history)."""
     return all(re.match(r"used to (design|compute|build|fit|check|run|plan|model|make|find)", text[m.start():])
                for m in re.finditer("used to ", text))
+
+
+def test_the_gallery_shows_every_example_and_its_images_exist():
+    text = (ROOT / "docs" / "gallery.md").read_text()
+    for script in sorted((ROOT / "examples").glob("*.py")):
+        assert f"examples/{script.name}" in text, script.name
+    images = re.findall(r"!\[[^\]]*\]\(([^)]+)\)", text)
+    assert len(images) >= 30
+    for image in images:
+        assert (ROOT / "docs" / image).is_file(), image
