@@ -11,9 +11,10 @@ The stage: a 2.5 kg carriage whose friction is a Dahl model (3.2) with rest stif
 2. ``2_fit.png``, ``2_validation.png``: a Dahl model, the mass and the offset fitted to the first
    60 % of the record (:class:`prefriction.identify.Motion`, multiple shooting) and validated on
    the held-out 40 % (the fitted stage driven by the recorded force).
-3. ``3_compensation.png``: the PID designed on the fitted stage, alone and with the fitted
-   model's feedforward, tracking back-and-forth moves in the *true* stage's sampled loop, with
-   the encoder step, measurement noise and the fitted model's error (mismatch).
+3. ``3_compensation.png``: the PID designed on the fitted stage, alone, with the fitted model's
+   feedforward and with a friction observer of the fitted model, tracking back-and-forth moves in
+   the *true* stage's sampled loop, with the encoder step, measurement noise and the fitted
+   model's error (mismatch).
 4. ``4_optimal_move.png``: the minimum-time 20 um move of the fitted stage under ``|u| <= 12 N``
    (IPOPT, one phase per velocity sign), replayed through the true stage.
 5. ``5_c_code.png``: the compensated controller as C99 (``stage_ctl.h``, ``stage_ctl.c``), compiled
@@ -222,14 +223,15 @@ def main(outdir: "str | Path", record_csv: "str | None" = None, quick: bool = Fa
     seconds = 0.2 if quick else 0.5
     ref = back_and_forth(seconds)
     feedforward = controllers.Feedforward(fit.model)
+    observer = controllers.FrictionObserver(fit.model, pole=1000.0)  # the fitted gamma = 1 is its structure
     loops = {}
-    for name, comp in (("PID alone", None), ("PID + feedforward", feedforward)):
+    for name, comp in (("PID alone", None), ("PID + feedforward", feedforward), ("PID + friction observer", observer)):
         loops[name] = controllers.simulate_loop(true_stage, pid, ref, seconds, Ts=TS, compensator=comp,
                                                 quantization=QUANTUM, noise_rms=NOISE)
     out["spikes"] = {name: reversal_spikes(res, seconds) for name, res in loops.items()}
     out["figures"].append(plot_compensation(loops, outdir))
-    log(f"3. compensation: reversal error {out['spikes']['PID alone'] * 1e9:.3g} nm alone, "
-        f"{out['spikes']['PID + feedforward'] * 1e9:.3g} nm with feedforward ({time.perf_counter() - clock:.1f} s)")
+    log("3. compensation: reversal error " + ", ".join(f"{name} {e * 1e9:.3g} nm" for name, e in out["spikes"].items())
+        + f" ({time.perf_counter() - clock:.1f} s)")
 
     # 4. the minimum-time move of the fitted stage, replayed through the true one
     move = pf.optimal.point_to_point(stage, 20e-6, u_max=U_MAX)
@@ -255,17 +257,19 @@ def main(outdir: "str | Path", record_csv: "str | None" = None, quick: bool = Fa
 # --- figures of steps 3 to 5 ------------------------------------------------------------------------
 
 def plot_compensation(loops: dict, outdir: Path) -> Path:
-    fig, axes = new_figure(2, 1, size=(8.0, 5.0), sharex=True)
+    fig, axes = new_figure(2, 1, size=(8.0, 5.5))
     ax1, ax2 = axes[:, 0]
     first = next(iter(loops.values()))
-    ax1.plot(first.t * 1e3, first.reference * 1e6, color="k", lw=1.0, label="reference")
-    for name, res in loops.items():
-        ax2.plot(res.t * 1e3, res.error * 1e9, lw=0.8, label=name)
+    window = (first.t >= 0.095) & (first.t <= 0.17)  # one move forward and the start of the next
+    ax1.plot(first.t * 1e3, first.reference * 1e6, color="k", lw=1.0)
+    ax1.axvspan(95.0, 170.0, color="0.9")
     ax1.set_ylabel("reference [µm]")
-    ax1.legend(loc="upper right", fontsize=8)
+    ax1.set_xlabel("time [ms] (shaded: the window below)")
+    for name, res in loops.items():
+        ax2.plot(res.t[window] * 1e3, res.error[window] * 1e9, lw=0.9, label=name)
     ax2.set_ylabel("tracking error r - x [nm]")
     ax2.set_xlabel("time [ms]")
-    ax2.legend(loc="upper right", fontsize=8)
+    ax2.legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=3, fontsize=8)
     ax1.set_title("3. true stage in the loop: 10 nm encoder, 2 nm noise, fitted model")
     return save(fig, outdir, "3_compensation.png")
 

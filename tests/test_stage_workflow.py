@@ -33,6 +33,7 @@ def test_every_step_of_the_chain(tmp_path):
     assert fit.estimate("offset") == pytest.approx(w.OFFSET, abs=0.03)
     assert val.fit_percent > 80.0
     assert out["spikes"]["PID + feedforward"] < 0.8 * out["spikes"]["PID alone"]
+    assert out["spikes"]["PID + friction observer"] < 0.8 * out["spikes"]["PID alone"]
     assert abs(out["move"].replay.x_error) < 1e-9                 # the plan lands on the fitted stage
     assert abs(out["move_on_true"].x_error) < 0.02 * 20e-6         # and near it on the true one
     assert out["c_vs_python"] < 1e-10 * 20e-6                     # measured 2e-17 m
