@@ -33,17 +33,19 @@ def _public_names() -> list[tuple[str, object]]:
 
 
 def _resolve(path: str) -> object:
-    """The object an API entry ``::: a.b.C`` names: the longest importable module, then attributes."""
+    """The object an API entry ``::: a.b.C`` names, by attribute access from the package (as a
+    user reaches it); a submodule is imported only where no attribute has the name. Importing
+    first could shadow a lazily loaded function by its own module (``identify.fit``)."""
     parts = path.split(".")
-    for k in range(len(parts), 0, -1):
+    obj = importlib.import_module(parts[0])
+    for k, attr in enumerate(parts[1:], 1):
         try:
-            obj = importlib.import_module(".".join(parts[:k]))
-        except ImportError:
-            continue
-        for attr in parts[k:]:
             obj = getattr(obj, attr)
-        return obj
-    raise ImportError(path)
+        except AttributeError:
+            if not inspect.ismodule(obj):  # a function named like its module: ``a.fit.fit``
+                obj = importlib.import_module(".".join(parts[:k]))
+            obj = getattr(obj, attr) if hasattr(obj, attr) else importlib.import_module(".".join(parts[:k + 1]))
+    return obj
 
 
 @functools.lru_cache(maxsize=None)
