@@ -132,17 +132,21 @@ def read_record(path: Path) -> Record:
 
 
 def plot_record(rec: Record, outdir: Path) -> Path:
-    fig, axes = new_figure(2, 1, size=(8.0, 5.0), sharex=True)
-    ax1, ax2 = axes[:, 0]
-    if np.all(np.isfinite(rec.r)):
-        ax1.plot(rec.t, rec.r * 1e6, lw=1.0, label="reference")
-    ax1.plot(rec.t, rec.x * 1e6, lw=0.8, label="encoder position")
-    ax1.set_ylabel("position [µm]")
-    ax1.legend(loc="best", fontsize=8)
-    ax2.plot(rec.t, rec.u, lw=0.6, color="C2")
-    ax2.set_ylabel("motor force u [N]")
-    ax2.set_xlabel("time [s]")
-    ax1.set_title("1. closed-loop record (PID at 5 kHz, 10 nm encoder)")
+    known = bool(np.all(np.isfinite(rec.r)))
+    fig, axes = new_figure(3 if known else 2, 1, size=(8.0, 6.5 if known else 5.0), sharex=True)
+    axes = list(axes[:, 0])
+    if known:
+        axes[0].plot(rec.t, rec.r * 1e6, color="k", lw=1.0, label="reference")
+    axes[0].plot(rec.t, rec.x * 1e6, lw=0.8, ls="--" if known else "-", label="encoder position")
+    axes[0].set_ylabel("position [µm]")
+    axes[0].legend(loc="upper right", fontsize=8)
+    if known:
+        axes[1].plot(rec.t, (rec.r - rec.x) * 1e9, lw=0.6, color="C3")
+        axes[1].set_ylabel("tracking error [nm]")
+    axes[-1].plot(rec.t, rec.u, lw=0.6, color="C2")
+    axes[-1].set_ylabel("drive's force u [N]")
+    axes[-1].set_xlabel("time [s]")
+    axes[0].set_title("1. closed-loop record (PID at 5 kHz, 10 nm encoder)")
     return save(fig, outdir, "1_record.png")
 
 
@@ -291,12 +295,12 @@ def plot_move(move: "pf.optimal.PointToPointResult", on_true: "pf.optimal.Replay
 
 
 def plot_c(py: "controllers.LoopResult", c: "export.LoopRun", outdir: Path) -> Path:
-    fig, axes = new_figure(2, 1, size=(8.0, 5.0), sharex=True)
+    fig, axes = new_figure(2, 1, size=(8.0, 5.5), sharex=True)
     ax1, ax2 = axes[:, 0]
     ax1.plot(py.t * 1e3, py.x * 1e6, label="Python loop (simulate_loop)")
     ax1.plot(py.t * 1e3, c.x * 1e6, "--", label="C controller + C stage")
     ax1.set_ylabel("position [µm]")
-    ax1.legend(loc="center right", fontsize=8)
+    ax1.legend(loc="upper center", bbox_to_anchor=(0.5, -0.08), ncol=2, fontsize=8)
     ax2.plot(py.t * 1e3, c.x - py.x, color="C3")
     ax2.set_ylabel("x_C - x_Python [m]")
     ax2.set_xlabel("time [ms]")
