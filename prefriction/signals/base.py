@@ -177,10 +177,10 @@ class Signal(ABC):
         """
         tt = np.asarray(check_real_array("t", t, "s"), dtype=float)
         breaks = self.breaks()
+        after = np.append(breaks, np.inf)[np.searchsorted(breaks, tt, side="right")]  # next break after t
         value = np.full(tt.shape, np.nan)
         for i, ti in np.ndenumerate(tt):  # piecewise-linear kinds: the slope of the line after ti
-            later = breaks[breaks > ti]
-            piece = self.linear_piece(float(ti), float(later[0]) if later.size else float(ti) + 1.0)
+            piece = self.linear_piece(float(ti), float(after[i]) if np.isfinite(after[i]) else float(ti) + 1.0)
             if piece is None:
                 break
             value[i] = piece[1]
