@@ -309,9 +309,14 @@ def plot_c(py: "controllers.LoopResult", c: "export.LoopRun", outdir: Path) -> P
 
 
 if __name__ == "__main__":
+    usage = "usage: stage_workflow.py OUTDIR [RECORD.csv] [--quick]"
+    if any(a in ("-h", "--help") for a in sys.argv[1:]):
+        print(usage)
+        raise SystemExit(0)
     args = [a for a in sys.argv[1:] if a != "--quick"]
     if not args or len(args) > 2 or any(a.startswith("-") for a in args):
-        print("usage: stage_workflow.py OUTDIR [RECORD.csv] [--quick]", file=sys.stderr)
+        print(f"{usage}\nerror: one output directory and at most one CSV record expected, got {sys.argv[1:]!r}",
+              file=sys.stderr)
         raise SystemExit(2)
     result = main(args[0], args[1] if len(args) > 1 else None, quick="--quick" in sys.argv[1:])
     print(f"wrote {len(result['figures'])} figures and the C code to {args[0]} in {result['seconds']:.0f} s")
