@@ -28,8 +28,8 @@ import stat
 import tempfile
 from pathlib import Path
 
-__all__ = ["UnsafeFile", "dir_problem", "make_private_dir", "open_lock", "printable", "read_owned",
-           "write_atomic"]
+__all__ = ["UnsafeFile", "dir_problem", "make_private_dir", "open_lock", "printable", "read_nofollow",
+           "read_owned", "write_atomic"]
 
 _NOFOLLOW = getattr(os, "O_NOFOLLOW", 0)
 _CLOEXEC = getattr(os, "O_CLOEXEC", 0)
@@ -117,6 +117,15 @@ def make_private_dir(path: Path) -> None:
         os.chmod(p, 0o700)  # mkdir's mode is reduced by the umask
 
 
+def read_nofollow(path: Path, limit: int) -> bytes:
+    """The bytes of the regular file ``path``, read without following a link (whoever owns it).
+
+    Raises :class:`UnsafeFile` if ``path`` is a link, not a regular file or longer than ``limit``
+    bytes; ``OSError`` (e.g. ``FileNotFoundError``) if it cannot be opened.
+    """
+    return _read(path, limit, owned=False)
+
+
 def read_owned(path: Path, limit: int) -> bytes:
     """The bytes of the regular file ``path``, read without following a link.
 
@@ -124,6 +133,10 @@ def read_owned(path: Path, limit: int) -> bytes:
     writable by group or others, or longer than ``limit`` bytes; ``OSError`` (e.g.
     ``FileNotFoundError``) if it cannot be opened.
     """
+    return _read(path, limit, owned=True)
+
+
+def _read(path: Path, limit: int, owned: bool) -> bytes:
     try:
         fd = os.open(path, os.O_RDONLY | _NOFOLLOW | _CLOEXEC | _NONBLOCK)
     except OSError as exc:
@@ -134,7 +147,7 @@ def read_owned(path: Path, limit: int) -> bytes:
         st = os.fstat(fd)
         if not stat.S_ISREG(st.st_mode):
             raise UnsafeFile(f"{path} is not a regular file")
-        problem = _owner_problem(Path(path), st)
+        problem = _owner_problem(Path(path), st) if owned else ""
         if problem:
             raise UnsafeFile(problem)
         if st.st_size > limit:

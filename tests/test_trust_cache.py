@@ -36,7 +36,6 @@ __attribute__((constructor)) static void planted(void) {
   FILE *f = fopen("@MARKER@", "w");
   if (f) { fputs("planted code ran\n", f); fclose(f); }
 }
-int pf_run(void) { return 0; }
 """
 OTHER_UID = 12345
 
