@@ -1,0 +1,105 @@
+"""Defects of issue 26, item 10: symbolic.plant_step checks, FrictionStream copy and pickle,
+PointToPoint at extreme limits.
+
+References: the Dahl branch from the virgin state in closed form, ``F = Fc (1 - exp(-sigma x / Fc))``
+(gamma = 1, a monotone move); the S-curve's end position is its distance by construction.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import pickle
+
+import numpy as np
+import pytest
+
+import prefriction as pf
+from prefriction.signals import PointToPoint
+from prefriction.symbolic import plant_step
+
+
+@pytest.fixture(scope="module")
+def step():
+    return plant_step(pf.Dahl(sigma=1e4, Fc=1.0))
+
+
+GOOD = dict(y0=[0.0, 1.0, 0.0, 1.0], q=[1.0], u=0.0, h=3.0, rtol=1e-10)
+
+
+@pytest.mark.parametrize("name, value, said", [
+    ("h", -1.0, "h must be a finite step >= 0"),
+    ("h", math.nan, "h must be a finite step >= 0"),
+    ("h", math.inf, "h must be a finite step >= 0"),
+    ("u", math.nan, "u must be a finite"),
+    ("rtol", 0.0, "rtol must lie in"),
+    ("rtol", math.nan, "rtol must lie in"),
+    ("rtol", 0.5, "rtol must lie in"),
+    ("y0", [0.0, math.nan, 0.0, 1.0], "y0 must be 4 finite numbers"),
+    ("y0", [0.0, 1.0, 0.0], "y0 must be 4 finite numbers"),
+    ("q", [math.inf], "q must be"),
+])
+def test_plant_step_refuses_bad_numbers(step, name, value, said) -> None:
+    """A negative step reported ok = 1; NaN force or zero/NaN rtol gave raw CasADi errors."""
+    args = {**GOOD, name: value}
+    with pytest.raises(ValueError, match=said):
+        step(*args.values())
+
+
+def test_plant_step_too_long_a_step_is_a_solver_error(step) -> None:
+    """h = 1e12 (normalised) is more events than one step holds: a SolverError saying what helps."""
+    with pytest.raises(pf.SolverError, match="Take shorter steps"):
+        step(*{**GOOD, "h": 1e12}.values())
+
+
+def test_plant_step_still_symbolic_and_right(step) -> None:
+    """Checked numeric calls give the documented numbers; symbolic calls pass through."""
+    import casadi as ca
+
+    y1, n, ok = step(*GOOD.values())
+    assert int(n) == 1 and int(ok) == 1
+    y = ca.MX.sym("y", 4)
+    out = step(y, [1.0], 0.0, 3.0, 1e-10)
+    f = ca.Function("f", [y], [out[0]])
+    np.testing.assert_array_equal(np.asarray(f(GOOD["y0"])), np.asarray(y1))
+
+
+def _virgin_dahl(x: float, sigma: float = 1e5, Fc: float = 1.0) -> float:
+    return Fc * (1.0 - math.exp(-sigma * x / Fc))
+
+
+def test_friction_stream_copy_is_independent() -> None:
+    """copy.copy shared the state with the original (both then 1.66 N off)."""
+    stream = pf.FrictionStream(pf.Dahl(sigma=1e5, Fc=1.0), x0=0.0)
+    assert stream.step(1e-5, 1.0) == pytest.approx(_virgin_dahl(1e-5), rel=1e-12)
+    for twin in (copy.copy(stream), copy.deepcopy(stream)):
+        assert twin.step(2e-5, 2.0) == pytest.approx(_virgin_dahl(2e-5), rel=1e-12)
+    assert stream.step(2e-5, 2.0) == pytest.approx(_virgin_dahl(2e-5), rel=1e-12)
+    assert stream.step(3e-5, 3.0) == pytest.approx(_virgin_dahl(3e-5), rel=1e-12)
+
+
+def test_friction_stream_pickles() -> None:
+    """Pickling failed with a raw SWIG error; now the stream resumes where it was."""
+    stream = pf.FrictionStream(pf.Dahl(sigma=1e5, Fc=1.0), x0=0.0)
+    stream.step(1e-5, 1.0)
+    again = pickle.loads(pickle.dumps(stream))
+    assert (again.x, again.t, again.F) == (stream.x, stream.t, stream.F)
+    assert again.step(2e-5, 2.0) == pytest.approx(_virgin_dahl(2e-5), rel=1e-12)
+    assert stream.step(2e-5, 2.0) == pytest.approx(_virgin_dahl(2e-5), rel=1e-12)
+
+
+@pytest.mark.parametrize("args, kw", [((1e-5, 1e100, 1e100), {"j_max": 1e100}),
+                                      ((1e-310, 1e-3, 1e-2), {"j_max": 1.0})])
+def test_point_to_point_that_cannot_be_evaluated_is_refused(args, kw) -> None:
+    """These ended at 3.5e9 m and 1.1e-95 m instead of their distance."""
+    with pytest.raises(ValueError, match="cannot be evaluated in double precision"):
+        PointToPoint(*args, **kw)
+
+
+@pytest.mark.parametrize("args, kw", [((1e-5, 2e-4, 5e-3), {"j_max": 0.5}), ((1e-5, 2e-4, 5e-3), {}),
+                                      ((-3e-3, 1e-2, 1.0), {"j_max": 1e3, "position": 0.5}),
+                                      ((1e-9, 1e-3, 1e2), {"j_max": 1e6})])
+def test_point_to_point_ordinary_moves_still_land(args, kw) -> None:
+    move = PointToPoint(*args, **kw)
+    end = move(move.start + move.duration + 1.0)
+    assert end == pytest.approx(move.position + move.distance, rel=1e-9, abs=1e-20)
