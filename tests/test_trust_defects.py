@@ -103,3 +103,35 @@ def test_point_to_point_ordinary_moves_still_land(args, kw) -> None:
     move = PointToPoint(*args, **kw)
     end = move(move.start + move.duration + 1.0)
     assert end == pytest.approx(move.position + move.distance, rel=1e-9, abs=1e-20)
+
+
+# --- item 11: size limits that count memory, not samples -----------------------------------
+
+def test_friction_along_limit_counts_the_state() -> None:
+    """A 100-element Maxwell-slip along half the sample limit asked for 15 GiB; now refused at once."""
+    from prefriction._memory import MAX_BYTES
+
+    model = pf.MaxwellSlip(np.full(100, 1e3), np.full(100, 1e-3))
+    k = model.n_states + model.n_flags
+    n = MAX_BYTES // (8 * (16 + 3 * k)) + 1000  # just above what fits
+    t = np.linspace(0.0, 1.0, n)
+    with pytest.raises(ValueError, match=r"friction_along of MaxwellSlip .* GiB, more than the limit of 4 GiB"):
+        pf.friction_along(model, t, 1e-6 * np.sin(t))
+
+
+def test_sum_of_models_cannot_bypass_the_element_limit() -> None:
+    """Ten 100-element Maxwell-slip models (1,010 states) took 106 s to compile; now refused."""
+    m = pf.MaxwellSlip(np.full(100, 1e3), np.full(100, 1e-3))
+    with pytest.raises(ValueError, match="at most 256 states in all"):
+        pf.models.Parallel.of(*[m] * 10)
+    assert (m + m).n_states == 202  # two still fit
+
+
+def test_simulate_loop_limit_counts_memory() -> None:
+    """At its own sample limit a loop needed more than 4 GB and ended in a raw MemoryError."""
+    from prefriction import controllers
+
+    stage = pf.Oscillator(pf.Dahl(2e5, 1.5), mass=0.5)
+    C = controllers.design_pid(stage, wn=2 * np.pi * 150)
+    with pytest.raises(ValueError, match=r"sampled loop of Dahl: 9_900_001 sample instants .* limit of 4 GiB"):
+        controllers.simulate_loop(stage, C, 1e-6, 990.0, Ts=1e-4)

@@ -18,6 +18,7 @@ from typing import Optional
 import casadi as ca
 import numpy as np
 
+from prefriction._memory import check_memory
 from prefriction.models import Oscillator
 from prefriction.signals import Constant
 from prefriction.simulation.compiled import compiled, jit_available
@@ -216,9 +217,11 @@ def run_sampled(
     eps = rtol * _CAL * math.sqrt(L.n_active / L.nx)
     Ts_n, t_end_n = fb.Ts / sc.t, t_end / sc.t
     n_s = sample_count(t_end_n, Ts_n, t_end / fb.Ts)
-    tk = np.minimum(np.arange(n_s) * Ts_n, t_end_n)
     blk, setup, mode = _block(spec, jit)
     LL = blk.LL
+    check_memory(f"the sampled loop of {type(model).__name__}", n_s, LL.nw + LL.nrec + 12 + n_user,
+                 "sample instants", "increase Ts or split the run")
+    tk = np.minimum(np.arange(n_s) * Ts_n, t_end_n)
     # run-time parameters: the plant's constants, the controller (SI, padded), limit, scales
     par = blk.par
     par[:] = 0.0
