@@ -135,3 +135,72 @@ def test_simulate_loop_limit_counts_memory() -> None:
     C = controllers.design_pid(stage, wn=2 * np.pi * 150)
     with pytest.raises(ValueError, match=r"sampled loop of Dahl: 9_900_001 sample instants .* limit of 4 GiB"):
         controllers.simulate_loop(stage, C, 1e-6, 990.0, Ts=1e-4)
+
+
+# --- item 15: the smaller items --------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def loop_case():
+    from prefriction import controllers
+
+    stage = pf.Oscillator(pf.Dahl(2e5, 1.5), mass=0.5)
+    return stage, controllers.design_pid(stage, wn=2 * np.pi * 150)
+
+
+def test_mismatch_names_itself(loop_case) -> None:
+    """``mismatch=(nan, 1)`` named "stiffness", an argument simulate_loop does not have."""
+    from prefriction import controllers
+
+    stage, C = loop_case
+    with pytest.raises(ValueError, match=r"mismatch\[0\] \(the stiffness factor\) must be finite"):
+        controllers.simulate_loop(stage, C, 1e-6, 0.01, Ts=1e-4, compensator=controllers.Feedforward(stage.friction),
+                                  mismatch=(math.nan, 1.0))
+
+
+def test_mismatch_with_a_disturbance_observer_is_refused(loop_case) -> None:
+    """``mismatch`` was silently ignored with the model-free DisturbanceObserver."""
+    from prefriction import controllers
+
+    stage, C = loop_case
+    dob = controllers.DisturbanceObserver(mass=0.5, bandwidth=2 * np.pi * 300)
+    with pytest.raises(ValueError, match="DisturbanceObserver has none"):
+        controllers.simulate_loop(stage, C, 1e-6, 0.01, Ts=1e-4, compensator=dob, mismatch=(1.2, 0.8))
+
+
+@pytest.mark.parametrize("kw, said", [({"x0": math.nan}, "x0 must be finite"), ({"v0": math.inf}, "v0 must be finite"),
+                                      ({"F0": 3.0}, r"F0 must lie in \[-1.5, 1.5\] N")])
+def test_compensated_loop_start_is_checked(loop_case, kw, said) -> None:
+    """With a compensator, x0 = nan, v0 = inf and F0 = 2 Fc ended in SolverError instead of ValueError."""
+    from prefriction import controllers
+
+    stage, C = loop_case
+    with pytest.raises(ValueError, match=said):
+        controllers.simulate_loop(stage, C, 1e-6, 0.01, Ts=1e-4, compensator=controllers.Feedforward(stage.friction),
+                                  **kw)
+
+
+@pytest.fixture(scope="module")
+def along():
+    t = np.linspace(0.0, 1.0, 50)
+    return pf.friction_along(pf.Dahl(sigma=1e5, Fc=1.0), t, 1e-5 * np.sin(2 * np.pi * t))
+
+
+def test_plot_path_errors_are_clear(along, tmp_path) -> None:
+    """Plot paths raised raw FileNotFoundError / NotADirectoryError."""
+    with pytest.raises(ValueError, match="path .*does not exist"):
+        along.plot(tmp_path / "missing" / "a.png")
+    (tmp_path / "file").write_text("")
+    with pytest.raises(ValueError, match="path .*(does not exist|cannot be written)"):
+        along.plot(tmp_path / "file" / "a.png")
+    with pytest.raises(ValueError, match="must name a file"):
+        along.plot(tmp_path)
+
+
+def test_plot_does_not_write_through_a_link(along, tmp_path) -> None:
+    victim = tmp_path / "victim.txt"
+    victim.write_text("precious")
+    link = tmp_path / "along.png"
+    link.symlink_to(victim)
+    out = along.plot(link)
+    assert victim.read_text() == "precious" and not out.is_symlink()
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
