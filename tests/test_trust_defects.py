@@ -204,3 +204,16 @@ def test_plot_does_not_write_through_a_link(along, tmp_path) -> None:
     out = along.plot(link)
     assert victim.read_text() == "precious" and not out.is_symlink()
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.slow
+def test_point_to_point_with_eight_phases_starts() -> None:
+    """Dahl gamma = 2 with 8 phases failed at its start point (Invalid_Number_Detected after 0
+    iterations: the first guess drove a wrong-way branch to NaN). Now it solves, and its extra
+    phases collapse: the same time as the two-phase move (the optimum has no other reversal)."""
+    from prefriction.optimal import point_to_point
+
+    stage = pf.Oscillator(pf.Dahl(1e4, 1.0, 2.0), mass=1.0)
+    eight = point_to_point(stage, 1e-3, u_max=5.0, modes=(1.0, -1.0) * 4, intervals=12)
+    two = point_to_point(stage, 1e-3, u_max=5.0, modes=(1.0, -1.0), intervals=12)
+    assert eight.t_final == pytest.approx(two.t_final, rel=1e-4)
