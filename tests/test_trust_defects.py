@@ -217,3 +217,31 @@ def test_point_to_point_with_eight_phases_starts() -> None:
     eight = point_to_point(stage, 1e-3, u_max=5.0, modes=(1.0, -1.0) * 4, intervals=12)
     two = point_to_point(stage, 1e-3, u_max=5.0, modes=(1.0, -1.0), intervals=12)
     assert eight.t_final == pytest.approx(two.t_final, rel=1e-4)
+
+
+# --- item 15: wrong facts in the documentation ------------------------------------------------
+
+def _doc(name: str) -> str:
+    from pathlib import Path
+
+    return (Path(__file__).resolve().parent.parent / "docs" / name).read_text()
+
+
+def test_reliability_budget_is_the_code_s() -> None:
+    """docs/reliability.md said the reversal budget is 1e6 where the code holds 1e7."""
+    import re
+
+    from prefriction.simulation.simulate import MAX_REVERSALS
+
+    (value,) = re.findall(r"`MAX_REVERSALS = ([0-9.e+]+)`", _doc("reliability.md"))
+    assert float(value) == MAX_REVERSALS
+
+
+def test_interpreted_fallback_is_not_claimed_bit_identical() -> None:
+    """The interpreted fallback was said to give "the same results"; it differs by rounding
+    (8.6e-10 relative seen on Maxwell-slip). The pages that describe it must not claim more."""
+    import prefriction.simulation.compiled as compiled
+
+    for text in (_doc("simulator.md"), _doc("sweeps.md"), _doc("reliability.md"), compiled.__doc__):
+        assert "same results" not in " ".join(text.split())
+    assert "not bit for bit" in " ".join(_doc("reliability.md").split()) and "#security" in _doc("reliability.md")
