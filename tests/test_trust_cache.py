@@ -120,8 +120,10 @@ def test_planted_library_is_never_loaded(native_name, tmp_path, how) -> None:
     elif how == "world_writable":
         os.chmod(cache, 0o777)
     else:  # the directory is ours and private, the library and its checksum another user's
+        os.chmod(cache, 0o700)
         os.chown(lib, OTHER_UID, OTHER_UID)
         os.chown(lib.with_name(lib.name + ".sha256"), OTHER_UID, OTHER_UID)
+    before = sorted((p.name, p.stat().st_ino, p.stat().st_mtime_ns) for p in cache.iterdir())
     out = _victim(cache)
     assert not marker.exists(), "the planted library's constructor ran"
     F0, jit = out.stdout.split()
@@ -134,7 +136,8 @@ def test_planted_library_is_never_loaded(native_name, tmp_path, how) -> None:
         assert len(refusals) == 1 and str(cache) in refusals[0]
         assert ("owned by uid 12345" in refusals[0] or "(uid 12345)" in refusals[0]
                 if how == "other_owner" else "writable by others" in refusals[0])
-        assert os.stat(lib).st_ino == os.stat(lib).st_ino and lib.exists()  # the refused cache is left alone
+        after = sorted((p.name, p.stat().st_ino, p.stat().st_mtime_ns) for p in cache.iterdir())
+        assert after == before  # the refused cache is left alone: nothing written there
 
 
 def test_planted_lock_link_is_not_followed(native_name, tmp_path) -> None:
