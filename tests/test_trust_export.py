@@ -177,3 +177,28 @@ def test_run_c_from_threads_on_first_use(tmp_path) -> None:
                           env={**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)})
     assert done.returncode == 0, done.stderr
     assert done.stdout.split()[0] == "0", done.stdout
+
+
+def test_unwritable_directory_is_a_clear_error(tmp_path) -> None:
+    """Item 15: an export into a directory it cannot write names the directory (no raw PermissionError)."""
+    if hasattr(os, "geteuid") and os.geteuid() == 0:
+        if shutil.which("setpriv") is None:
+            pytest.skip("root bypasses permissions and setpriv is missing")
+        code = ("import prefriction as pf; from prefriction import export\n"
+                "try:\n    export.c_source(pf.Dahl(2e5, 1.5), 'd', {d!r})\n"
+                "except ValueError as exc:\n    print('ValueError', exc)\n")
+        d = tmp_path / "ro"
+        d.mkdir()
+        os.chmod(d, 0o555)
+        done = subprocess.run(["setpriv", "--bounding-set=-dac_override,-dac_read_search,-fowner", sys.executable,
+                               "-c", code.format(d=str(d))], capture_output=True, text=True, timeout=300,
+                              env={**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)})
+        out = done.stdout
+    else:
+        d = tmp_path / "ro"
+        d.mkdir()
+        os.chmod(d, 0o555)
+        with pytest.raises(ValueError) as info:
+            export.c_source(pf.Dahl(2e5, 1.5), "d", d)
+        out = f"ValueError {info.value}"
+    assert out.startswith("ValueError directory") and "cannot be written" in out, out

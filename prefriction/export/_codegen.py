@@ -102,7 +102,8 @@ def write_export(path: Path, name: str, header: str, body: str) -> tuple[Path, P
     """Write ``<name>.h`` and ``<name>.c`` into the directory ``path``; their paths and digest.
 
     Each file is written atomically (a new temporary file renamed over it, mode 0644); a symbolic
-    link at either path is refused (``ValueError``), never followed or replaced. The digest is the
+    link at either path is refused (``ValueError``), never followed or replaced, and a directory
+    that cannot be written is a ``ValueError`` naming it. The digest is the
     SHA-256 of both texts, which :meth:`prefriction.export.CSource.texts` checks before use.
     """
     h_path, c_path = path / f"{name}.h", path / f"{name}.c"
@@ -117,7 +118,8 @@ def write_export(path: Path, name: str, header: str, body: str) -> tuple[Path, P
         safe.write_atomic(h_path, data[0], 0o644)
         safe.write_atomic(c_path, data[1], 0o644)
     except OSError as exc:
-        raise OSError(exc.errno, f"the export {name!r} cannot be written into {path} ({exc.strerror or exc})") from exc
+        raise ValueError(f"directory {str(path)!r}: the export {name!r} cannot be written there "
+                         f"({exc.strerror or exc})") from exc
     return h_path, c_path, digest(*data)
 
 
