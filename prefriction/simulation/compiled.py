@@ -212,16 +212,17 @@ def library(name: str, source: str, what: str, load: Callable[[Path, str], tuple
     start = time.perf_counter()
     key = hashlib.sha256(source.encode() + " ".join((cc, *cflags)).encode()
                          + ca.__version__.encode()).hexdigest()[:24]
-    directory, refused = store.trusted_dir(cache_dir())
+    cache = cache_dir()
+    directory, refused = store.trusted_dir(cache)
     if refused:
-        _say(f"the compile cache {cache_dir()} is refused ({refused}): a library there could have been written by "
+        _say(f"the compile cache {cache} is refused ({refused}): a library there could have been written by "
              f"someone else. Compiled code is kept for this process only, in {directory}; make the cache yours and "
              f"private (chown, chmod 700) or set PREFRICTION_CACHE to a directory of yours")
     lib = directory / f"{name}_{key}.so"
     found, problem = _from_cache(name, lib, key, load, fallback)
     if found is not None:
         return found
-    blocked = store.unwritable(directory, lib)
+    blocked = store.unwritable(directory, lib) or (f"the cache {cache} is not trusted" if directory != cache else "")
     if blocked:
         return _build(name, source, what, (cc, *cflags), lib, key, problem, blocked, start, load, fallback)
     patience = compile_timeout() + 10.0  # the holder's compiler is stopped after compile_timeout()
