@@ -217,11 +217,12 @@ def run_sampled(
     eps = rtol * _CAL * math.sqrt(L.n_active / L.nx)
     Ts_n, t_end_n = fb.Ts / sc.t, t_end / sc.t
     n_s = sample_count(t_end_n, Ts_n, t_end / fb.Ts)
-    blk, setup, mode = _block(spec, jit)
-    LL = blk.LL
-    check_memory(f"the sampled loop of {type(model).__name__}", n_s, LL.nw + LL.nrec + 12 + n_user,
+    lay = LoopLayout(spec)  # before any compile: the inputs and records of every sample
+    check_memory(f"the sampled loop of {type(model).__name__}", n_s, lay.nw + lay.nrec + 12 + n_user,
                  "sample instants", "increase Ts or split the run")
     tk = np.minimum(np.arange(n_s) * Ts_n, t_end_n)
+    blk, setup, mode = _block(spec, jit)
+    LL = blk.LL
     # run-time parameters: the plant's constants, the controller (SI, padded), limit, scales
     par = blk.par
     par[:] = 0.0
