@@ -266,3 +266,73 @@ def test_one_warning_per_process_without_compiler(monkeypatch) -> None:
         assert mod.jit_available() is False
     (w,) = [c for c in caught if issubclass(c.category, RuntimeWarning)]
     assert "no C compiler" in str(w.message) and "100 times slower" in str(w.message) and "install" in str(w.message)
+
+
+# --- the primitives every loader and writer calls (prefriction._safe_files) -------------------
+
+def test_safe_files_refuse_links_and_foreign_or_shared_files(tmp_path) -> None:
+    from prefriction import _safe_files as safe
+
+    real = tmp_path / "real"
+    real.write_bytes(b"data")
+    os.chmod(real, 0o600)
+    assert safe.read_owned(real, 100) == b"data"
+    link = tmp_path / "link"
+    link.symlink_to(real)
+    with pytest.raises(safe.UnsafeFile, match="symbolic link"):
+        safe.read_owned(link, 100)
+    with pytest.raises(safe.UnsafeFile, match="symbolic link"):
+        safe.open_lock(link)
+    with pytest.raises(safe.UnsafeFile, match="more than the 3"):
+        safe.read_owned(real, 3)
+    os.chmod(real, 0o620)
+    with pytest.raises(safe.UnsafeFile, match="writable by its group"):
+        safe.read_owned(real, 100)
+    if _can_chown():
+        os.chmod(real, 0o600)
+        os.chown(real, OTHER_UID, OTHER_UID)
+        with pytest.raises(safe.UnsafeFile, match="uid 12345"):
+            safe.read_owned(real, 100)
+        with pytest.raises(safe.UnsafeFile, match="uid 12345"):
+            safe.open_lock(real)
+
+
+def test_write_atomic_replaces_a_link_without_following_it(tmp_path) -> None:
+    from prefriction import _safe_files as safe
+
+    victim = tmp_path / "victim"
+    victim.write_text("precious")
+    dest = tmp_path / "dest"
+    dest.symlink_to(victim)
+    safe.write_atomic(dest, b"new")
+    assert victim.read_text() == "precious" and not dest.is_symlink() and dest.read_bytes() == b"new"
+    assert stat.S_IMODE(os.stat(dest).st_mode) == 0o600
+
+
+def test_dir_problem_judges_the_directory_and_its_parents(tmp_path) -> None:
+    from prefriction import _safe_files as safe
+
+    mine = tmp_path / "a" / "b"
+    old = os.umask(0)
+    try:
+        safe.make_private_dir(mine)
+    finally:
+        os.umask(old)
+    assert stat.S_IMODE(os.stat(tmp_path / "a").st_mode) == 0o700 and safe.dir_problem(mine) == ""
+    os.chmod(tmp_path / "a", 0o777)  # a parent others can write: they could swap b
+    assert "writable by others" in safe.dir_problem(mine)
+    os.chmod(tmp_path / "a", 0o1777)  # sticky, as /tmp: they cannot
+    assert safe.dir_problem(mine) == ""
+    os.chmod(tmp_path / "a", 0o700)
+    via = tmp_path / "via"
+    via.symlink_to(mine)
+    assert safe.dir_problem(via) == ""
+    os.chmod(mine, 0o770)
+    assert "writable by its group" in safe.dir_problem(via)
+
+
+def test_printable_makes_notes_inert() -> None:
+    from prefriction import _safe_files as safe
+
+    assert safe.printable("a\x1b[2Jb\nc\td\x07") == "a?[2Jb c d?"
+    assert len(safe.printable("x" * 1000, 50)) == 50
