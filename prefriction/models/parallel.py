@@ -18,9 +18,13 @@ from prefriction.models.base import FrictionModel
 if TYPE_CHECKING:
     from prefriction.units import Scales
 
-__all__ = ["MAX_MODELS", "Parallel", "local_names", "qualified_names"]
+__all__ = ["MAX_MODELS", "MAX_STATES", "Parallel", "local_names", "qualified_names"]
 
 MAX_MODELS = 16
+MAX_STATES = 256
+"""Most continuous states a sum of models may hold in all (each model's own limit, e.g. 100
+elements, held per term only: ten 100-element Maxwell-slip models took 106 s to compile for a
+1,001-sample run). Generated code and compile time grow with the states."""
 """Most models in one sum."""
 
 
@@ -133,6 +137,12 @@ class Parallel(FrictionModel):
             raise TypeError("models must not contain a Parallel (use Parallel.of or +, which flatten sums)")
         if not 1 <= len(self.models) <= MAX_MODELS:
             raise ValueError(f"models must hold 1 to {MAX_MODELS} friction models, got {len(self.models)}")
+        total = sum(int(m.n_states) for m in self.models)
+        if total > MAX_STATES:
+            raise ValueError(f"models must hold at most {MAX_STATES} states in all (MAX_STATES: the generated code "
+                             f"and its compile time grow with them), got {total} in "
+                             f"{[f'{type(m).__name__}: {m.n_states}' for m in self.models]}; merge the terms into "
+                             f"one model (e.g. one MaxwellSlip with all the elements, up to its own limit)")
 
     @classmethod
     def of(cls, *models: FrictionModel) -> "Parallel":
