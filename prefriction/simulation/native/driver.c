@@ -194,6 +194,18 @@ static double pf_first_step(pf_ctx* c, const pf_scales* S, const double* y, cons
   return fmin(fmin(100.0 * h0, h1), dur);
 }
 
+#if PF_VSCALE
+/* A step near a narrow curve of the force in the speed (Stribeck velocity vs): within PF_CURVE_K vs
+ * of v = 0 the speed changes by at most PF_CURVE_C vs per step (at the rate a = v'), and a step
+ * from outside ends at most PF_CURVE_C vs inside that band, so that stages sample the curve and
+ * the error estimate sees it (docs/simulator.md#narrow-stribeck). */
+#define PF_CURVE_K 3.0
+#define PF_CURVE_C 0.5
+static double pf_curve_bound(double vs, double v, double a) {
+  return (fmax(fabs(v) - PF_CURVE_K * vs, 0.0) + PF_CURVE_C * vs) / fmax(fabs(a), 1e-300);
+}
+#endif
+
 /* One run from the state st[] until n_max reversals, the time t_end or a failure (the codes
  * above). Each reversal writes its time, position, force (after the model's reset) and the model
  * events of the half-cycle it ends. eps: the run's tolerance; snap: the coincidence tolerance of
@@ -203,7 +215,7 @@ int pf_run(const double* q, double eps, double snap, double* st, double t_end, l
   pf_ctx c;
   pf_scales S;
   double y[PF_NY], y0[PF_NY], ys[PF_NY], f0[PF_NY], e[PF_NY], U[7][PF_NY], g0[PF_NEA], g1[PF_NEA];
-  double t = st[0], ne = st[4], t_last = st[5], t_prev = st[6], h, err, err_prev = 1.0, fac, dur;
+  double t = st[0], ne = st[4], t_last = st[5], t_prev = st[6], h, err, err_prev = 1.0, fac, dur, vs = 0.0;
   long n = 0, branch_steps = 0;
   int i, j, rejected = 0, fsal = 0, nonfinite = 0, code = PF_T_END;
   memset(&c, 0, sizeof c);
@@ -215,6 +227,13 @@ int pf_run(const double* q, double eps, double snap, double* st, double t_end, l
   y[1] = st[2];
   for (i = 0; i < PF_NZ; ++i) y[2 + i] = st[PF_HEAD + i];
   for (i = 0; i < PF_NM; ++i) c.m[i] = st[PF_HEAD + PF_NZ + i];
+#if PF_VSCALE
+  pf_args(&c, y); /* the model's velocity scale from its numbers q */
+  c.res[0] = &vs;
+  pf_vscale(c.arg, c.res, c.iw, c.w, 0);
+#else
+  (void)vs;
+#endif
 #define PF_DURATION() ((isfinite(t_prev) ? 2.0 * (t_last - t_prev) : 2.0 * M_PI / fmax(1.0, fabs(y[1]))) * S.grow)
 #define PF_BRANCH()                                \
   do {                                             \
@@ -241,6 +260,10 @@ int pf_run(const double* q, double eps, double snap, double* st, double t_end, l
       break;
     }
     if (++branch_steps > PF_BRANCH_STEPS) { code = PF_TOO_MANY_STEPS; break; }
+#if PF_VSCALE
+    if (!fsal) { pf_f(&c, y, f0); fsal = 1; }
+    h = fmin(h, pf_curve_bound(vs, y[1], f0[1]));
+#endif
     if (t + h >= t_end) { h = t_end - t; last = 1; }
     if (!(h > 1e-15 * fmax(fabs(t), 1e-300))) { code = nonfinite ? PF_NONFINITE : PF_STEP_UNDERFLOW; break; }
     if (!fsal) { pf_f(&c, y, f0); fsal = 1; }
