@@ -78,3 +78,11 @@ def test_wide_curve_declares_its_scale_and_others_none() -> None:
     V = 1.0 / np.sqrt(2.0 * 1e5)  # the velocity unit Fc / sqrt(m sigma0) [m/s]
     assert model.velocity_scale(q) == pytest.approx(1e-3 / V, rel=1e-15)
     assert pf.Dahl(1e5, 1.0).velocity_scale(pf.Dahl(1e5, 1.0).runtime_params()) is None
+
+
+def test_a_sum_declares_the_narrowest_curve_in_its_units() -> None:
+    """In a sum the velocity unit is sum(Fc_i) / sqrt(m sum(sigma_i)): 3 N / sqrt(3e5 N/m kg)."""
+    model = pf.LuGre(1e5, 300.0, 0.4, 1.0, 1.5, 1e-3) + pf.Dahl(1e5, 1.0) + pf.LuGre(1e5, 300.0, 0.4, 1.0, 1.5, 1e-4)
+    V = 3.0 / np.sqrt(3e5)
+    assert model.velocity_scale(model.runtime_params()) == pytest.approx(1e-4 / V, rel=1e-14)
+    assert (pf.Dahl(1e5, 1.0) + pf.Dahl(1e4, 1.0)).velocity_scale(np.ones(8)) is None
