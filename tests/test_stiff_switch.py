@@ -112,3 +112,11 @@ def test_deep_gross_sliding_lands_on_the_energy_balance(gamma: float, tail: floa
     assert abs(res.reversals.x[0] / x_ref - 1.0) <= 10 * rtol
     assert res.reversals.F[0] == pytest.approx(Fc, rel=1e-15)
     assert res.stats.steps < 5_000
+
+
+def test_deep_gross_sliding_without_a_compiler_too() -> None:
+    """The interpreted compact model (``jit=False``) holds the log-gap the same way."""
+    sigma, Fc, rtol, speed = 1e4, 1.0, 1e-8, 1e10
+    res = pf.simulate(pf.Oscillator(pf.Dahl(sigma, Fc, 1.0), mass=1.0), speed * Fc / math.sqrt(sigma),
+                      reversals=1, rtol=rtol, jit=False)
+    assert abs(res.reversals.x[0] / ((0.5 * speed**2 + 1.0) * Fc / sigma) - 1.0) <= 10 * rtol

@@ -57,15 +57,16 @@ def stiff_functions(model: "FrictionModel") -> StiffFunctions:
     return _FUNCTIONS[key]
 
 
-def _scales(y: np.ndarray, F: float, eps: float) -> np.ndarray:
+def _scales(y: np.ndarray, F: float, eps: float, travel: bool) -> np.ndarray:
     """Absolute tolerances from the amplitude ``A = hypot(v~, F~)``, as the native driver's
     ``pf_scale``: position ``max(A, A^2/2, min(|x~|, 1))``, velocity ``A``, model states
-    ``max(min(A, 1), |z|)``, all times ``eps``."""
+    ``min(A, 1)`` (``max(min(A, 1), |z|)`` for states that carry the ``travel``), all times
+    ``eps``."""
     A = max(math.hypot(y[1], F), 1e-300)
     out = np.empty(y.size)
     out[0] = max(A, 0.5 * A * A, min(abs(y[0]), 1.0))
     out[1] = A
-    out[2:] = np.maximum(min(A, 1.0), np.abs(y[2:]))
+    out[2:] = np.maximum(min(A, 1.0), np.abs(y[2:])) if travel else min(A, 1.0)
     return out * eps
 
 
@@ -114,7 +115,7 @@ def advance_stiff(run: "Run", t_target: float, n_target: float) -> bool:
             else:  # inside: stop on leaving it
                 events.append(_event(lambda _t, yy, s=s: _BAND * vs - s * yy[1]))
                 max_step = 0.25 * vs / max(abs(F), 1e-300)
-        atol = _scales(y, F, rtol)
+        atol = _scales(y, F, rtol, model.tracks_position)
         sol = solve_ivp(rhs, (t, min(t_target, 1e300)), y, method="Radau", jac=jac, rtol=rtol, atol=atol,
                         events=events, max_step=max_step)
         steps += int(sol.t.size - 1)

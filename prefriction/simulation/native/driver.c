@@ -169,10 +169,11 @@ static void pf_scale(pf_scales* S, const double* y, double F, double eps) {
   int i;
   S->sc[0] = fmax(fmax(A, 0.5 * A * A), fmin(fabs(y[0]), 1.0)) * eps;
   S->sc[1] = A * eps;
-  /* a model state far above the force scale (Dahl's log-gap L in deep gross sliding, gamma = 1:
-   * L grows like the travel v^2/2 while F = 1 - exp(-L) has long saturated) is held to its own
-   * size: against eps alone, the round-off of v in its increments stopped the run at |v| ~ 1.5e7 */
-  for (i = 2; i < PF_NY; ++i) S->sc[i] = fmax(fmin(A, 1.0), fabs(y[i])) * eps;
+  /* a state that carries the travel (models that track the position: Dahl's log-gap L, gamma >= 1,
+   * grows like v^2/2 in deep gross sliding while F = 1 - exp(-L) has long saturated) is held to
+   * its own size, as the position would be: against eps alone, the round-off of v in its
+   * increments stopped the run at |v| ~ 1.5e7 */
+  for (i = 2; i < PF_NY; ++i) S->sc[i] = (PF_NORM_X ? fmin(A, 1.0) : fmax(fmin(A, 1.0), fabs(y[i]))) * eps;
 }
 
 /* the scales and the branch energy at the state y */
