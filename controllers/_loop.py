@@ -238,7 +238,7 @@ def simulate_loop(
     if special and (Ts is None or system.forced):
         raise ValueError("a compensator, quantization, noise_rms and delay need a sampled controller (Ts or a "
                          "discrete controller) and an oscillator without its own input force (system.u = None)")
-    closed_loop(system, C, regime="presliding", warn=True)
+    closed_loop(system, C, regime="presliding", warn=True, delay=measurement.delay if Ts is not None else 0)
     fb_reference = reference
     stats = None
     extra: dict = {}

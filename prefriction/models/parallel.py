@@ -11,6 +11,7 @@ from collections import Counter
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Hashable, Optional, Sequence
 
+import casadi as ca
 import numpy as np
 
 from prefriction.models.base import FrictionModel
@@ -262,6 +263,17 @@ class Parallel(FrictionModel):
         for model, z_i, m_i, v_i, _tau, phi, q_i in self._parts(z, m, v, q):
             total = total + phi * model.force(z_i, m_i, v_i, s, q_i)
         return total
+
+    def velocity_scale(self, q: Any) -> Any:
+        """The least of the models' velocity scales in the sum's units (``vs~_i phi_i / tau_i``),
+        or None if no model has one (:meth:`FrictionModel.velocity_scale`)."""
+        out = None
+        for model, _z, _m, _v, tau, phi, q_i in self._parts([], [], None, q):
+            vs = model.velocity_scale(q_i)
+            if vs is not None:
+                vs = vs * phi / tau
+                out = vs if out is None else (min(out, vs) if isinstance(out + vs, float) else ca.fmin(out, vs))
+        return out
 
     def events(self, z: Sequence[Any], m: Sequence[Any], v: Any, s: Any, q: Any) -> list[Any]:
         out: list[Any] = []
