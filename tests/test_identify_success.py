@@ -148,7 +148,8 @@ def test_gms_tribometer_fit_returns_a_valid_model():
 
 @pytest.mark.slow
 def test_success_rate_over_the_stages():
-    """Issue 25's target: at least 90 % of fits from starts within a factor 2 land within 5 %."""
-    rows = success_table(STAGES, (2.0,), fits=4, samples=1000, seed=0)
-    total = sum(r.successes for r in rows) / sum(r.fits for r in rows)
-    assert total >= 0.9, table_text(rows)
+    """Issue 25's target on every stage (one start each within a factor 2, 1,000 samples): the
+    fits land within 5 % of every true parameter. The full table:
+    ``python -m prefriction.identify._success``."""
+    rows = success_table(STAGES, (2.0,), fits=1, samples=1000, seed=0)
+    assert all(r.successes == r.fits for r in rows), table_text(rows)

@@ -287,3 +287,25 @@ def table_text(rows: list[SuccessRow]) -> str:
         lines.append(f"| {r.stage} | x{r.distance:g} | {r.samples} | {r.successes}/{r.fits} | {r.converged}/{r.fits} "
                      f"| {r.median_time:.1f} | {r.max_time:.1f} | {r.worst} |")
     return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> None:
+    """``python -m prefriction.identify._success [--fits N] [--samples N] [--distances 1.5,2]``:
+    print the table, one progress line per fit on stderr."""
+    import argparse
+    import sys
+
+    ap = argparse.ArgumentParser(prog="python -m prefriction.identify._success", description=main.__doc__)
+    ap.add_argument("--fits", type=int, default=10)
+    ap.add_argument("--samples", type=int, default=1000)
+    ap.add_argument("--distances", default="1.5,2")
+    ap.add_argument("--seed", type=int, default=0)
+    args = ap.parse_args(argv)
+    rows = success_table(STAGES, tuple(float(d) for d in args.distances.split(",")), fits=args.fits,
+                         samples=args.samples, seed=args.seed,
+                         progress=lambda line: print(line, file=sys.stderr, flush=True))
+    print(table_text(rows))
+
+
+if __name__ == "__main__":
+    main()
