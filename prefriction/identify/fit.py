@@ -48,7 +48,7 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
         force ``u`` (a free decay for ``u = 0``), held or linear between samples as
         ``data.hold`` says; fitted by multiple shooting over segments of 50 samples with
         scipy's trust-region least squares in an augmented Lagrangian, records of more than 4,000
-        samples after a fit of their first 2,000 (``docs/identify_motion.md``: time and memory
+        samples after a fit of their 2,000 with the most reversals (``docs/identify_motion.md``: time and memory
         grow linearly with the samples).
     free : sequence of str, optional
         Parameters to fit (names of ``type(model).parameters``; ``"stiffness[0]"`` for an

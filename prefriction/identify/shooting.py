@@ -8,8 +8,8 @@ of a segment must meet the next node. The objective is the sum of squared positi
 minimised subject to the continuity of the segments by scipy's trust-region least squares in an
 augmented Lagrangian on sparse matrices (:mod:`prefriction.identify.constrained_lsq`), with
 forward sensitivities propagated sample by sample. A record longer than ``2 WINDOW`` samples
-fits its first :data:`WINDOW` samples first and starts the full record from their estimates
-(continuation). Nothing holds more than a few numbers per sample and sensitivity column, so the
+fits its :data:`WINDOW` samples with the most reversals first and starts the full record from
+their estimates (continuation). Nothing holds more than a few numbers per sample and sensitivity column, so the
 time and the memory of a fit grow linearly with the samples (measured:
 ``docs/identify_motion.md``).
 
@@ -293,21 +293,42 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
     theta0 = space.theta0
     progress = _progress if verbose or len(data) >= LONG else None
     if len(data) > 2 * WINDOW:
-        head = Motion(data.t[:WINDOW], data.x[:WINDOW], data.u[:WINDOW], data.mass, data.hold)
-        given = None if reversals is None else [r for r in reversals if r < data.t[WINDOW - 1]]
+        k0 = _busiest_window(data)
+        part = slice(k0, k0 + WINDOW)
+        head = Motion(data.t[part], data.x[part], data.u[part], data.mass, data.hold)
+        given = None if reversals is None else [r for r in reversals if head.t[0] < r < head.t[-1]]
         first = _solve_record(model, head, space, theta0, n_sub, max_iter, tol, given, progress, 0.01)
         if first.success:
             theta0 = first.w[: space.n_free]
             vals = space.values(theta0)
             model = space.build(vals)  # the sub-steps of the full record from the window's estimates
-            steps.append(f"continuation: the first {WINDOW} samples fitted first ({first.message}); the full "
-                         f"record started from their estimates ({_at(space, first.w)})")
+            steps.append(f"continuation: samples {k0} to {k0 + WINDOW - 1} fitted first ({first.message}); the "
+                         f"full record started from their estimates ({_at(space, first.w)})")
         else:
-            steps.append(f"continuation: the fit of the first {WINDOW} samples did not converge "
+            steps.append(f"continuation: the fit of samples {k0} to {k0 + WINDOW - 1} did not converge "
                          f"({first.message}); the full record started from the start values")
     sol = _solve_record(model, data, space, theta0, n_sub, max_iter, tol, reversals, progress,
                         0.01 if not steps or "did not" in steps[0] else 10.0)
     return dataclasses.replace(sol, steps=tuple(steps))
+
+
+def _busiest_window(data: Motion) -> int:
+    """First sample of the :data:`WINDOW`-sample window (starts every ``WINDOW / 4`` samples) with
+    the most velocity reversals of the smoothed positions, then the most travel: the part of the
+    record that excites the friction most."""
+    _x, v, _a = derivatives(data.t, data.x)
+    moving = np.abs(v) > 0.05 * float(np.max(np.abs(v)))
+    sv = np.where(moving, np.sign(v), 0.0)
+    nz = np.flatnonzero(sv)
+    flips = np.zeros(len(data))
+    flips[nz[1:][sv[nz[1:]] != sv[nz[:-1]]]] = 1.0
+    travel = np.abs(np.diff(data.x, prepend=data.x[0]))
+    best, key = 0, (-1.0, -1.0)
+    for k in range(0, len(data) - WINDOW + 1, WINDOW // 4):
+        cand = (float(flips[k:k + WINDOW].sum()), float(travel[k:k + WINDOW].sum()))
+        if cand > key:
+            best, key = k, cand
+    return best
 
 
 def _solve_record(model: FrictionModel, data: Motion, space: ParameterSpace, theta0: np.ndarray,
