@@ -42,6 +42,9 @@ _INNER = 40
 """Most Jacobian evaluations of one inner solve (an early, loose one need not converge)."""
 _RESTARTS = 2
 """Most restarts of the nuisance entries after a stalled outer iteration."""
+_RESTART_ABOVE = 1e-2
+"""Smallest constraint violation of a stalled outer iteration that restarts the nodes (below it
+a restart loses more than it gains: measured on 25,000 samples, 1.2e-5 became 5e-4)."""
 
 
 @dataclass(frozen=True)
@@ -100,7 +103,7 @@ def solve(full: Callable, plain: Callable, w0: np.ndarray, lo: np.ndarray, hi: n
     restart : callable, optional
         ``w -> w'``: a new start of the nuisance entries at the parameters of ``w`` (the shooting
         nodes simulated from the data), used when an outer iteration stalls (no step, constraints
-        not met): at a kink of the motion (a reversal that moves between sub-steps) the trust
+        violated by more than :data:`_RESTART_ABOVE`): at a kink of the motion (a reversal that moves between sub-steps) the trust
         region can shrink to nothing. At most :data:`_RESTARTS` times, each reported.
     progress : callable, optional
         Called with one line per outer iteration.
@@ -152,7 +155,7 @@ def solve(full: Callable, plain: Callable, w0: np.ndarray, lo: np.ndarray, hi: n
         w = sol.x
         r, g = plain(w)
         gmax = float(np.abs(g).max(initial=0.0))
-        if stalled and gmax > gtol and restart is not None and len(restarts) < _RESTARTS:
+        if stalled and gmax > _RESTART_ABOVE and restart is not None and len(restarts) < _RESTARTS:
             w = restart(w)
             r, g = plain(w)
             lam = np.zeros(g.size)
