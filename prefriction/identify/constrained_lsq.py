@@ -103,8 +103,8 @@ def solve(full: Callable, plain: Callable, w0: np.ndarray, lo: np.ndarray, hi: n
     restart : callable, optional
         ``w -> w'``: a new start of the nuisance entries at the parameters of ``w`` (the shooting
         nodes simulated from the data), used when an outer iteration stalls (no step, constraints
-        violated by more than :data:`_RESTART_ABOVE`): at a kink of the motion (a reversal that moves between sub-steps) the trust
-        region can shrink to nothing. At most :data:`_RESTARTS` times, each reported.
+        violated by more than :data:`_RESTART_ABOVE`): at a kink of the motion (a reversal that
+        moves between sub-steps) the trust region can shrink to nothing. At most :data:`_RESTARTS` times, each reported.
     progress : callable, optional
         Called with one line per outer iteration.
     """
