@@ -109,6 +109,7 @@ class Dahl(FrictionModel):
         Parameter("Fc", "N", 0.0, math.inf, low_open=True),
         Parameter("gamma", "-", 0.0, math.inf),
     )
+    rate_independent = True
 
     def __post_init__(self) -> None:
         self._validate()

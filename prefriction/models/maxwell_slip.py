@@ -135,6 +135,7 @@ class MaxwellSlip(ParallelElements):
     )
 
     _stiffness_field: ClassVar[str] = "stiffness"
+    rate_independent = True
 
     def _validate(self) -> None:
         """Check both arrays elementwise (each entry in the declared range) and their lengths."""
