@@ -2,7 +2,7 @@
 
 - :class:`FrictionModel` (``base.py``): the contract every model implements (``docs/models.md``);
 - :class:`Dahl` (``dahl.py``): the Dahl model (3.2) of the paper;
-- :class:`MaxwellSlip` (``maxwell_slip.py``): N elasto-plastic elements (Iwan; Lampaert et al.);
+- :class:`MaxwellSlip` (``maxwell_slip.py``): N elastic-plastic (Jenkin) elements (Iwan; Lampaert et al.);
 - :class:`LuGre` (``lugre.py``): the LuGre model (Canudas de Wit et al. 1995);
 - :class:`ElastoPlastic` (``elasto_plastic.py``): the single-state elasto-plastic model (Dupont et al. 2002);
 - :class:`GMS` (``gms.py``): the generalised Maxwell-slip model (Al-Bender et al. 2005);
