@@ -14,7 +14,7 @@ from typing import Any, Hashable, Optional, Sequence
 import casadi as ca
 import numpy as np
 
-from prefriction.analysis.branch import branch_potential
+from prefriction.models.dahl_branch import branch_potential
 from prefriction.models.base import FrictionModel, Parameter
 from prefriction.models.closed_form import exp, log1p_ratio, pick
 
@@ -257,5 +257,5 @@ class Dahl(FrictionModel):
         return s * (distance_of_log_gap(z1[0], g) - distance_of_log_gap(z0[0], g))
 
     def branch_energy_of_force(self, F: np.ndarray, s: Any) -> np.ndarray:
-        """``H_gamma(s F~)`` (:func:`prefriction.analysis.branch.branch_potential`), (3.9) for gamma = 1."""
+        """``H_gamma(s F~)`` (:func:`prefriction.models.dahl_branch.branch_potential`), (3.9) for gamma = 1."""
         return np.asarray(branch_potential(np.clip(s * np.asarray(F, dtype=float), -1.0, 1.0), self.gamma), dtype=float)
