@@ -23,7 +23,8 @@ import numpy as np
 import casadi as ca
 
 from prefriction._validation import check_nonnegative, check_positive, check_real
-from prefriction.models.defaults import normalised_parameters
+from prefriction.models.defaults import (branch_energy_by_quadrature, detect_rate_independent, normalised_parameters,
+                                         state_of_force)
 
 if TYPE_CHECKING:  # prefriction.units imports the models
     from prefriction.units import Scales
@@ -151,8 +152,6 @@ class FrictionModel(ABC):
         """True if the force ignores ``v`` and the rate is ``v`` times a function of the state: the
         energy analysis (2.3)-(2.12) applies. Default: read off :meth:`force` and :meth:`rate` on
         CasADi symbols (a class may declare it)."""
-        from prefriction.models.defaults import detect_rate_independent
-
         return detect_rate_independent(self)
 
     # --- normalisation: attributes (or properties) of every model -----------------------
@@ -227,8 +226,6 @@ class FrictionModel(ABC):
         if self.n_states != 1:
             raise NotImplementedError(f"{type(self).__name__} does not define initial_state(f0, s), the state of "
                                       f"a given force at rest, which a start from F0 != 0 needs")
-        from prefriction.models.defaults import state_of_force
-
         return [state_of_force(self, float(f0), float(s), self.runtime_params().tolist())], [0.0] * self.n_flags
 
     @abstractmethod
@@ -273,14 +270,15 @@ class FrictionModel(ABC):
         """
         return None
 
+    _sum: ClassVar[Any] = None
+    """``Parallel.of``, set by :mod:`prefriction.models.parallel` (which subclasses this class)."""
+
     def __add__(self, other: "FrictionModel") -> "FrictionModel":
         """``a + b``: the models in parallel (forces summed, each with its own state),
         :class:`prefriction.Parallel`."""
-        from prefriction.models.parallel import Parallel
-
         if not isinstance(other, FrictionModel):
             return NotImplemented
-        return Parallel.of(self, other)
+        return FrictionModel._sum(self, other)
 
     @property
     def has_free_branch(self) -> bool:
@@ -349,6 +347,4 @@ class FrictionModel(ABC):
                 f"{type(self).__name__} gives no branch energy as a function of the force alone "
                 f"(define branch_energy_of_force(F, s); the quadrature default serves one-state models)"
             )
-        from prefriction.models.defaults import branch_energy_by_quadrature
-
         return branch_energy_by_quadrature(self, F, s)

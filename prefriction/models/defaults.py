@@ -1,4 +1,5 @@
-"""The bookkeeping :class:`prefriction.FrictionModel` derives from a model's mathematics.
+"""The bookkeeping :class:`prefriction.FrictionModel` derives from a model's mathematics
+(``model`` is a :class:`prefriction.FrictionModel`, annotated ``Any``: the base imports this module).
 
 A model declares its parameters, ``n_states``, ``rate`` and ``force`` (and, if it has them,
 ``events`` with ``on_event``); the base class fills in the rest from these functions:
@@ -17,13 +18,10 @@ from __future__ import annotations
 
 import math
 import re
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import casadi as ca
 import numpy as np
-
-if TYPE_CHECKING:
-    from prefriction.models.base import FrictionModel
 
 __all__ = ["branch_energy_by_quadrature", "detect_rate_independent", "normalised_parameters", "state_of_force",
            "unit_exponents"]
@@ -50,7 +48,7 @@ def unit_exponents(unit: str) -> tuple[int, int, int]:
     return total[0], total[1], total[2]
 
 
-def normalised_parameters(model: "FrictionModel", x: float, F: float, t: float) -> np.ndarray:
+def normalised_parameters(model: Any, x: float, F: float, t: float) -> np.ndarray:
     """Every declared parameter of ``model`` divided by its unit ``F^a x^b t^c`` (the system's
     force, length and time units ``F = Fc``, ``x = Fc / sigma``, ``t = sqrt(m / sigma)``)."""
     out = []
@@ -64,7 +62,7 @@ def normalised_parameters(model: "FrictionModel", x: float, F: float, t: float) 
     return np.array(out, dtype=float)
 
 
-def detect_rate_independent(model: "FrictionModel") -> bool:
+def detect_rate_independent(model: Any) -> bool:
     """True if ``force`` does not depend on ``v`` and ``rate`` is ``v`` times a function of the state
     (the model traces the same curve at any speed), traced on CasADi symbols."""
     nz, nm, nq = model.n_states, model.n_flags, len(model.runtime_params())
@@ -86,7 +84,7 @@ def detect_rate_independent(model: "FrictionModel") -> bool:
                for _ in range(3))
 
 
-def state_of_force(model: "FrictionModel", f: float, s: float, q: Any) -> float:
+def state_of_force(model: Any, f: float, s: float, q: Any) -> float:
     """The state ``z`` of a one-state model whose force at rest is ``f`` on a branch of direction
     ``s`` (the force increasing with ``s z``; bracketed by doubling, then ``brentq``)."""
     from scipy.optimize import brentq
@@ -107,7 +105,7 @@ def state_of_force(model: "FrictionModel", f: float, s: float, q: Any) -> float:
                      f"direction {s!r}; give initial_state(f0, s) for this model")
 
 
-def branch_energy_by_quadrature(model: "FrictionModel", F: np.ndarray, s: Any) -> np.ndarray:
+def branch_energy_by_quadrature(model: Any, F: np.ndarray, s: Any) -> np.ndarray:
     """``-int F dx`` along the branch of direction ``s`` from the state of force ``F`` to the one of
     force zero, ``dx = s dz / rate(z, s)`` at unit speed: ``quad`` per entry (one-state models)."""
     from scipy.integrate import quad
