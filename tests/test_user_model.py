@@ -63,6 +63,18 @@ def test_friction_along_matches_an_independent_integration():
     np.testing.assert_allclose(got.F / 0.5, ref, rtol=0, atol=1e-9)
 
 
+def test_user_model_fits_force_displacement_data():
+    """The fit builds the model on CasADi symbols: the base's units and run-time numbers follow."""
+    from prefriction import identify
+
+    t = np.linspace(0.0, 1.0, 801)
+    x = 6e-6 * np.sin(2 * np.pi * t) + 1e-6 * np.sin(6 * np.pi * t)
+    truth = BoucWen(k=2e5, Fy=0.5)
+    F = pf.friction_along(truth, t, x).F
+    res = identify.fit(BoucWen(k=1.5e5, Fy=0.6), identify.ForceDisplacement(t, x, F), fixed=["c"])
+    assert res.model.k == pytest.approx(2e5, rel=1e-6) and res.model.Fy == pytest.approx(0.5, rel=1e-6)
+
+
 @dataclass(frozen=True)
 class Cubic(pf.FrictionModel):
     """The element alone: rate-independent, so the energy analysis applies (branch energy by quadrature)."""

@@ -134,18 +134,25 @@ class FrictionModel(ABC):
         refuse events without ``on_event`` (called by ``__post_init__``)."""
         for par in self.parameters:
             object.__setattr__(self, par.name, par.check(getattr(self, par.name)))
-        for unit, role in (("N/m", "sigma"), ("N", "Fc")):
-            if not hasattr(self, role):
-                declared = [p.name for p in self.parameters if unit_of(p) == unit]
-                if not declared:
-                    raise TypeError(f"{type(self).__name__} has no {role}, the reference "
-                                    f"{'stiffness [N/m]' if role == 'sigma' else 'force [N]'} of the normalised "
-                                    f"units: declare a parameter in {unit} or define {role}")
-                object.__setattr__(self, role, getattr(self, declared[0]))
+        for role in ("sigma", "Fc"):
+            getattr(self, role)  # a class attribute or property, else the declared parameter (__getattr__)
         cls = type(self)
         if cls.events is not FrictionModel.events and cls.on_event is FrictionModel.on_event:
             raise TypeError(f"{cls.__name__} defines events() but not on_event(k, z, m, s, q), the state just "
                             f"after event k, which the simulator applies at every event")
+
+    def __getattr__(self, name: str) -> Any:
+        """``sigma`` and ``Fc`` of a class that does not define them: the first declared parameter
+        in ``N/m`` and in ``N`` (read each time, so a copy with other numbers has its own)."""
+        units = {"sigma": "N/m", "Fc": "N"}
+        if name not in units:
+            raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+        declared = [p.name for p in type(self).parameters if unit_of(p) == units[name]]
+        if not declared:
+            raise TypeError(f"{type(self).__name__} has no {name}, the reference "
+                            f"{'stiffness [N/m]' if name == 'sigma' else 'force [N]'} of the normalised units: "
+                            f"declare a parameter in {units[name]} or define {name}")
+        return getattr(self, declared[0])
 
     @cached_property
     def rate_independent(self) -> bool:  # type: ignore[override]

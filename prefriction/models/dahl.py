@@ -110,9 +110,7 @@ class Dahl(FrictionModel):
         Parameter("gamma", "-", 0.0, math.inf),
     )
     rate_independent = True
-
-    def __post_init__(self) -> None:
-        self._validate()
+    n_states = 1
 
     @property
     def saturates(self) -> bool:
@@ -123,10 +121,6 @@ class Dahl(FrictionModel):
     def tracks_position(self) -> bool:  # type: ignore[override]
         """Without saturation ``x - x_start = s (p - p_start)`` on a branch."""
         return not self.saturates
-
-    @property
-    def n_states(self) -> int:
-        return 1
 
     @property
     def n_flags(self) -> int:

@@ -58,7 +58,9 @@ def normalised_parameters(model: Any, x: float, F: float, t: float) -> np.ndarra
         except ValueError as err:
             raise TypeError(f"{type(model).__name__}: parameter {par.name}: {err}; declare a unit of that form "
                             f"or override runtime_params_for(scales), which gives the run-time numbers") from None
-        out.append(float(getattr(model, par.name)) / (F ** a * x ** b * t ** c))
+        out.append(getattr(model, par.name) / (F ** a * x ** b * t ** c))
+    if any(isinstance(v, (ca.SX, ca.MX)) for v in out):  # the fit's symbolic parameters: a list of them
+        return out  # type: ignore[return-value]
     return np.array(out, dtype=float)
 
 

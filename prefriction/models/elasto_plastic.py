@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from types import SimpleNamespace
 from typing import TYPE_CHECKING, Any, Hashable, Sequence
 
 import casadi as ca
@@ -157,9 +158,7 @@ class ElastoPlastic(FrictionModel):
 
     def runtime_params(self) -> np.ndarray:
         """:meth:`runtime_params_for` of a unit mass (``V = Fc / sqrt(sigma0)``)."""
-        V = self.Fc / math.sqrt(self.sigma0)
-        return np.array([self.sigma1 * V / self.Fc, self.sigma2 * V / self.Fc, self.Fs / self.Fc - 1.0,
-                         self.vs / V, self.sigma0 * self.z_ba / self.Fc])
+        return self.runtime_params_for(SimpleNamespace(v=self.Fc / math.sqrt(self.sigma0)))  # type: ignore[arg-type]
 
     def initial_state(self, f0: float, s: float) -> tuple[list[float], list[float]]:
         """Bristle force ``zeta = f0`` at rest; past breakaway if ``s f0 > b``, saturated if ``s f0 >= Fs/Fc``."""
