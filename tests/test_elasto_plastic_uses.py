@@ -30,11 +30,32 @@ def test_fit_recovers_the_parameters_from_force_displacement_data():
     assert res.rms == pytest.approx(1e-3, rel=0.1)
 
 
-def test_motion_fit_is_refused_with_the_way_out():
-    t = np.linspace(0.0, 0.05, 200)
-    data = identify.Motion(t, 1e-6 * np.sin(2 * np.pi * 40 * t), u=0.1, mass=0.5)
-    with pytest.raises(ValueError, match="ElastoPlastic has 2 events: fit it to ForceDisplacement"):
+@pytest.mark.slow  # about 30 s: the reference under a sampled force, then multiple shooting
+def test_motion_fit_with_the_crossings_in_the_right_hand_side():
+    """Positions from the reference under a known force; the motion fit needs the form without
+    events (``crossings=False``), and names it for the form with them."""
+    t = np.linspace(0.0, 0.25, 501)
+    u = 0.2 + 0.9 * np.sin(2 * np.pi * 8 * t)
+    ref = oscillator(TRUE, 0.5, 1e-300, u=lambda tt: float(np.interp(tt, t, u)), t_end=0.25, times=t)
+    assert ref["breakaways"] >= 3
+    x = ref["dense"][:, 0] + 1e-9 * np.random.default_rng(0).standard_normal(t.size)
+    data = identify.Motion(t, x, u=u, mass=0.5, hold="linear")
+    with pytest.raises(ValueError, match="ElastoPlastic has 2 events: fit it to ForceDisplacement data, or give it "
+                                         "with crossings=False"):
         identify.fit(TRUE, data)
+    start = pf.ElastoPlastic(0.7e5, 100.0, 0.4, 1.2, 1.3, 1e-3, 0.4e-5, crossings=False)
+    res = identify.fit(start, data, fixed=["sigma1", "sigma2", "vs"])
+    for name in ("sigma0", "Fc", "Fs", "z_ba"):
+        assert getattr(res.model, name) == pytest.approx(getattr(TRUE, name), rel=2e-3), name
+
+
+def test_crossings_in_the_right_hand_side_match_the_2002_equations():
+    ep = pf.ElastoPlastic(1e5, 100.0, 0.4, 1.0, 1.5, 1e-3, 0.5e-5, crossings=False)
+    assert (ep.n_flags, ep.n_events) == (0, 0)
+    res = pf.simulate(pf.Oscillator(ep, mass=0.5), 0.05, reversals=8, rtol=1e-10)
+    ref = oscillator(TRUE, 0.5, 0.05, t_end=res.reversals.t[-1] * (1 + 1e-7))["reversals"]
+    assert np.max(np.abs(res.reversals.t - ref[:, 0]) / ref[:, 0]) < 1e-9
+    assert np.max(np.abs(res.reversals.F - ref[:, 2])) < 1e-9 * np.max(np.abs(ref[:, 2]))
 
 
 def test_loop_with_feedforward_and_observers():

@@ -87,6 +87,11 @@ class ElastoPlastic(FrictionModel):
         Stribeck velocity [m/s], ``0 < vs < inf``.
     z_ba : float
         Breakaway displacement [m], ``0 < z_ba < Fc / sigma0`` (below every ``z_ss(v)``).
+    crossings : bool, default True
+        Locate the breakaway and saturation crossings as events (flags ``broke``, ``sat``).
+        ``False``: ``alpha`` straight from its definition inside the right-hand side (C1 kinks
+        that the integrators' error control steps over; no flags and no events), the form
+        :func:`prefriction.identify.fit` needs for :class:`~prefriction.identify.Motion` data.
 
     Raises
     ------
@@ -114,6 +119,7 @@ class ElastoPlastic(FrictionModel):
     Fs: float
     vs: float
     z_ba: float
+    crossings: bool = True
 
     parameters = (
         Parameter("sigma0", "N/m", 0.0, math.inf, low_open=True),
@@ -126,8 +132,6 @@ class ElastoPlastic(FrictionModel):
     )
     rate_independent = False
     n_states = 1
-    n_flags = 2
-    n_events = 2
 
     def __post_init__(self) -> None:
         self._validate()
@@ -147,8 +151,16 @@ class ElastoPlastic(FrictionModel):
         """The static force ``Fs`` [N] (the bristle force never exceeds ``f_ss(0)``)."""
         return self.Fs
 
+    @property
+    def n_flags(self) -> int:  # type: ignore[override]
+        return 2 if self.crossings else 0
+
+    @property
+    def n_events(self) -> int:  # type: ignore[override]
+        return 2 if self.crossings else 0
+
     def structure_key(self) -> Hashable:
-        return ("ElastoPlastic", "one bristle state, breakaway and saturation")
+        return ("ElastoPlastic", "crossings as events" if self.crossings else "crossings in the right-hand side")
 
     def runtime_params_for(self, scales: "Scales") -> np.ndarray:
         """``q = [sigma1 V/Fc, sigma2 V/Fc, Fs/Fc - 1, vs/V, sigma0 z_ba/Fc]``, ``V = scales.v``."""
@@ -163,6 +175,8 @@ class ElastoPlastic(FrictionModel):
     def initial_state(self, f0: float, s: float) -> tuple[list[float], list[float]]:
         """Bristle force ``zeta = f0`` at rest; past breakaway if ``s f0 > b``, saturated if ``s f0 >= Fs/Fc``."""
         w, b = s * f0, self.sigma0 * self.z_ba / self.Fc
+        if not self.crossings:
+            return [float(f0)], []
         return [float(f0)], [1.0 if w > b else 0.0, 1.0 if w >= self.Fs / self.Fc else 0.0]
 
     @staticmethod
@@ -174,13 +188,18 @@ class ElastoPlastic(FrictionModel):
     def rate(self, z: Sequence[Any], m: Sequence[Any], v: Any, s: Any, q: Any) -> list[Any]:
         g, w = self.stribeck(v, q), s * z[0]
         t = alpha(w, g, q[4])
-        a = m[0] * (m[1] * pick(w >= g, 1.0, t) + (1.0 - m[1]) * t)
+        if not self.crossings:
+            a = pick(w <= q[4], 0.0, pick(w >= g, 1.0, t))
+        else:
+            a = m[0] * (m[1] * pick(w >= g, 1.0, t) + (1.0 - m[1]) * t)
         return [v * (1.0 - a * w / g)]
 
     def force(self, z: Sequence[Any], m: Sequence[Any], v: Any, s: Any, q: Any) -> Any:
         return z[0] + q[0] * self.rate(z, m, v, s, q)[0] + q[1] * v
 
     def events(self, z: Sequence[Any], m: Sequence[Any], v: Any, s: Any, q: Any) -> list[Any]:
+        if not self.crossings:
+            return []
         w, g = s * z[0], self.stribeck(v, q)
         breakaway = pick(m[0] > 0.5, 1.0, q[4] - w)
         saturation = pick(m[0] > 0.5, pick(m[1] > 0.5, 1.0, g - w), 1.0)
@@ -193,6 +212,8 @@ class ElastoPlastic(FrictionModel):
 
     def reverse(self, z: Sequence[Any], m: Sequence[Any], s_new: Any, q: Any, snap: Any) -> tuple[list[Any], list[Any]]:
         """``zeta`` kept; ``broke`` if ``s_new zeta > b`` (the bristle has not unloaded), ``sat`` cleared."""
+        if not self.crossings:
+            return [z[0]], []
         return [z[0]], [pick(s_new * z[0] > q[4], 1.0, 0.0), 0.0]
 
     def advance(self, z: Sequence[Any], m: Sequence[Any], v: Any, dt: Any, s: Any,
@@ -206,11 +227,11 @@ class ElastoPlastic(FrictionModel):
         approaches ``g`` without reaching it, so no saturation falls inside an interval; one at
         its start (``g`` lower at the new speed) is taken there."""
         g, b, w0, xi = self.stribeck(v, q), q[4], s * z[0], s * v * dt
-        broke = m[0] > 0.5
+        broke = m[0] > 0.5 if self.crossings else w0 > b
         elastic = _and(_not(broke), w0 + xi <= b)
         w_start = pick(broke, w0, b)
         rest = pick(broke, xi, w0 + xi - b)
-        sat = _or(m[1] > 0.5, w_start >= g)
+        sat = _or(m[1] > 0.5, w_start >= g) if self.crossings else True
         relax = g + (w_start - g) * exp(-rest / g)
         slope = lambda w: 1.0 - pick(sat, pick(w >= g, 1.0, alpha(w, g, b)), alpha(w, g, b)) * w / g  # noqa: E731
         w_rk, h = w_start, rest / TRANSITION_STEPS
@@ -221,6 +242,8 @@ class ElastoPlastic(FrictionModel):
             k4 = slope(w_rk + h * k3)
             w_rk = w_rk + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
         w1 = pick(elastic, w0 + xi, pick(_and(sat, w_start >= g), relax, w_rk))
+        if not self.crossings:
+            return [s * w1], []
         return [s * w1], [pick(elastic, m[0], 1.0), pick(elastic, m[1], pick(sat, 1.0, 0.0))]
 
     def steady_force(self, v: Any) -> Any:
