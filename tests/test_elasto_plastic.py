@@ -84,3 +84,14 @@ def test_below_breakaway_the_model_is_a_spring():
 def test_bad_parameters_are_refused_by_name(bad, name):
     with pytest.raises(ValueError, match=name):
         pf.ElastoPlastic(**{**EP, **bad})
+
+
+def test_sweep_over_the_breakaway_displacement_equals_single_runs():
+    """One compiled plant for every ``z_ba``; each sweep member as its own run (and the reference)."""
+    models = [pf.ElastoPlastic(**{**EP, "z_ba": z}) for z in (0.2e-5, 0.5e-5, 0.8e-5)]
+    systems = [pf.Oscillator(m, mass=MASS) for m in models]
+    swept = pf.sweep(systems, 0.05, reversals=4, rtol=1e-10)
+    assert swept.success
+    for system, res in zip(systems, swept):
+        ref = oscillator(system.friction, MASS, 0.05, t_end=res.reversals.t[-1] * (1.0 + 1e-7))["reversals"]
+        assert np.max(np.abs(res.reversals.F - ref[:, 2])) < 1e-9 * np.max(np.abs(ref[:, 2]))
