@@ -137,3 +137,27 @@ def test_missing_pieces_are_refused_naming_them():
 
     with pytest.raises(TypeError, match="has no Fc"):
         NoUnits(1.0, 1.0)
+
+
+@dataclass(frozen=True)
+class TwoElements(pf.FrictionModel):
+    """Two Bouc-Wen elements of stiffness ratio 1:3 and a damper: several states, no initial_state."""
+
+    k: float
+    Fy: float
+    c: float
+    parameters = BoucWen.parameters
+    n_states = 2
+
+    def rate(self, z, m, v, s, q):
+        return [0.25 * v * (1.0 - s * (2.0 * z[0]) ** 3), 0.75 * v * (1.0 - s * (2.0 * z[1]) ** 3)]
+
+    def force(self, z, m, v, s, q):
+        return z[0] + z[1] + q[2] * v
+
+
+def test_several_states_without_initial_state():
+    model = TwoElements(1e4, 2.0, 5.0)
+    assert check_model(model, v0=1.0, reversals=5, t_end=60.0).n_reversals >= 3
+    with pytest.raises(NotImplementedError, match="does not define initial_state"):
+        pf.simulate(pf.Oscillator(model), 0.0, F0=0.5, reversals=2)
