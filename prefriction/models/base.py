@@ -64,6 +64,10 @@ class Parameter:
         return v
 
 
+_UNITS = {"sigma": "N/m", "Fc": "N"}
+"""The units of the reference stiffness and force, by which the base finds them among the parameters."""
+
+
 def unit_of(par: Parameter) -> str:
     """The unit of ``par`` with single spaces."""
     return " ".join(par.unit.split())
@@ -97,8 +101,8 @@ class FrictionModel(ABC):
 
     **Compile once per structure.** The simulator builds one CasADi function per
     :meth:`structure_key`. Everything that may change without changing the generated code is a
-    run-time number returned by :meth:`runtime_params_for` (``q``; by default
-    :meth:`runtime_params`, numbers independent of the mass); :meth:`rate`, :meth:`force`,
+    run-time number returned by :meth:`runtime_params_for` (``q``; by default the declared
+    parameters in normalised units, in their order); :meth:`rate`, :meth:`force`,
     :meth:`events`, :meth:`on_event` and :meth:`reverse` must build their expressions from
     ``q`` and never from the instance's own numbers, and must work on Python floats, numpy
     arrays and CasADi ``SX`` symbols alike (the test helper
@@ -129,13 +133,16 @@ class FrictionModel(ABC):
         self._validate()
 
     def _validate(self) -> None:
-        """Check every declared parameter, derive the units ``sigma`` and ``Fc`` if the class does
-        not define them (a parameter of that name, else the first in ``N/m`` and in ``N``), and
-        refuse events without ``on_event`` (called by ``__post_init__``)."""
+        """Check every declared parameter, refuse a model without the units ``sigma`` and ``Fc``
+        (defined, or a parameter in ``N/m`` and in ``N``) and events without ``on_event``
+        (called by ``__post_init__``)."""
         for par in self.parameters:
             object.__setattr__(self, par.name, par.check(getattr(self, par.name)))
-        for role in ("sigma", "Fc"):
-            getattr(self, role)  # a class attribute or property, else the declared parameter (__getattr__)
+        for role, unit in _UNITS.items():
+            if not hasattr(self, role):
+                raise TypeError(f"{type(self).__name__} has no {role}, the reference "
+                                f"{'stiffness' if role == 'sigma' else 'force'} [{unit}] of the normalised units: "
+                                f"declare a parameter in {unit} or define {role}")
         cls = type(self)
         if cls.events is not FrictionModel.events and cls.on_event is FrictionModel.on_event:
             raise TypeError(f"{cls.__name__} defines events() but not on_event(k, z, m, s, q), the state just "
@@ -144,14 +151,9 @@ class FrictionModel(ABC):
     def __getattr__(self, name: str) -> Any:
         """``sigma`` and ``Fc`` of a class that does not define them: the first declared parameter
         in ``N/m`` and in ``N`` (read each time, so a copy with other numbers has its own)."""
-        units = {"sigma": "N/m", "Fc": "N"}
-        if name not in units:
-            raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
-        declared = [p.name for p in type(self).parameters if unit_of(p) == units[name]]
+        declared = [p.name for p in type(self).parameters if name in _UNITS and unit_of(p) == _UNITS[name]]
         if not declared:
-            raise TypeError(f"{type(self).__name__} has no {name}, the reference "
-                            f"{'stiffness [N/m]' if name == 'sigma' else 'force [N]'} of the normalised units: "
-                            f"declare a parameter in {units[name]} or define {name}")
+            raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
         return getattr(self, declared[0])
 
     @cached_property
