@@ -95,3 +95,12 @@ def test_sweep_over_the_breakaway_displacement_equals_single_runs():
     for system, res in zip(systems, swept):
         ref = oscillator(system.friction, MASS, 0.05, t_end=res.reversals.t[-1] * (1.0 + 1e-7))["reversals"]
         assert np.max(np.abs(res.reversals.F - ref[:, 2])) < 1e-9 * np.max(np.abs(ref[:, 2]))
+
+
+def test_sum_with_a_damper_is_the_viscous_term():
+    """``ElastoPlastic(sigma2=0) + Viscous(b)`` and ``ElastoPlastic(sigma2=b)``: the same equations."""
+    summed = pf.ElastoPlastic(**{**EP, "sigma2": 0.0}) + pf.Viscous(b=EP["sigma2"])
+    one = pf.simulate(pf.Oscillator(pf.ElastoPlastic(**EP), mass=MASS), 0.05, reversals=6, rtol=1e-10).reversals
+    two = pf.simulate(pf.Oscillator(summed, mass=MASS), 0.05, reversals=6, rtol=1e-10).reversals
+    np.testing.assert_allclose(two.t, one.t, rtol=1e-9)
+    np.testing.assert_allclose(two.F, one.F, rtol=0, atol=1e-9 * np.max(np.abs(one.F)))
