@@ -1,7 +1,9 @@
 """Friction models behind one protocol, and the oscillator (2.1) they act in.
 
-- :class:`FrictionModel` (``base.py``): the contract every model implements (``docs/models.md``);
-- :class:`Dahl` (``dahl.py``): the Dahl model (3.2) of the paper;
+- :class:`FrictionModel` (``base.py``): the contract every model implements (``docs/models.md``),
+  with the bookkeeping it derives from a model's mathematics in ``defaults.py``;
+- :class:`Dahl` (``dahl.py``): the Dahl model (3.2) of the paper, its branch functions for any
+  gamma in ``dahl_branch.py`` (public as :mod:`prefriction.analysis.branch`);
 - :class:`MaxwellSlip` (``maxwell_slip.py``): N elastic-plastic (Jenkin) elements (Iwan; Lampaert et al.);
 - :class:`LuGre` (``lugre.py``): the LuGre model (Canudas de Wit et al. 1995);
 - :class:`ElastoPlastic` (``elasto_plastic.py``): the single-state elasto-plastic model (Dupont et al. 2002);
