@@ -1,4 +1,6 @@
-"""Dahl friction model (3.2) through the friction-model protocol.
+"""Dahl friction model (3.2) through the friction-model protocol::
+
+    dF/dx = sigma (1 - s F / Fc)^gamma,   s = sign(x');   normalised: f' = s v (1 - f)^gamma, f = s F~
 
 gamma is a run-time number of the compiled plant; the structure only distinguishes the
 saturating case (gamma < 1: branch-distance state, a saturation event and flag) from

@@ -1,4 +1,6 @@
-"""Maxwell-slip friction: N elastic-plastic (Jenkin) elements in parallel, through the protocol.
+"""Maxwell-slip friction: N elastic-plastic (Jenkin) elements in parallel, through the protocol::
+
+    F = sum_i F_i,   F_i' = k_i x' while |F_i| < W_i (sticking),   F_i = s W_i while slipping
 
 Iwan's parallel model of elastic-plastic elements (W. D. Iwan, "A distributed-element model for
 hysteresis and its steady-state dynamic response", J. Appl. Mech. 33 (1966) 893-900) in the
