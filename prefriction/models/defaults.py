@@ -64,9 +64,21 @@ def normalised_parameters(model: Any, x: float, F: float, t: float) -> np.ndarra
     return np.array(out, dtype=float)
 
 
+_RATE_INDEPENDENT: dict = {}  # (class, structure key) -> bool: traced once per structure
+
+
 def detect_rate_independent(model: Any) -> bool:
     """True if ``force`` does not depend on ``v`` and ``rate`` is ``v`` times a function of the state
-    (the model traces the same curve at any speed), traced on CasADi symbols."""
+    (the model traces the same curve at any speed), traced on CasADi symbols once per structure
+    (the methods build their expressions from ``q``, so every instance of a structure agrees)."""
+    key = (type(model), model.structure_key())
+    if key not in _RATE_INDEPENDENT:
+        _RATE_INDEPENDENT[key] = _trace_rate_independent(model)
+    return _RATE_INDEPENDENT[key]
+
+
+def _trace_rate_independent(model: Any) -> bool:
+    """:func:`detect_rate_independent` for one instance."""
     nz, nm, nq = model.n_states, model.n_flags, len(model.runtime_params())
     z = [ca.SX.sym(f"z{i}") for i in range(nz)]
     m = [ca.SX.sym(f"m{i}") for i in range(nm)]
