@@ -56,7 +56,10 @@ def test_friction_along_matches_the_2002_equations():
     x = 2e-5 * np.sin(40.0 * math.pi * t) + 0.6e-5 * np.sin(94.0 * math.pi * t)
     got = pf.friction_along(ep, t, x)
     assert got.step == "exact"
-    assert _rel(got.F, along(ep, t, x)) < 1e-10
+    ref = along(ep, t, x)
+    assert _rel(got.F, ref) < 1e-10
+    inside = pf.friction_along(pf.ElastoPlastic(**EP, crossings=False), t, x)  # no flags: the same step
+    assert _rel(inside.F, ref) < 1e-10 and inside.flags.shape == (t.size, 0)
     # sample by sample: the same forces
     stream = pf.FrictionStream(ep, x0=x[0], t0=t[0])
     F = np.array([stream.step(xi, ti) for ti, xi in zip(t[1:], x[1:])])
