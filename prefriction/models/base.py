@@ -18,9 +18,8 @@ from dataclasses import dataclass
 from functools import cached_property
 from typing import TYPE_CHECKING, Any, ClassVar, Hashable, Optional, Sequence
 
-import numpy as np
-
 import casadi as ca
+import numpy as np
 
 from prefriction._validation import check_nonnegative, check_positive, check_real
 from prefriction.models.defaults import (branch_energy_by_quadrature, detect_rate_independent, normalised_parameters,
