@@ -18,16 +18,15 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from types import SimpleNamespace
-from typing import TYPE_CHECKING, Any, Hashable, Sequence
+from typing import Any, Hashable, Sequence
 
 import casadi as ca
 import numpy as np
 
 from prefriction.models.base import FrictionModel, Parameter
 from prefriction.models.closed_form import exp, pick, symbolic
-
-if TYPE_CHECKING:  # units imports the models
-    from prefriction.units import Scales
+from prefriction.models.lugre import LuGre
+from prefriction.units import Scales
 
 __all__ = ["ElastoPlastic", "TRANSITION_STEPS", "alpha"]
 
@@ -121,35 +120,18 @@ class ElastoPlastic(FrictionModel):
     z_ba: float
     crossings: bool = True
 
-    parameters = (
-        Parameter("sigma0", "N/m", 0.0, math.inf, low_open=True),
-        Parameter("sigma1", "N s/m", 0.0, math.inf),
-        Parameter("sigma2", "N s/m", 0.0, math.inf),
-        Parameter("Fc", "N", 0.0, math.inf, low_open=True),
-        Parameter("Fs", "N", 0.0, math.inf, low_open=True),
-        Parameter("vs", "m/s", 0.0, math.inf, low_open=True),
-        Parameter("z_ba", "m", 0.0, math.inf, low_open=True),
-    )
+    parameters = LuGre.parameters + (Parameter("z_ba", "m", 0.0, math.inf, low_open=True),)
     rate_independent = False
     n_states = 1
+    sigma = LuGre.sigma
+    max_hysteretic_force = LuGre.max_hysteretic_force
+    steady_force = LuGre.steady_force
 
     def __post_init__(self) -> None:
-        self._validate()
-        if not self.Fs >= self.Fc:
-            raise ValueError(f"Fs must be >= Fc = {self.Fc!r} [N] (allowed range: Fc <= Fs < inf), got {self.Fs!r}")
+        LuGre.__post_init__(self)  # type: ignore[arg-type]  # LuGre's parameters, Fc <= Fs
         if not self.z_ba < self.Fc / self.sigma0:
             raise ValueError(f"z_ba must lie in (0, Fc / sigma0) = (0, {self.Fc / self.sigma0!r}) [m] (breakaway "
                              f"before the steady-state deflection), got {self.z_ba!r}")
-
-    @property
-    def sigma(self) -> float:  # type: ignore[override]
-        """Reference stiffness of the normalised units: ``sigma0`` [N/m]."""
-        return self.sigma0
-
-    @property
-    def max_hysteretic_force(self) -> float:  # type: ignore[override]
-        """The static force ``Fs`` [N] (the bristle force never exceeds ``f_ss(0)``)."""
-        return self.Fs
 
     @property
     def n_flags(self) -> int:  # type: ignore[override]
@@ -162,7 +144,7 @@ class ElastoPlastic(FrictionModel):
     def structure_key(self) -> Hashable:
         return ("ElastoPlastic", "crossings as events" if self.crossings else "crossings in the right-hand side")
 
-    def runtime_params_for(self, scales: "Scales") -> np.ndarray:
+    def runtime_params_for(self, scales: Scales) -> np.ndarray:
         """``q = [sigma1 V/Fc, sigma2 V/Fc, Fs/Fc - 1, vs/V, sigma0 z_ba/Fc]``, ``V = scales.v``."""
         V = scales.v
         return np.array([self.sigma1 * V / self.Fc, self.sigma2 * V / self.Fc, self.Fs / self.Fc - 1.0,
@@ -245,8 +227,3 @@ class ElastoPlastic(FrictionModel):
         if not self.crossings:
             return [s * w1], []
         return [s * w1], [pick(elastic, m[0], 1.0), pick(elastic, m[1], pick(sat, 1.0, 0.0))]
-
-    def steady_force(self, v: Any) -> Any:
-        """Steady-state friction [N] at the constant velocity ``v`` [m/s] (numpy): ``sign(v) f_ss(v) + sigma2 v``."""
-        v = np.asarray(v, dtype=float)
-        return np.sign(v) * (self.Fc + (self.Fs - self.Fc) * np.exp(-(v / self.vs) ** 2)) + self.sigma2 * v
