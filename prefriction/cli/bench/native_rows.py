@@ -1,0 +1,174 @@
+"""``prefriction bench --native``: every run kind of the native driver against its own references.
+
+Each row times :func:`prefriction.simulate` (end to end, warm) and a reference written from the
+equations, in interleaved rounds, process CPU time, the least of each (robust to a loaded
+machine), and prints the ratio (``docs/bench.md#native``):
+
+- the unforced headline (Dahl, 50 reversals) at ``rtol`` 1e-8 and 1e-4 against the plain-C
+  reference (:mod:`prefriction.cli.bench.plain_c`: the same Runge-Kutta 5(4), states and scaling);
+- forced Dahl and LuGre under a sine force, Dahl under a :class:`~prefriction.signals.Samples`
+  force at 1 kHz, and forced Dahl with 1,000 dense samples against the numba references of
+  :mod:`prefriction.cli.bench.numba_refs` (when numba is installed), **at matched error**: the
+  reference runs at the loosest tolerance of a ladder whose reversal error is no larger than
+  that of ``simulate``, both errors measured against the reference at ``rtol = 1e-13``.
+
+Targets (issue 27): unforced headline <= 2x, forced sine rows <= 2x, Samples and dense rows
+<= 3x, loose-tolerance headline <= 3x.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from typing import Callable, Optional
+
+import numpy as np
+
+__all__ = ["NativeRow", "main", "run"]
+
+_LADDER = (1e-6, 3e-7, 1e-7, 3e-8, 1e-8, 3e-9, 1e-9, 3e-10, 1e-10, 3e-11, 1e-11, 1e-12)
+SIGMA, FC, MASS, AMP, FREQ = 1e4, 1.0, 1.0, 2.0, 5.0  # N/m, N, kg, N, Hz
+LUGRE = (1e5, 300.0, 0.4, 1.0, 1.5, 1e-3)
+
+
+@dataclass
+class NativeRow:
+    """One row: the two minima [s], the errors and the target."""
+
+    name: str
+    reference: str
+    sim_s: float
+    ref_s: float
+    sim_error: float
+    ref_error: float
+    target: float
+    same_rtol_s: float = math.nan  # the reference at simulate's rtol (less accurate), for comparison
+
+    @property
+    def ratio(self) -> float:
+        """simulate over the reference."""
+        return self.sim_s / self.ref_s
+
+    def line(self) -> str:
+        ok = "PASS" if self.ratio <= self.target else "FAIL"
+        return (f"  {self.name:<38s} {self.sim_s * 1e3:9.3f} ms  {self.reference:<7s} {self.ref_s * 1e3:9.3f} ms  "
+                f"ratio {self.ratio:5.2f}  (target <= {self.target:g}x: {ok})  errors {self.sim_error:.1e} / "
+                f"{self.ref_error:.1e}" + ("" if math.isnan(self.same_rtol_s) else
+                                            f"; reference at rtol 1e-8: {self.same_rtol_s * 1e3:.3f} ms "
+                                            f"(ratio {self.sim_s / self.same_rtol_s:.2f})"))
+
+
+def _interleaved(a: Callable[[], object], b: Callable[[], object], rounds: int) -> tuple[float, float]:
+    """Least process CPU time of ``a`` and of ``b`` over interleaved rounds."""
+    best_a = best_b = math.inf
+    for _ in range(rounds):
+        t0 = time.process_time()
+        a()
+        t1 = time.process_time()
+        b()
+        t2 = time.process_time()
+        best_a, best_b = min(best_a, t1 - t0), min(best_b, t2 - t1)
+    return best_a, best_b
+
+
+def _error(t: np.ndarray, x: np.ndarray, F: np.ndarray, ref: np.ndarray) -> float:
+    """Largest error of reversal times (relative to the run's length), positions (to the largest
+    |x|) and forces (to Fc) against the reference rows ``ref``; inf if the counts differ."""
+    if len(t) != ref.shape[1]:
+        return math.inf
+    if not len(t):
+        return 0.0
+    return max(float(np.max(np.abs(t - ref[0]))), float(np.max(np.abs(x - ref[1]))) / max(float(np.max(np.abs(ref[1]))), 1e-300),
+               float(np.max(np.abs(F - ref[2]))) / FC)
+
+
+def _forced_rows(rounds: int) -> list[NativeRow]:
+    import prefriction as pf
+    from prefriction.cli.bench import numba_refs as nr
+    from prefriction.signals import Samples, Sine
+
+    ts = np.linspace(0.0, 1.0, 1001)
+    us = AMP * np.sin(2 * np.pi * FREQ * ts)
+    td = np.linspace(0.0, 1.0, 1000)
+    dahl = pf.Dahl(SIGMA, FC)
+    lugre = pf.LuGre(*LUGRE)
+    w = 2 * np.pi * FREQ
+    cases = [
+        ("forced Dahl, sine force", pf.Oscillator(dahl, MASS, Sine(AMP, FREQ)), None, nr.DAHL, nr.SINE, 2.0),
+        ("forced LuGre, sine force", pf.Oscillator(lugre, MASS, Sine(AMP, FREQ)), None, nr.LUGRE, nr.SINE, 2.0),
+        ("Dahl, Samples force at 1 kHz, 1 s", pf.Oscillator(dahl, MASS, Samples(ts, us)), None, nr.DAHL, nr.SAMPLES, 3.0),
+        ("forced Dahl, 1,000 dense samples", pf.Oscillator(dahl, MASS, Sine(AMP, FREQ)), td, nr.DAHL, nr.SINE, 3.0),
+    ]
+    rows = []
+    for name, system, dense, model, kind, target in cases:
+        mp = np.array([SIGMA, FC, MASS]) if model == nr.DAHL else np.array([*LUGRE[:3], *LUGRE[3:], MASS])
+        scale = np.array([FC / SIGMA, FC / math.sqrt(SIGMA * MASS), FC if model == nr.DAHL else FC / LUGRE[0]])
+        up = np.array([AMP, w])
+        tds = np.zeros(0) if dense is None else dense
+
+        def reference(rtol: float, tds: np.ndarray = tds, mp: np.ndarray = mp, model: int = model,
+                      kind: int = kind, scale: np.ndarray = scale, up: np.ndarray = up) -> tuple:
+            return nr.forced_run(model, mp, kind, up, ts, us, np.zeros(3), 1.0, 1.0, rtol, rtol * scale, tds)
+
+        exact = reference(1e-13)[0]
+        kw = {} if dense is None else {"dense": dense}
+        res = pf.simulate(system, 0.0, t_end=1.0, rtol=1e-8, **kw)
+        sim_err = _error(res.reversals.t, res.reversals.x, res.reversals.F, exact)
+        chosen, ref_err = _LADDER[-1], math.inf
+        for rtol in _LADDER:  # the loosest reference at least as accurate as simulate
+            rev = reference(rtol)[0]
+            err = _error(rev[0], rev[1], rev[2], exact)
+            if err <= sim_err:
+                chosen, ref_err = rtol, err
+                break
+        sim_s, ref_s = _interleaved(lambda: pf.simulate(system, 0.0, t_end=1.0, rtol=1e-8, **kw),
+                                    lambda: reference(chosen), rounds)
+        _, same_s = _interleaved(lambda: None, lambda: reference(1e-8), rounds)
+        rows.append(NativeRow(name, f"numba({chosen:.0e})", sim_s, ref_s, sim_err, ref_err, target, same_s))
+    return rows
+
+
+def _headline_rows(rounds: int) -> list[NativeRow]:
+    import prefriction as pf
+    from prefriction.cli.bench.cases import HEADLINE, N_REV, reversal_error
+    from prefriction.cli.bench.plain_c import c_reversals
+
+    case = HEADLINE
+    ref = pf.exact_reversals(case.system, case.v0, N_REV, F0=case.F0)
+    rows = []
+    for rtol, target in ((1e-8, 2.0), (1e-4, 3.0)):
+        res = pf.simulate(case.system, case.v0, F0=case.F0, reversals=N_REV, rtol=rtol)
+        t, x, F, _ = c_reversals(case.system, case.v0, N_REV, rtol, case.F0)
+        sim_s, ref_s = _interleaved(lambda: pf.simulate(case.system, case.v0, F0=case.F0, reversals=N_REV, rtol=rtol),
+                                    lambda: c_reversals(case.system, case.v0, N_REV, rtol, case.F0), rounds)
+        tab = res.reversals
+        rows.append(NativeRow(f"unforced Dahl, {N_REV} reversals, rtol {rtol:g}", "C", sim_s, ref_s,
+                              reversal_error(case, tab.t, tab.x, tab.F, ref), reversal_error(case, t, x, F, ref), target))
+    return rows
+
+
+def run(quick: bool = False) -> list[NativeRow]:
+    """The rows (plain-C rows need a C compiler, numba rows numba)."""
+    from prefriction.cli.bench import numba_refs
+    from prefriction.cli.bench.plain_c import c_available
+
+    rounds = 5 if quick else 30
+    rows: list[NativeRow] = []
+    if c_available():
+        rows += _headline_rows(rounds)
+    if numba_refs.available():
+        rows += _forced_rows(rounds)
+    return rows
+
+
+def main(quick: bool = False, rows: Optional[list[NativeRow]] = None) -> int:
+    """Print the table; 0 if every row meets its target."""
+    rows = run(quick) if rows is None else rows
+    print("Native driver against references written from the equations (process CPU time, least of "
+          "interleaved rounds; errors: simulate / reference):")
+    for row in rows:
+        print(row.line())
+    if not rows:
+        print("  no reference available (no C compiler, numba not installed)")
+    return 0 if rows and all(r.ratio <= r.target for r in rows) else 1
