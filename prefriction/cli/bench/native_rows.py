@@ -44,6 +44,7 @@ class NativeRow:
     ref_error: float
     target: float
     same_rtol_s: float = math.nan  # the reference at simulate's rtol (less accurate), for comparison
+    erk_s: float = math.nan  # the CasADi path (method="erk", the CasADi block Function): the time before issue 27
 
     @property
     def ratio(self) -> float:
@@ -52,11 +53,18 @@ class NativeRow:
 
     def line(self) -> str:
         ok = "PASS" if self.ratio <= self.target else "FAIL"
-        return (f"  {self.name:<38s} {self.sim_s * 1e3:9.3f} ms  {self.reference:<7s} {self.ref_s * 1e3:9.3f} ms  "
-                f"ratio {self.ratio:5.2f}  (target <= {self.target:g}x: {ok})  errors {self.sim_error:.1e} / "
-                f"{self.ref_error:.1e}" + ("" if math.isnan(self.same_rtol_s) else
-                                            f"; reference at rtol 1e-8: {self.same_rtol_s * 1e3:.3f} ms "
-                                            f"(ratio {self.sim_s / self.same_rtol_s:.2f})"))
+        text = (f"  {self.name:<44s} {_t(self.sim_s)}  {self.reference:<12s} {_t(self.ref_s)}  ratio {self.ratio:5.2f}  "
+                f"(target <= {self.target:g}x: {ok})  errors {self.sim_error:.1e} / {self.ref_error:.1e}")
+        if not math.isnan(self.erk_s):
+            text += f"; CasADi path {_t(self.erk_s)} (ratio {self.erk_s / self.ref_s:.1f})"
+        if not math.isnan(self.same_rtol_s):
+            text += f"; reference at rtol 1e-8 {_t(self.same_rtol_s)}"
+        return text
+
+
+def _t(seconds: float) -> str:
+    """A time in ms, or in us below 1 ms."""
+    return f"{seconds * 1e3:8.3f} ms" if seconds >= 1e-3 else f"{seconds * 1e6:8.3f} us"
 
 
 def _interleaved(a: Callable[[], object], b: Callable[[], object], rounds: int) -> tuple[float, float]:
@@ -125,8 +133,68 @@ def _forced_rows(rounds: int) -> list[NativeRow]:
         sim_s, ref_s = _interleaved(lambda: pf.simulate(system, 0.0, t_end=1.0, rtol=1e-8, **kw),
                                     lambda: reference(chosen), rounds)
         _, same_s = _interleaved(lambda: None, lambda: reference(1e-8), rounds)
-        rows.append(NativeRow(name, f"numba({chosen:.0e})", sim_s, ref_s, sim_err, ref_err, target, same_s))
+        erk_s, _ = _interleaved(lambda: pf.simulate(system, 0.0, t_end=1.0, rtol=1e-8, method="erk", **kw),
+                                lambda: None, max(2, rounds // 5))
+        rows.append(NativeRow(name, f"numba({chosen:.0e})", sim_s, ref_s, sim_err, ref_err, target, same_s, erk_s))
     return rows
+
+
+def _loop_rows(rounds: int) -> list[NativeRow]:
+    """10 kHz PID loops (1 s, a 5 um sine reference) around Dahl and LuGre stages: time per sample
+    of ``controllers.simulate_loop`` against the numba loop at the loosest tolerance that matches
+    the trajectory to 1e-8 of the stroke (both against the numba loop at rtol 1e-13)."""
+    import prefriction as pf
+    from prefriction import controllers
+    from prefriction.cli.bench import numba_refs as nr
+    from prefriction.signals import Sine
+
+    Ts, t_end, stroke = 1e-4, 1.0, 5e-6
+    ref = Sine(0.5 * stroke, 5.0, phase=-math.pi / 2, offset=0.5 * stroke)
+    tk = Ts * np.arange(int(round(t_end / Ts)) + 1)
+    r = np.asarray(ref(tk), dtype=float)
+    lugre = (1e6, 300.0, 0.4, 1.0, 1.5, 1e-3)
+    cases = [("10 kHz PID loop around Dahl", pf.Dahl(1e6, 1.0), nr.DAHL, np.array([1e6, 1.0, MASS])),
+             ("10 kHz PID loop around LuGre", pf.LuGre(*lugre), nr.LUGRE, np.array([*lugre, MASS]))]
+    rows = []
+    for name, model, kind, mp in cases:
+        stage = pf.Oscillator(model, MASS)
+        Cd = controllers.design_pid(stage, wn=2 * np.pi * 150.0, zeta=0.7).c2d(Ts)
+        scale = np.array([stroke, stroke * 1e3, 1.0])
+
+        def reference(rtol: float, mp: np.ndarray = mp, kind: int = kind, Cd=Cd, scale=scale) -> tuple:
+            return nr.pid_loop(kind, mp, Cd.A, Cd.B, Cd.C, float(Cd.D[0, 0]), Ts, r, rtol, rtol * scale)
+
+        exact = reference(1e-13)[0]
+
+        def sim(stage=stage, Cd=Cd):
+            return controllers.simulate_loop(stage, Cd, ref, t_end, rtol=1e-8)
+
+        res = sim()
+        sim_err = float(np.max(np.abs(res.x - exact))) / stroke
+        chosen, ref_err = _LADDER[-1], math.inf
+        for rtol in _LADDER:
+            err = float(np.max(np.abs(reference(rtol)[0] - exact))) / stroke
+            if err <= 1e-8:
+                chosen, ref_err = rtol, err
+                break
+        sim_s, ref_s = _interleaved(sim, lambda: reference(chosen), max(3, rounds // 5))
+        erk_s, _ = _interleaved(lambda: _casadi_loop(sim), lambda: None, 2)
+        n = len(tk) - 1
+        rows.append(NativeRow(name + " (per sample)", f"numba({chosen:.0e})", sim_s / n, ref_s / n, sim_err, ref_err,
+                              3.0, erk_s=erk_s / n))
+    return rows
+
+
+def _casadi_loop(sim: Callable[[], object]) -> object:
+    """``sim()`` with the sampled loop on the CasADi block Function (the path before issue 27)."""
+    from prefriction.simulation.loops import runner
+
+    saved = runner.loop_driver
+    runner.loop_driver = lambda spec: (None, 0.0)
+    try:
+        return sim()
+    finally:
+        runner.loop_driver = saved
 
 
 def _headline_rows(rounds: int) -> list[NativeRow]:
@@ -159,6 +227,7 @@ def run(quick: bool = False) -> list[NativeRow]:
         rows += _headline_rows(rounds)
     if numba_refs.available():
         rows += _forced_rows(rounds)
+        rows += _loop_rows(rounds)
     return rows
 
 

@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["DAHL", "LUGRE", "SINE", "SAMPLES", "available", "forced_run"]
+__all__ = ["DAHL", "LUGRE", "SINE", "SAMPLES", "available", "forced_run", "pid_loop"]
 
 DAHL, LUGRE = 0, 1
 SINE, SAMPLES = 0, 1
@@ -48,6 +48,8 @@ def _kernel() -> Any:
     def u_at(t: float, kind: int, up: np.ndarray, ts: np.ndarray, us: np.ndarray, k: int) -> float:
         if kind == 0:
             return up[0] * np.sin(up[1] * t)
+        if kind == 2:  # held (a sampled loop's force)
+            return up[0]
         if k < 0:
             return us[0]
         if k >= ts.size - 1:
@@ -83,24 +85,18 @@ def _kernel() -> Any:
             out[i] = y0[i] + h * acc
 
     @numba.njit(cache=False)
-    def run(model: int, mp: np.ndarray, kind: int, up: np.ndarray, ts: np.ndarray, us: np.ndarray,
-            y0in: np.ndarray, s0: float, t_end: float, rtol: float, atol: np.ndarray, td: np.ndarray,
-            rev: np.ndarray, dout: np.ndarray) -> tuple:
-        n = y0in.size
-        y = y0in.copy()
+    def advance(model: int, mp: np.ndarray, kind: int, up: np.ndarray, ts: np.ndarray, us: np.ndarray,
+                y: np.ndarray, s: float, t: float, t_end: float, h: float, rtol: float, atol: np.ndarray,
+                td: np.ndarray, rev: np.ndarray, dout: np.ndarray, nrev: int, jd: int, K: np.ndarray) -> tuple:
+        """From (t, y, s) to t_end with the step size h; returns (s, h, nrev, jd, steps)."""
+        n = y.size
         ynew = np.empty(n)
         ytmp = np.empty(n)
-        K = np.empty((7, n))
-        s = s0
-        t = 0.0
         k = -1  # sample interval index: [ts[k], ts[k+1]]
         if kind == 1:
             while k + 1 < ts.size and ts[k + 1] <= t:
                 k += 1
         rhs(t, y, s, model, mp, kind, up, ts, us, k, K[0])
-        h = 1e-6
-        nrev = 0
-        jd = 0
         steps = 0
         while t < t_end:
             t_lim = t_end
@@ -188,9 +184,52 @@ def _kernel() -> Any:
             else:
                 t += h
                 h *= fac
+        return s, h, nrev, jd, steps
+
+    @numba.njit(cache=False)
+    def run(model: int, mp: np.ndarray, kind: int, up: np.ndarray, ts: np.ndarray, us: np.ndarray,
+            y0in: np.ndarray, s0: float, t_end: float, rtol: float, atol: np.ndarray, td: np.ndarray,
+            rev: np.ndarray, dout: np.ndarray) -> tuple:
+        y = y0in.copy()
+        K = np.empty((7, y.size))
+        s, h, nrev, jd, steps = advance(model, mp, kind, up, ts, us, y, s0, 0.0, t_end, 1e-6, rtol, atol, td, rev,
+                                        dout, 0, 0, K)
         return nrev, jd, steps
 
-    return run
+    @numba.njit(cache=False)
+    def loop(model: int, mp: np.ndarray, Ad: np.ndarray, Bd: np.ndarray, Cd: np.ndarray, Dd: float, Ts: float,
+             r: np.ndarray, y0in: np.ndarray, rtol: float, atol: np.ndarray, xs: np.ndarray, rev: np.ndarray) -> tuple:
+        """The sampled loop: u_k = C xc + D (r_k - x_k) held over [k Ts, (k+1) Ts], xc += ..."""
+        y = y0in.copy()
+        K = np.empty((7, y.size))
+        xc = np.zeros(Ad.shape[0])
+        xn = np.empty(Ad.shape[0])
+        up = np.zeros(2)
+        none = np.zeros(0)
+        dnone = np.zeros((3, 1))
+        s, h, nrev, steps = 1.0, 1e-7, 0, 0
+        for kk in range(r.size - 1):
+            e = r[kk] - y[0]
+            xs[kk] = y[0]
+            u = Dd * e
+            for i in range(xc.size):
+                u += Cd[i] * xc[i]
+            for i in range(xc.size):
+                acc = Bd[i] * e
+                for j in range(xc.size):
+                    acc += Ad[i, j] * xc[j]
+                xn[i] = acc
+            xc[:] = xn
+            up[0] = u
+            if kk == 0:
+                s = 1.0 if u > 0 else -1.0
+            s, h, nrev, jd, st = advance(model, mp, 2, up, none, none, y, s, kk * Ts, (kk + 1) * Ts, h, rtol, atol,
+                                         none, rev, dnone, nrev, 0, K)
+            steps += st
+        xs[r.size - 1] = y[0]
+        return nrev, steps
+
+    return run, loop
 
 
 def forced_run(model: int, mp: np.ndarray, kind: int, up: np.ndarray, ts: np.ndarray, us: np.ndarray,
@@ -215,8 +254,26 @@ def forced_run(model: int, mp: np.ndarray, kind: int, up: np.ndarray, ts: np.nda
     (numpy.ndarray, numpy.ndarray, int)
         Reversals ``(t, x, F)`` as rows, samples ``(x, v, state 2)`` as rows, accepted steps.
     """
-    run = _kernel()
+    run = _kernel()[0]
     rev = np.empty((3, max_rev))
     dout = np.empty((3, max(td.size, 1)))
     nrev, nd, steps = run(model, mp, kind, up, ts, us, y0, s0, t_end, rtol, atol, td, rev, dout)
     return rev[:, :min(nrev, max_rev)], dout[:, :nd], int(steps)
+
+
+def pid_loop(model: int, mp: np.ndarray, Ad: np.ndarray, Bd: np.ndarray, Cd: np.ndarray, Dd: float, Ts: float, r: np.ndarray,
+             rtol: float, atol: np.ndarray, max_rev: int = 100_000) -> tuple[np.ndarray, np.ndarray, int]:
+    """The sampled loop around a stage (``model``, ``mp`` as in :func:`forced_run`) from rest: a discrete
+    controller ``(Ad, Bd, Cd, Dd)`` (SI) with the reference samples ``r`` [m] at ``k Ts``.
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray, int)
+        Positions at the sample instants [m], the reversals ``(t, x, F)`` as rows, accepted steps.
+    """
+    loop = _kernel()[1]
+    xs = np.empty(r.size)
+    rev = np.empty((3, max_rev))
+    nrev, steps = loop(model, mp, np.ascontiguousarray(Ad, dtype=float), np.ascontiguousarray(Bd, dtype=float).ravel(),
+                       np.ascontiguousarray(Cd, dtype=float).ravel(), float(Dd), Ts, r, np.zeros(3), rtol, atol, xs, rev)
+    return xs, rev[:, :min(nrev, max_rev)], int(steps)
