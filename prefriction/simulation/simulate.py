@@ -49,6 +49,7 @@ from prefriction.simulation.budget import check_input_budget
 from prefriction._validation import check_count, check_finite, check_positive
 from prefriction.models import Oscillator, check_oscillator
 from prefriction.reversals import ReversalTable
+from prefriction.simulation.lazy_table import LazyReversalTable
 from prefriction.simulation.result import RunStats, SimulationResult
 from prefriction.units import Scales
 
@@ -412,44 +413,23 @@ def _sampled_loop(run: Run, xc0: np.ndarray, t_end: float, n_target: float) -> t
     return samples, u_hist
 
 
-_ENERGY_BLOCK = 4096  # reversals per branch_energy_of_force call: temporaries of ~2 MB (Dahl: 57 doubles each)
-
-
 def _reversal_table(rev: Union[list, tuple], system: Oscillator, s0: float, v0: float, F0: float,
                     sc: Optional[Scales] = None) -> tuple[ReversalTable, np.ndarray]:
-    """The reversals as a :class:`ReversalTable` in SI, and the input's work over each
-    half-cycle [J]; ``E_p`` is the branch potential (3.9), ``E_d`` the balance (2.10).
+    """The reversals as a :class:`ReversalTable` in SI (its energies ``E_p`` (3.9), ``E_d``
+    (2.10), ``E_0`` computed on first use: :class:`~prefriction.simulation.lazy_table.LazyReversalTable`),
+    and the input's work over each half-cycle [J].
 
     ``rev``: a list of ``(t~, x~, F~, W~)`` tuples, or the four columns
     (:meth:`~prefriction.simulation.reversal_log.ReversalLog.columns`; writable columns are
     converted to SI in place, so that a long run holds them once); ``sc``: the system's scales,
     if known."""
     sc = Scales.of(system) if sc is None else sc
-    model = system.friction
     if isinstance(rev, list):
         R = np.array(rev, dtype=float).reshape(-1, 4)
         rev = (R[:, 0], R[:, 1], R[:, 2], R[:, 3])
-    n = len(rev[0])
-    if not model.rate_independent:  # no stored branch energy: E_p is not defined (NaN), E_0 kinetic
-        E_p = np.full(n, np.nan)
-        E0 = 0.5 * system.mass * v0 * v0
-    else:  # the start and every reversal, in blocks (each call costs ~50 us whatever its size)
-        E = np.empty(n + 1)  # the start (F0, s0), then reversal k on the branch s0 (-1)^k
-        for a in range(0, n + 1, _ENERGY_BLOCK):
-            b = min(n + 1, a + _ENERGY_BLOCK)
-            F = rev[2][max(a - 1, 0):b - 1]
-            if a == 0:
-                F = np.concatenate(([F0 / sc.F], F))
-            E[a:b] = model.branch_energy_of_force(F, np.where(np.arange(a, b) % 2 == 0, s0, -s0)) * sc.E
-        E0, E_p = 0.5 * system.mass * v0 * v0 + float(E[0]), E[1:]
     t_r, x_r, F_r, W_r = (np.multiply(col, unit, out=col if col.flags.writeable else None)
                           for col, unit in zip(rev, (sc.t, sc.x, sc.F, sc.E)))
-    E_d = np.empty(n)
-    if n:
-        E_d[0] = E0 - E_p[0] + W_r[0]
-        np.add(E_p[:-1], W_r[1:], out=E_d[1:])
-        E_d[1:] -= E_p[1:]
-    return ReversalTable(t=t_r, x=x_r, F=F_r, E_p=E_p, E_d=E_d, E_0=E0), W_r
+    return LazyReversalTable(t_r, x_r, F_r, W_r, system, s0, v0, F0), W_r
 
 
 def _padded(fb: LinearFeedback, order: int) -> LinearFeedback:
