@@ -42,14 +42,15 @@ class Run(StateIO, Rest):
     """
 
     def __init__(self, system: Oscillator, spec: PlantSpec, fb: Optional[LinearFeedback],
-                 eps: float, jit: bool, native: bool = True) -> None:
+                 eps: float, jit: bool, native: bool = True, sc: Optional[Scales] = None,
+                 L: Optional[Layout] = None) -> None:
         self.system, self.spec, self.fb = system, spec, fb
-        self.sc = Scales.of(system)
+        self.sc = Scales.of(system) if sc is None else sc  # (simulate has them already)
         self.model = system.friction
         self.q = self.model.runtime_params_for(self.sc)  # may depend on the mass (units)
         self.eps = eps  # run-time tolerance: states are scaled by amplitude * eps
         self.eps_native = eps  # the same for the native drivers' norm over the active states (simulate sets it)
-        self.L = Layout(spec)  # the same for any number of outputs per call
+        self.L = Layout(spec) if L is None else L  # the same for any number of outputs per call
         # a sampled controller on a plant without a hold control: its force joins the input piece
         self.hold_in_piece = fb is not None and fb.sampled and spec.fb == "none"
         # one plant: a dense run makes its single-output calls on the dense plant, padded

@@ -229,7 +229,7 @@ def simulate(
     L = Layout(spec)
     # error control on states scaled by amplitude * eps (the plant's run-time tolerance)
     eps = min(rtol, atol) * _CAL * math.sqrt(L.n_active / L.nx)
-    run = Run(system, spec, feedback, eps, jit, native=method == "native")
+    run = Run(system, spec, feedback, eps, jit, native=method == "native", sc=sc, L=L)
     run.eps_native = min(rtol, atol) * _CAL  # the native drivers' RMS norm runs over the active states only
     run.snap = rtol
     run.P0 = run._constant_params(run.L)
