@@ -63,8 +63,10 @@ class NativeRow:
 
 
 def _t(seconds: float) -> str:
-    """A time in ms, or in us below 1 ms."""
-    return f"{seconds * 1e3:8.3f} ms" if seconds >= 1e-3 else f"{seconds * 1e6:8.3f} us"
+    """A time in ms, us or ns."""
+    if seconds >= 1e-3:
+        return f"{seconds * 1e3:8.3f} ms"
+    return f"{seconds * 1e6:8.3f} us" if seconds >= 1e-6 else f"{seconds * 1e9:8.1f} ns"
 
 
 def _interleaved(a: Callable[[], object], b: Callable[[], object], rounds: int) -> tuple[float, float]:
@@ -185,6 +187,34 @@ def _loop_rows(rounds: int) -> list[NativeRow]:
     return rows
 
 
+def _along_rows(rounds: int) -> list[NativeRow]:
+    """``friction_along`` of a Maxwell-slip model of 3 elements over 1e6 samples against the
+    numba elastoplastic update (per sample); error: the largest force difference over the slip
+    force sum. The CasADi block loop (without a compiler) is the time before issue 27."""
+    import prefriction as pf
+    import prefriction.along.run as along_run
+    from prefriction.cli.bench import numba_refs as nr
+
+    k, f = np.array([6e4, 3e4, 1e4]), np.array([0.3, 0.4, 0.3])
+    model = pf.MaxwellSlip(k, f)
+    t = np.linspace(0.0, 10.0, 1_000_001)
+    x = 2e-5 * np.sin(2 * np.pi * 3.0 * t) + 1e-6 * np.sin(2 * np.pi * 37.0 * t)
+    res = pf.friction_along(model, t, x)
+    ref = nr.maxwell_slip_along(x, k, f)
+    err = float(np.max(np.abs(res.F - ref))) / float(f.sum())
+    sim_s, ref_s = _interleaved(lambda: pf.friction_along(model, t, x), lambda: nr.maxwell_slip_along(x, k, f),
+                                max(3, rounds // 5))
+    saved = along_run.along_driver
+    along_run.along_driver = lambda model, substeps: None
+    try:
+        erk_s, _ = _interleaved(lambda: pf.friction_along(model, t, x), lambda: None, 2)
+    finally:
+        along_run.along_driver = saved
+    n = t.size
+    return [NativeRow("friction_along Maxwell-slip(3), 1e6 samples (per sample)", "numba", sim_s / n, ref_s / n, err,
+                      0.0, 3.0, erk_s=erk_s / n)]
+
+
 def _casadi_loop(sim: Callable[[], object]) -> object:
     """``sim()`` with the sampled loop on the CasADi block Function (the path before issue 27)."""
     from prefriction.simulation.loops import runner
@@ -228,6 +258,7 @@ def run(quick: bool = False) -> list[NativeRow]:
     if numba_refs.available():
         rows += _forced_rows(rounds)
         rows += _loop_rows(rounds)
+        rows += _along_rows(rounds)
     return rows
 
 

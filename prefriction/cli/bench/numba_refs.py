@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["DAHL", "LUGRE", "SINE", "SAMPLES", "available", "forced_run", "pid_loop"]
+__all__ = ["DAHL", "LUGRE", "SINE", "SAMPLES", "available", "forced_run", "maxwell_slip_along", "pid_loop"]
 
 DAHL, LUGRE = 0, 1
 SINE, SAMPLES = 0, 1
@@ -277,3 +277,35 @@ def pid_loop(model: int, mp: np.ndarray, Ad: np.ndarray, Bd: np.ndarray, Cd: np.
     nrev, steps = loop(model, mp, np.ascontiguousarray(Ad, dtype=float), np.ascontiguousarray(Bd, dtype=float).ravel(),
                        np.ascontiguousarray(Cd, dtype=float).ravel(), float(Dd), Ts, r, np.zeros(3), rtol, atol, xs, rev)
     return xs, rev[:, :min(nrev, max_rev)], int(steps)
+
+
+@functools.lru_cache(maxsize=1)
+def _ms_kernel() -> Any:
+    import numba
+
+    @numba.njit(cache=False)
+    def along(x: np.ndarray, k: np.ndarray, f: np.ndarray, F: np.ndarray) -> None:
+        w = np.full(k.size, x[0])  # anchors: every element relaxed at the start
+        for j in range(x.size):
+            total = 0.0
+            for i in range(k.size):
+                Fi = k[i] * (x[j] - w[i])
+                if Fi > f[i]:
+                    Fi = f[i]
+                    w[i] = x[j] - f[i] / k[i]
+                elif Fi < -f[i]:
+                    Fi = -f[i]
+                    w[i] = x[j] + f[i] / k[i]
+                total += Fi
+            F[j] = total
+
+    return along
+
+
+def maxwell_slip_along(x: np.ndarray, k: np.ndarray, f: np.ndarray) -> np.ndarray:
+    """Force [N] of Maxwell-slip elements (stiffness ``k`` [N/m], slip force ``f`` [N]) along the
+    positions ``x`` [m] from the relaxed state: each element elastic, ``k (x - w)``, its anchor
+    ``w`` dragged along while it slips (``|k (x - w)| = f``); exact for a piecewise-linear motion."""
+    F = np.empty(x.size)
+    _ms_kernel()(np.ascontiguousarray(x, dtype=float), np.asarray(k, dtype=float), np.asarray(f, dtype=float), F)
+    return F
