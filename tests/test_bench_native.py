@@ -43,6 +43,7 @@ def _dahl_scipy(u, t_end: float) -> np.ndarray:
     return np.array(times)
 
 
+@pytest.mark.slow  # numba compiles the integrator (about 10 s)
 def test_numba_forced_dahl_against_scipy() -> None:
     w = 2 * np.pi * 5.0
     ref = _dahl_scipy(lambda t: 2.0 * math.sin(w * t), 0.5)
