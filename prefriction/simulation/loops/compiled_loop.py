@@ -112,7 +112,7 @@ def control_law(spec: LoopSpec, LL: LoopLayout, S: ca.SX, w: ca.SX, par: ca.SX) 
     loop state ``S``, the sample's inputs ``w`` and the parameters ``par``: the friction force
     ``F``, the measurement (``y_now``, ``past``, ``y_meas``), the compensator (``cs``, ``cs_next``,
     ``comp``), the applied force ``u`` (and ``u_total`` with the oscillator's own input) and the
-    controller's next state ``xc_next`` (the native loop compiles the same law, native/loop.py)."""
+    controller's next state ``xc_next`` (the native loop compiles the same law, loops/native_loop.py)."""
     L, model, n = LL.plant, spec.plant.model, spec.n_c
     st = {k: S[i] for k, i in LL.state.items()}
     wi = {k: w[i] for k, i in LL.inp.items()}

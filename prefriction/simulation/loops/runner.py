@@ -30,8 +30,8 @@ from prefriction.simulation.simulate import _CAL, _reversal_table
 from prefriction.units import Scales
 
 from .compiled_loop import MAX_DELAY, NSTOP, LoopLayout, LoopSpec, NoCompensation, loop_function
+from .native_loop import loop_driver, run_blocks
 from .records import collect, failure, finish_in_python, initial_state
-from prefriction.simulation.native.loop import loop_driver, run_blocks
 
 __all__ = ["BLOCK", "NATIVE_BLOCK", "LoopStats", "Measurement", "Compensation", "run_sampled"]
 
@@ -201,7 +201,7 @@ def run_sampled(
     compensation : Compensation, optional
         A compensator whose force is added to the controller's (default: none).
     native : bool, default True
-        Run the periods on the native loop (:mod:`prefriction.simulation.native.loop`: blocks of
+        Run the periods on the native loop (:mod:`prefriction.simulation.loops.native_loop`: blocks of
         :data:`NATIVE_BLOCK` periods per C call) where it can be built; False: the CasADi block
         Function (the reference it is tested against).
 

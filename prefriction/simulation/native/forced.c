@@ -111,7 +111,7 @@ typedef struct {
 
 /* indicator k at th: -1 the reversal s v + off, -3 minus the slope of s v, else the model's k */
 static double pf_find(pf_fctx* f, const pf_step* P, double th, int k) {
-  double y[PF_NF], g[PF_NEA];
+  double y[PF_NF], g[PF_NEA] = {0.0};
   if (k == -1) return f->c.s * pf_fdense1(P->U, P->y0, th, 1, 0) + P->off;
   if (k == -3) return -f->c.s * pf_fdense1(P->U, P->y0, th, 1, 1);
   pf_fdense(P->U, P->y0, th, y);
@@ -158,14 +158,6 @@ static double pf_fnorm(const double* sc, const double* e, int n_act, int dense) 
 #endif
   if (dense) acc += (e[PF_IE] / sc[PF_IE]) * (e[PF_IE] / sc[PF_IE]);
   return sqrt(acc / n_act);
-}
-
-/* the model force at rest (v = 0) in the state Y */
-static double pf_Frest(pf_fctx* f, const double* Y) {
-  double y[PF_NF];
-  memcpy(y, Y, sizeof y);
-  y[1] = 0.0;
-  return pf_F(&f->c, y);
 }
 
 /* the energy of the branch after a reversal or at a start: v^2/2 + potential - W */

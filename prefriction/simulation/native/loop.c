@@ -5,7 +5,7 @@
  * (docs/controllers.md#compiled-loop).
  *
  * This file follows forced.c (compiled with PF_FORCED 1 and the piecewise-linear input) and needs
- * the loop layout's sizes and indices (native/loop.py): PF_LNS (loop state), PF_LNW (inputs per
+ * the loop layout's sizes and indices (loops/native_loop.py): PF_LNS (loop state), PF_LNW (inputs per
  * sample), PF_LNREC (record), PF_LI_T0, PF_LI_T1, PF_LI_ACTIVE, PF_LI_TL, PF_LI_DA, PF_LI_DB
  * (inputs), PF_LS_S (index of s in the loop state; rest, W and Amax follow it), PF_LR_F, PF_LR_U,
  * PF_LR_MOVED, PF_LR_Y, PF_LR_COMP (record).

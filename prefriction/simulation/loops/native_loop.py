@@ -3,7 +3,7 @@
 :func:`loop_driver` builds (once per loop structure: model, controller order, compensator) the
 library of the model's generated code, the piecewise-linear input, the controller's law at a
 sample instant (``pf_ctrl``, from :func:`prefriction.simulation.loops.compiled_loop.control_law`)
-and ``loop.c`` on ``forced.c``; :func:`run_blocks` runs the periods of
+and ``native/loop.c`` on ``native/forced.c``; :func:`run_blocks` runs the periods of
 :func:`prefriction.simulation.loops.runner.run_sampled` on it, block by block, with the loop
 state, inputs and records of :class:`~prefriction.simulation.loops.compiled_loop.LoopLayout`
 (``docs/controllers.md#compiled-loop``). Any number of reversals per period; the step size is
@@ -26,14 +26,14 @@ from prefriction.errors import SolverError
 from prefriction.models.sizes import check_sizes
 from prefriction.signals import Constant, compiled_form
 from prefriction.simulation.compiled import CompileInfo, jit_available, library
-from prefriction.simulation.loops.compiled_loop import LoopLayout, LoopSpec, control_law
+from .compiled_loop import LoopLayout, LoopSpec, control_law
 from prefriction.simulation.native.forced import _FORCED, FHEAD, _input_function, _load_forced
 from prefriction.simulation.native.library import _DRIVER
 from prefriction.simulation.native.model_code import model_source
 
 __all__ = ["CAPACITY", "LoopDriver", "loop_driver", "run_blocks"]
 
-_LOOP = (Path(__file__).parent / "loop.c").read_text()
+_LOOP = (Path(__file__).parent.parent / "native" / "loop.c").read_text()  # with the driver's other C files
 _D = np.ctypeslib.ndpointer(dtype=np.float64, flags="C_CONTIGUOUS")
 _L = np.ctypeslib.ndpointer(dtype=np.int64, flags="C_CONTIGUOUS")
 _CACHE: dict = {}
