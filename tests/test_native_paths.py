@@ -175,7 +175,8 @@ def _compensator(name):
             "disturbance_observer": lambda: controllers.DisturbanceObserver(bandwidth=1e3)}[name]()
 
 
-@pytest.mark.parametrize("case", sorted(LOOP_CASES))
+@pytest.mark.parametrize("case", [pytest.param(c, marks=pytest.mark.slow) if "compensator" in LOOP_CASES[c] else c
+                                  for c in sorted(LOOP_CASES)])  # a compensator: two more compiles each
 def test_native_loop_agrees_with_the_casadi_block_function(case: str, monkeypatch: pytest.MonkeyPatch) -> None:
     """10 kHz PID loop around a Dahl stage tracking a 5 um sine: the native loop and the CasADi
     block Function (same law, same plant, each integrated at rtol 1e-8) agree to 1e-8 of the stroke."""
