@@ -2,7 +2,7 @@
 
 The energies of a :class:`~prefriction.ReversalTable` (``E_p`` (3.9), ``E_d`` (2.10), ``E_0``)
 take the model's branch energy of every reversal force: on the native driver that was a third
-of a 50-reversal run at ``rtol = 1e-4`` (issue 27). :class:`LazyReversalTable` is a
+of a 50-reversal run at ``rtol = 1e-4``. :class:`LazyReversalTable` is a
 ``ReversalTable`` whose ``t, x, F`` are set (and checked) at once and whose energies are
 computed and checked the first time one of them is read, then kept. It pickles with its inputs
 (the energies are computed where they are read); :meth:`LazyReversalTable.eager` gives the plain

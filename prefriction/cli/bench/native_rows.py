@@ -12,7 +12,7 @@ machine), and prints the ratio (``docs/bench.md#native``):
   reference runs at the loosest tolerance of a ladder whose reversal error is no larger than
   that of ``simulate``, both errors measured against the reference at ``rtol = 1e-13``.
 
-Targets (issue 27): unforced headline <= 2x, forced sine rows <= 2x, Samples and dense rows
+Targets: unforced headline <= 2x, forced sine rows <= 2x, Samples and dense rows
 <= 3x, loose-tolerance headline <= 3x.
 """
 
@@ -44,7 +44,7 @@ class NativeRow:
     ref_error: float
     target: float
     same_rtol_s: float = math.nan  # the reference at simulate's rtol (less accurate), for comparison
-    erk_s: float = math.nan  # the CasADi path (method="erk", the CasADi block Function): the time before issue 27
+    erk_s: float = math.nan  # the CasADi path (method="erk", the CasADi block Function), same run
 
     @property
     def ratio(self) -> float:
@@ -190,7 +190,7 @@ def _loop_rows(rounds: int) -> list[NativeRow]:
 def _along_rows(rounds: int) -> list[NativeRow]:
     """``friction_along`` of a Maxwell-slip model of 3 elements over 1e6 samples against the
     numba elastoplastic update (per sample); error: the largest force difference over the slip
-    force sum. The CasADi block loop (without a compiler) is the time before issue 27."""
+    force sum. The CasADi block loop (without a compiler) is timed too."""
     import prefriction as pf
     import prefriction.along.run as along_run
     from prefriction.cli.bench import numba_refs as nr
@@ -216,7 +216,7 @@ def _along_rows(rounds: int) -> list[NativeRow]:
 
 
 def _casadi_loop(sim: Callable[[], object]) -> object:
-    """``sim()`` with the sampled loop on the CasADi block Function (the path before issue 27)."""
+    """``sim()`` with the sampled loop on the CasADi block Function (the path without a C compiler)."""
     from prefriction.simulation.loops import runner
 
     saved = runner.loop_driver
