@@ -180,10 +180,11 @@ int pf_forced(const double* q, const double* th, const double* brk, long nbrk, c
   const int dense = cfg[6] > 0.5, linear = cfg[7] > 0.5, ecorr = cfg[8] > 0.5;
   const int n_act = PF_NY + PF_FORCED + dense;
   double t = st[0], ne = st[4], Amax = st[8], h = st[9], Eb = st[11], t_last = st[12], t_prev = st[13];
-  double err, err_prev = 1.0, fac, F0, F_end, Fmax = 0.0;
+  double err, err_prev = 1.0, fac, F0, F_end, Fmax = 0.0, vs = 0.0;
   long n = cnt[0], jd = cnt[1], *steps = cnt + 2;
   int i, j, rejected = 0, fsal = 0, nonfinite = 0, rest = st[5] > 0.5, code = PF_F_T_END;
   memset(&f, 0, sizeof f);
+  (void)vs;
   f.c.q = q;
   f.c.snap = cfg[2];
   f.c.s = st[3];
@@ -207,6 +208,11 @@ int pf_forced(const double* q, const double* th, const double* brk, long nbrk, c
     cst[j] = acc;
   }
   while (f.kb < nbrk && brk[f.kb] <= t) ++f.kb;
+#if PF_VSCALE
+  pf_args(&f.c, Y); /* the model's velocity scale from its numbers q */
+  f.c.res[0] = &vs;
+  pf_vscale(f.c.arg, f.c.res, f.c.iw, f.c.w, 0);
+#endif
   F0 = pf_ff(&f, t, Y, f0);
   fsal = 1;
   if (!(h > 0.0)) { /* the first step (Hairer, Norsett & Wanner II.4, as driver.c) */
@@ -299,6 +305,10 @@ int pf_forced(const double* q, const double* th, const double* brk, long nbrk, c
       pf_g(&f.c, Y, g0);
       continue;
     }
+    if (!fsal) { F0 = pf_ff(&f, t, Y, f0); fsal = 1; }
+#if PF_VSCALE
+    h = fmin(h, pf_curve_bound(vs, Y[1], f0[1])); /* a narrow Stribeck curve: driver.c */
+#endif
     if (t + h >= t_lim) { hs = h; h = t_lim - t; clipped = 1; }
     else hs = h;
     if (!(h > 1e-15 * fmax(fabs(t), 1e-300))) {
