@@ -27,7 +27,7 @@ from prefriction.models.sizes import check_sizes
 from prefriction.signals import Constant, compiled_form
 from prefriction.simulation.compiled import CompileInfo, jit_available, library
 from .compiled_loop import LoopLayout, LoopSpec, control_law
-from prefriction.simulation.native.forced import _FORCED, FHEAD, _input_function, _load_forced
+from prefriction.simulation.native.forced import FORCED_SOURCE, FHEAD, input_function, load_forced
 from prefriction.simulation.native.library import _DRIVER
 from prefriction.simulation.native.model_code import model_source
 
@@ -94,7 +94,8 @@ def loop_driver(spec: LoopSpec) -> tuple[Optional[LoopDriver], float]:
                 "PF_LR_U": rec["u"], "PF_LR_MOVED": rec["moved"], "PF_LR_Y": rec["y"], "PF_LR_COMP": rec["comp"]}
         assert ix["rest"] == ix["s"] + 1 and ix["W"] == ix["s"] + 2 and ix["Amax"] == ix["s"] + 3  # loop.c reads them so
         head = "".join(f"#define {k} {v}\n" for k, v in defs.items())
-        source = head + model_source(model, (_input_function(u_sig), _control_function(spec, LL))) + _DRIVER + _FORCED + _LOOP
+        code = model_source(model, (input_function(u_sig), _control_function(spec, LL)))
+        source = head + code + _DRIVER + FORCED_SOURCE + _LOOP
         name = f"native_{type(model).__name__.lower()}_loop{spec.n_c}"
         if spec.comp.n_state or spec.comp.n_param:
             name += "_" + spec.comp.function().name()
@@ -105,7 +106,8 @@ def loop_driver(spec: LoopSpec) -> tuple[Optional[LoopDriver], float]:
 
 
 def _load_loop(lib: Path, key: str) -> tuple[Optional[ctypes.CDLL], str]:
-    handle, problem = _load_forced(lib, key)
+    """The verified library with ``pf_loop`` loaded with ctypes, or None and what is wrong."""
+    handle, problem = load_forced(lib, key)
     if handle is not None and not hasattr(handle, "pf_loop"):
         return None, f"{lib} has no pf_loop"
     return handle, problem

@@ -36,11 +36,12 @@ if TYPE_CHECKING:
     from prefriction.simulation.dense import SampleBuffer
     from prefriction.simulation.run import Run
 
-__all__ = ["ForcedDriver", "SAMPLE_BLOCK", "forced_driver", "linear_pieces", "run_forced"]
+__all__ = ["FORCED_SOURCE", "ForcedDriver", "SAMPLE_BLOCK", "forced_driver", "input_function", "linear_pieces",
+           "load_forced", "run_forced"]
 
 FHEAD = 14  # run-state entries before z and m (forced.c: st[])
 SAMPLE_BLOCK = 1 << 14  # requested times per C call (4 x 128 kB of output)
-_FORCED = (Path(__file__).parent / "forced.c").read_text()
+FORCED_SOURCE = (Path(__file__).parent / "forced.c").read_text()
 _D = np.ctypeslib.ndpointer(dtype=np.float64, flags="C_CONTIGUOUS")
 _L = np.ctypeslib.ndpointer(dtype=np.int64, flags="C_CONTIGUOUS")
 _CACHE: dict = {}
@@ -68,7 +69,7 @@ class ForcedDriver:
                               _D, ctypes.c_long, _D, _L]
 
 
-def _input_function(u_sig: Any) -> ca.Function:
+def input_function(u_sig: Any) -> ca.Function:
     """``pf_input(t [s], theta, piece) -> u [N]`` of the signal's structure."""
     t = ca.SX.sym("t")
     th = ca.SX.sym("th", u_sig.n_params)
@@ -91,17 +92,18 @@ def forced_driver(model: FrictionModel, u_sig: Any) -> tuple[Optional[ForcedDriv
             return _CACHE[key], 0.0
         start = time.perf_counter()
         check_sizes(model)
-        extra = () if u_sig is None else (_input_function(u_sig),)
+        extra = () if u_sig is None else (input_function(u_sig),)
         head = f"#define PF_FORCED {int(u_sig is not None)}\n#define PF_NPC {0 if u_sig is None else u_sig.n_piece}\n"
-        source = head + model_source(model, extra) + _DRIVER + _FORCED
+        source = head + model_source(model, extra) + _DRIVER + FORCED_SOURCE
         name = f"native_{type(model).__name__.lower()}_{'forced' if u_sig is not None else 'dense'}"
-        handle, info = library(name, source, "forced and dense runs in C", _load_forced, "the CasADi integrator loop")
+        handle, info = library(name, source, "forced and dense runs in C", load_forced, "the CasADi integrator loop")
         driver = None if handle is None else ForcedDriver(handle, model, u_sig, info)
         _CACHE[key] = driver
         return driver, time.perf_counter() - start
 
 
-def _load_forced(lib: Path, key: str) -> tuple[Optional[ctypes.CDLL], str]:
+def load_forced(lib: Path, key: str) -> tuple[Optional[ctypes.CDLL], str]:
+    """The verified library with ``pf_forced`` loaded with ctypes, or None and what is wrong."""
     handle, problem = _load(lib, key)
     if handle is not None and not hasattr(handle, "pf_forced"):
         return None, f"{lib} has no pf_forced"
