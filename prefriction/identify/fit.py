@@ -200,7 +200,8 @@ def _fit_prescribed(model: FrictionModel, data: ForceDisplacement, free: Any, fi
     sol = fit_prescribed(model, data, space, n_sub=substeps, max_iter=max_iter, tol=tol)
     values = space.values(sol.w[:-1])
     est = np.array([values[n] for n in space.free])
-    stats = gauss_newton(sol.jacobian, sol.residuals, space.free, est, space.scale, limit=limit)
+    stats = gauss_newton(sol.jacobian, sol.residuals, space.free, est, space.scale, limit=limit, covariance="hac",
+                         extra=sol.extra_covariance)
     nuisance = {"initial force F0 [N]": float(sol.prediction[0])}
     return _finish(space, values, est, stats, -sol.residuals, sol.prediction, data, None, nuisance, sol.message,
                    sol.success, level=6)
@@ -229,7 +230,7 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
     values = space.values(sol.w[: space.n_free])
     est = np.array([values[n] for n in space.free])
     stats = gauss_newton(sol.jacobian, sol.residuals, space.free, est, space.scale,
-                         constraints=sol.constraints, limit=limit)
+                         constraints=sol.constraints, limit=limit, covariance="hac")
     mass = values["mass"] if data.mass is None else data.mass
     return _finish(space, values, est, stats, -sol.residuals, sol.prediction, data, mass, sol.nuisance, sol.message,
                    getattr(sol, "success", True))
