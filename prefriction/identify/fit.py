@@ -9,6 +9,7 @@ import numpy as np
 
 from prefriction._validation import check_bool, check_count, check_positive
 from prefriction.identify.data import ForceDisplacement, ForceVelocity, Motion
+from prefriction.identify.diagnostics import ResidualWarning
 from prefriction.identify.parameters import ParameterSpace, name_list
 from prefriction.identify.result import FitResult
 from prefriction.identify.validation import model_name
@@ -255,6 +256,21 @@ def _finish(space: ParameterSpace, values: dict, est: np.ndarray, stats: Any, re
         warnings.warn(f"the fit of {model_name(fitted_model)} did not converge: {message}; the estimates are where "
                       f"the solver stopped (raise max_iter, or give better start values)", ConvergenceWarning,
                       stacklevel=level)
-    return FitResult(fitted_model, mass, tuple(space.free), tuple(space.units[n] for n in space.free), est,
-                     stats.stderr, low, high, stats.correlation, residuals, fitted, data, stats,
-                     nuisance, message, success=success, flags=flags)
+    res = FitResult(fitted_model, mass, tuple(space.free), tuple(space.units[n] for n in space.free), est,
+                    stats.stderr, low, high, stats.correlation, residuals, fitted, data, stats,
+                    nuisance, message, success=success, flags=flags)
+    _warn_structure(res, level)
+    return res
+
+
+def _warn_structure(res: FitResult, level: int) -> None:
+    """A :class:`ResidualWarning` if the residuals show structure (``docs/identify.md#diagnostics``)."""
+    diag = res.diagnostics
+    if not diag.structured:
+        return
+    who = "; ".join(f"{n} ({why})" for n, why in diag.distrust) if diag.distrust else \
+        "no single estimate stands out, every one may be biased"
+    warnings.warn(f"the residuals of the {model_name(res.model)} fit show structure the model does not explain: "
+                  f"{'; '.join(diag.findings)}. Distrust: {who}. Try another model or structure, free the "
+                  f"parameters held, or declare the position noise (docs/identify.md#diagnostics)",
+                  ResidualWarning, stacklevel=level + 1)
