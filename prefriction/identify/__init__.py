@@ -11,6 +11,8 @@
   stopped without converging.
 - :class:`ResidualWarning`: residuals with structure the model does not explain (runs, spikes
   at reversals), naming the estimates to distrust (``FitResult.diagnostics``).
+- :class:`NoisyPositionsWarning`: force-displacement positions that turn at the noise, with no
+  ``x_noise``/``quantum`` declared.
 - :class:`Validation`: prediction errors on held-out data (``FitResult.validate``).
 - :class:`ForceVelocity` and :class:`StaticFriction`: steady-sliding force against velocity and
   the classic static map (Coulomb + viscous + Stribeck, direction-dependent levels) it fits.
@@ -19,7 +21,7 @@
 from __future__ import annotations
 
 from prefriction.identify.data import ForceDisplacement, ForceVelocity, Motion
-from prefriction.identify.diagnostics import ResidualWarning
+from prefriction.identify.diagnostics import NoisyPositionsWarning, ResidualWarning
 from prefriction.identify.fit import fit
 from prefriction.identify.result import FitResult
 from prefriction.identify.static_map import StaticFriction
@@ -27,4 +29,4 @@ from prefriction.identify.statistics import BoundWarning, ConvergenceWarning, Id
 from prefriction.identify.validation import Validation
 
 __all__ = ["BoundWarning", "ConvergenceWarning", "FitResult", "ForceDisplacement", "ForceVelocity",
-           "IdentifiabilityWarning", "Motion", "ResidualWarning", "StaticFriction", "Validation", "fit"]
+           "IdentifiabilityWarning", "Motion", "NoisyPositionsWarning", "ResidualWarning", "StaticFriction", "Validation", "fit"]

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["ResidualDiagnostics", "ResidualWarning", "diagnose", "reversal_indices"]
+__all__ = ["NoisyPositionsWarning", "ResidualDiagnostics", "ResidualWarning", "diagnose", "reversal_indices"]
 
 RUNS_Z = -4.0
 """Runs z-score below which the runs are too few (eq. D1)."""
@@ -42,6 +42,12 @@ LAGS = 50
 class ResidualWarning(UserWarning):
     """The residuals of a fit show structure the model does not explain (runs, correlation,
     spikes at reversals); the message names the estimates to distrust."""
+
+
+class NoisyPositionsWarning(UserWarning):
+    """The positions of :class:`prefriction.identify.ForceDisplacement` data turn far more often
+    than the motion reverses, and no ``x_noise`` or ``quantum`` was declared: the fit integrates
+    the model along the noise and its estimates are biased (``docs/identify.md#positions``)."""
 
 
 @dataclass(frozen=True)

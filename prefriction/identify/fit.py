@@ -9,7 +9,7 @@ import numpy as np
 
 from prefriction._validation import check_bool, check_count, check_positive
 from prefriction.identify.data import ForceDisplacement, ForceVelocity, Motion
-from prefriction.identify.diagnostics import ResidualWarning
+from prefriction.identify.diagnostics import NoisyPositionsWarning, ResidualWarning
 from prefriction.identify.parameters import ParameterSpace, name_list
 from prefriction.identify.result import FitResult
 from prefriction.identify.validation import model_name
@@ -117,6 +117,13 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
         structure boundary such as Dahl's ``gamma = 1``); its interval starts at the bound.
     ConvergenceWarning
         If the solver stops at ``max_iter`` without converging.
+    NoisyPositionsWarning
+        For :class:`ForceDisplacement` data whose positions turn far more often than the motion
+        reverses, with neither ``x_noise`` nor ``quantum`` declared.
+    ResidualWarning
+        If the residuals show structure the model does not explain (runs with a lag-1
+        autocorrelation above 0.3, or spikes after the reversals); it names the estimates to
+        distrust (``FitResult.diagnostics``).
     IdentifiabilityWarning
         Naming every parameter the data cannot identify: a relative standard error above
         ``identifiability_limit`` (e.g. ``Fc`` from loops that never leave pre-sliding), or a
@@ -125,10 +132,12 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
 
     Notes
     -----
-    Standard errors are Gauss-Newton: ``s^2 (J^T J)^-1`` at the optimum with the residual
-    variance ``s^2 = |r|^2 / (n - p)``, nuisance variables (initial state, shooting nodes,
-    reversal times) marginalised; intervals are cut at the allowed range; see
-    ``docs/identify.md``.
+    Standard errors are the HAC (Newey-West) sandwich around the Gauss-Newton covariance
+    ``s^2 (J^T J)^-1`` (correlated residuals), never below it, nuisance variables (initial
+    state, shooting nodes, reversal times) marginalised; for :class:`ForceDisplacement` data with
+    declared ``x_noise`` or ``quantum`` the model follows the estimated true path and that path's
+    error is added (errors in variables); intervals are cut at the allowed range; see
+    ``docs/identify.md#statistics`` and ``#positions``.
 
     Examples
     --------
@@ -177,7 +186,11 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
     if mass0 is not None:
         raise ValueError(f"mass0 = {mass0!r} is for Motion data with a free mass; force-displacement data "
                          f"involve no mass (allowed: mass0=None)")
+    from prefriction.identify.positions import noisy_positions_message
     from prefriction.identify.structures import fit_structures, gamma_entry
+
+    if not data.noisy_positions and (why := noisy_positions_message(data.x)) is not None:
+        warnings.warn(why, NoisyPositionsWarning, stacklevel=2)
 
     scale = float(np.std(data.F)) if offset else None
 

@@ -34,7 +34,7 @@ from scipy.ndimage import convolve1d
 from scipy.signal import savgol_coeffs, savgol_filter
 
 __all__ = ["denoise_path", "dwell_error_sd", "dwell_sets", "noise_sd", "smoothed_covariance_factor",
-           "spurious_reversals"]
+           "noisy_positions_message", "turns"]
 
 POLYORDER = 3
 """Degree of the local polynomial (a cubic: exact on a parabola-shaped reversal)."""
@@ -202,11 +202,10 @@ def dwell_sets(path: np.ndarray, quantum: float) -> list[np.ndarray]:
         if s[j0] == s[j1]:
             continue
         e = j1  # the extreme: the samples j0 + 1 ... j1 are flat between the two directions
-        near = np.abs(path - path[e]) <= quantum
         a, b = e, e
-        while a > 0 and near[a - 1]:
+        while a > 0 and abs(path[a - 1] - path[e]) <= quantum:
             a -= 1
-        while b + 1 < path.size and near[b + 1]:
+        while b + 1 < path.size and abs(path[b + 1] - path[e]) <= quantum:
             b += 1
         out.append(np.arange(a, b + 1))
     return out
@@ -232,12 +231,30 @@ def smoothed_covariance_factor(G: np.ndarray, window: int) -> np.ndarray:
     return convolve1d(G, c[::-1], axis=-1, mode="constant")
 
 
-def spurious_reversals(x: np.ndarray) -> float:
-    """Fraction of the sample intervals at which the direction of ``x`` turns (``dx`` changes sign).
-
-    Smooth motion turns a few times per cycle; noisy positions turn at a large fraction of the
-    samples, which biases a hysteresis fit (module docstring).
-    """
+def turns(x: np.ndarray) -> int:
+    """How often the direction of ``x`` turns (``dx`` changes sign, steps of zero skipped)."""
     dx = np.diff(x)
     s = np.sign(dx[dx != 0.0])
-    return float(np.count_nonzero(s[1:] != s[:-1])) / max(x.size - 1, 1)
+    return int(np.count_nonzero(s[1:] != s[:-1]))
+
+
+def noisy_positions_message(x: np.ndarray) -> str | None:
+    """A sentence if the undeclared positions ``x`` [m] turn far more often than the motion
+    reverses (by more than 1 % of its range): at least 10 extra turns and twice the reversals.
+
+    It names the smallest step (a likely encoder step) and a noise level from the second
+    differences (``median(|d2 x|) / 0.6745 / sqrt(6)``, robust to the motion's curvature when the
+    sampling is fine), as values to declare.
+    """
+    from prefriction.identify.diagnostics import reversal_indices
+
+    n_turns, n_rev = turns(x), int(reversal_indices(x).size)
+    if n_turns - n_rev < max(10, 2 * n_rev):
+        return None
+    steps = np.abs(np.diff(x))
+    step = float(np.min(steps[steps > 0.0]))
+    sd = float(np.median(np.abs(np.diff(x, 2))) / 0.6745 / np.sqrt(6.0))
+    return (f"the positions turn {n_turns} times but the motion reverses {n_rev} times: noise or encoder steps "
+            f"on x make a spurious reversal at each turn, which biases a hysteresis fit. Declare them: "
+            f"ForceDisplacement(t, x, F, x_noise=..., quantum=...) (smallest step here {step:.3g} m, noise from the "
+            f"second differences about {sd:.3g} m; docs/identify.md#positions)")
