@@ -148,3 +148,13 @@ def test_report_says_what_happened(tmp_path):
     assert "start: sigma from the transients" in res.summary()
     out = res.plot_residuals(tmp_path / "res.png")
     assert out.stat().st_size > 10_000
+
+
+def test_bench_coverage_table_lists_every_parameter():
+    from prefriction.identify._coverage import table_text
+
+    rows = coverage_table(("maxwell-encoder",), runs=2, seed=5)
+    text = table_text(rows)
+    assert text.count("\n") == 2 and "| maxwell-encoder | 401 | 2 |" in text
+    for name in ("stiffness[0]", "stiffness[1]", "slip_force[0]", "slip_force[1]"):
+        assert name in text
