@@ -158,3 +158,32 @@ def test_bench_coverage_table_lists_every_parameter():
     assert text.count("\n") == 2 and "| maxwell-encoder | 401 | 2 |" in text
     for name in ("stiffness[0]", "stiffness[1]", "slip_force[0]", "slip_force[1]"):
         assert name in text
+
+
+def test_runs_test_matches_the_wald_wolfowitz_formula():
+    from prefriction.identify.diagnostics import _runs
+
+    r = np.array([1.0, 2.0, -1.0, 0.5, -0.2, -0.3, 0.4, 0.1])   # n+ = 5, n- = 3, runs + + | - | + | - - | + +
+    R, mean, z = _runs(r)
+    assert R == 5
+    assert mean == pytest.approx(1.0 + 2.0 * 5 * 3 / 8)
+    assert z == pytest.approx((5 - 4.75) / np.sqrt(2.0 * 15 * (30 - 8) / (64 * 7)))
+
+
+def test_spikes_after_reversals_name_the_parameter_they_pull():
+    from prefriction.identify.diagnostics import diagnose
+
+    n = 2000
+    x = np.sin(np.linspace(0.0, 4.0 * np.pi, n))          # reversals at n/8, 3n/8, 5n/8, 7n/8
+    r = 0.01 * np.random.default_rng(0).standard_normal(n)
+    rev = [250, 750, 1250, 1750]
+    spike = np.zeros(n)
+    for i in rev:
+        spike[i:i + 20] = 0.05
+    r = r + spike
+    psi = np.vstack([spike * 1e-3, 1e-6 * np.ones(n)])    # a: moved by the spikes only; b: by every sample alike
+    se = np.array([1e-3, 1e-3])
+    d = diagnose(r, x, ("a", "b"), se, se, psi)
+    assert list(d.reversals) == pytest.approx(rev, abs=1)
+    assert d.reversal_ratio > 2.0 and any("reversals" in f for f in d.findings)
+    assert [n_ for n_, _ in d.distrust] == ["a"]

@@ -121,8 +121,6 @@ class ForceDisplacement:
     quantum: Any = 0.0
 
     def __post_init__(self) -> None:
-        from prefriction.identify.positions import denoise_path
-
         t = _times(self.t)
         x = _samples("x", self.x, "m")
         F = _samples("F", self.F, "N")
@@ -132,7 +130,11 @@ class ForceDisplacement:
         _moving("F", F, "N")
         x_noise = check_nonnegative("x_noise", self.x_noise)
         quantum = check_nonnegative("quantum", self.quantum)
-        path, window = (x, 1) if x_noise == 0.0 and quantum == 0.0 else denoise_path(x, x_noise, quantum)
+        path, window = x, 1
+        if x_noise > 0.0 or quantum > 0.0:
+            from prefriction.identify.positions import denoise_path  # scipy.signal only when needed
+
+            path, window = denoise_path(x, x_noise, quantum)
         path.flags.writeable = False
         for name, val in (("t", t), ("x", x), ("F", F), ("x_noise", x_noise), ("quantum", quantum), ("path", path),
                           ("path_window", window)):
