@@ -88,8 +88,8 @@ def coverage_lines(quick: bool) -> tuple[list[str], bool]:
     rows = coverage_table(runs=runs, progress=lambda line: print(line, file=sys.stderr, flush=True))
     judged = [r for r in rows if not r.case.endswith("undeclared")]
     ok = all(r.pooled >= COVERAGE_TARGET for r in judged)
-    lines = [f"Coverage of the 95 % intervals, {runs} seeded records per case (sd of z = (estimate - truth) / "
-             f"stderr in brackets: 1 is honest, below 1 conservative)", table_text(rows),
+    lines = [f"Coverage of the 95 % intervals, {runs} seeded records per case (mean and sd of z = (estimate - "
+             f"truth) / stderr in brackets: 0 and 1 are honest, an sd below 1 conservative)", table_text(rows),
              f"target every case with its noise declared >= {COVERAGE_TARGET:.0%} of the intervals hold the "
              f"truth: {'PASS' if ok else 'FAIL'} (the undeclared row shows the bias it avoids)"]
     return lines, ok
