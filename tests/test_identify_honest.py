@@ -95,7 +95,8 @@ def test_coverage_fast():
 
 @pytest.mark.slow
 def test_coverage_at_least_90_percent():
-    rows = coverage_table(("dahl-clean", "dahl-encoder", "maxwell-encoder", "dahl-decay"), runs=40, seed=0)
+    rows = coverage_table(("dahl-clean", "dahl-encoder", "maxwell-encoder", "dahl-decay", "closed-loop-encoder"),
+                          runs=40, seed=0)
     for r in rows:
         assert r.pooled >= 0.90, (r.case, r.held)
 
