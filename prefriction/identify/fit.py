@@ -283,7 +283,9 @@ def _warn_structure(res: FitResult, level: int) -> None:
         return
     who = "; ".join(f"{n} ({why})" for n, why in diag.distrust) if diag.distrust else \
         "no single estimate stands out, every one may be biased"
+    noise = ", declare the position noise (x_noise, quantum)" if isinstance(res.data, ForceDisplacement) and \
+        not res.data.noisy_positions else ""
     warnings.warn(f"the residuals of the {model_name(res.model)} fit show structure the model does not explain: "
                   f"{'; '.join(diag.findings)}. Distrust: {who}. Try another model or structure, free the "
-                  f"parameters held, or declare the position noise (docs/identify.md#diagnostics)",
+                  f"parameters held{noise}, and look at res.plot_residuals() (docs/identify.md#diagnostics)",
                   ResidualWarning, stacklevel=level + 1)
