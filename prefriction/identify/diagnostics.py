@@ -144,7 +144,8 @@ def _acf(r: np.ndarray) -> np.ndarray:
 
 
 def diagnose(residuals: np.ndarray, x: np.ndarray, names: tuple[str, ...] | list[str], stderr: np.ndarray,
-             stderr_iid: np.ndarray | None, influence: np.ndarray | None) -> ResidualDiagnostics:
+             stderr_iid: np.ndarray | None, influence: np.ndarray | None,
+             reversals: np.ndarray | None = None) -> ResidualDiagnostics:
     """The diagnostics of one fit (module text).
 
     Parameters
@@ -159,6 +160,9 @@ def diagnose(residuals: np.ndarray, x: np.ndarray, names: tuple[str, ...] | list
         Their standard errors (HAC) and the white-residual ones.
     influence : numpy.ndarray or None
         ``psi`` of ``statistics.py`` (eq. S1), shape ``(k, n)``.
+    reversals : numpy.ndarray, optional
+        Sample indices of the reversals, if known (a Motion fit locates its own, small ones
+        included); default: those of ``x`` by more than 1 % of its range.
 
     Returns
     -------
@@ -168,7 +172,7 @@ def diagnose(residuals: np.ndarray, x: np.ndarray, names: tuple[str, ...] | list
     n = r.size
     R, mean, z = _runs(r)
     acf = _acf(r)
-    rev = reversal_indices(x)
+    rev = reversal_indices(x) if reversals is None else np.unique(np.asarray(reversals, dtype=int))
     window = int(max(2, n // (10 * (rev.size + 1)))) if rev.size else 0
     mask = np.zeros(n, dtype=bool)
     for i in rev:

@@ -91,7 +91,9 @@ class FitResult:
 
         x = self.data.path if isinstance(self.data, ForceDisplacement) else self.data.x
         st = self.statistics
-        return diagnose(self.residuals, x, self.names, self.stderr, st.stderr_iid, st.influence)
+        times = next((np.atleast_1d(v) for k, v in self.nuisance.items() if k.startswith("reversal times")), None)
+        rev = None if times is None else np.clip(np.searchsorted(self.data.t, times), 0, len(self.data.t) - 1)
+        return diagnose(self.residuals, x, self.names, self.stderr, st.stderr_iid, st.influence, rev)
 
     @property
     def unidentifiable(self) -> tuple[str, ...]:
