@@ -181,7 +181,8 @@ class FitResult:
 
     def summary(self) -> str:
         """A few lines: the fitted model, the residual level, estimates with intervals and bound
-        flags, any unidentifiable parameter, what was compared, and non-convergence."""
+        flags, any unidentifiable parameter, the start pipeline's steps (Motion fits), residual
+        structure and the estimates to distrust, what was compared, and non-convergence."""
         st = self.statistics
         unit = "m" if isinstance(self.data, Motion) else "N"
         lines = [f"{model_name(self.model)} fitted to {len(self.residuals)} samples of "
