@@ -65,9 +65,10 @@ def success_lines(quick: bool) -> tuple[list[str], bool]:
         print(f"bench --identify: success rate of {stage.name} ...", file=sys.stderr, flush=True)
         out = subprocess.run([sys.executable, "-m", "prefriction.cli.bench.identify_rates", "success", str(i),
                               str(fits), str(samples), ",".join(map(str, distances))],
-                             capture_output=True, text=True, check=False)
+                             stdout=subprocess.PIPE, text=True, check=False)  # its progress on our stderr
         if out.returncode != 0:
-            lines.append(f"| {stage.name} | - | {samples} | FAILED | | | | | {out.stderr.strip()[-200:]} |")
+            lines.append(f"| {stage.name} | - | {samples} | FAILED | | | | | exit code {out.returncode}, "
+                         f"see the messages above |")
             ok = False
             continue
         for r in json.loads(out.stdout.strip().splitlines()[-1]):
