@@ -89,6 +89,9 @@ class FitResult:
         distrust (:mod:`prefriction.identify.diagnostics`, ``docs/identify.md#diagnostics``)."""
         from prefriction.identify.diagnostics import diagnose
 
+        if not isinstance(self.data, (ForceDisplacement, Motion)):
+            raise TypeError(f"residual diagnostics need a fit of ForceDisplacement or Motion data (records in time), "
+                            f"got {type(self.data).__name__}")
         x = self.data.path if isinstance(self.data, ForceDisplacement) else self.data.x
         st = self.statistics
         times = next((np.atleast_1d(v) for k, v in self.nuisance.items() if k.startswith("reversal times")), None)
