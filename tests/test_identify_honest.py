@@ -193,3 +193,15 @@ def test_spikes_after_reversals_name_the_parameter_they_pull():
     assert list(d.reversals) == pytest.approx(rev, abs=1)
     assert d.reversal_ratio > 2.0 and any("reversals" in f for f in d.findings)
     assert [n_ for n_, _ in d.distrust] == ["a"]
+
+
+def test_diagnostics_of_a_static_map_fit_are_refused_by_name():
+    from prefriction.identify import ForceVelocity, StaticFriction
+
+    v = np.r_[-np.geomspace(1e-4, 1e-1, 20), np.geomspace(1e-4, 1e-1, 20)]
+    F = StaticFriction(Fc=20.0, b=200.0).force(v) + 0.1 * np.random.default_rng(0).standard_normal(v.size)
+    res = identify.fit(StaticFriction(Fc=10.0, b=100.0), ForceVelocity(v, F))
+    with pytest.raises(TypeError, match="ForceDisplacement or Motion"):
+        res.diagnostics
+    with pytest.raises(TypeError, match="ForceDisplacement or Motion"):
+        res.plot_residuals("never.png")
