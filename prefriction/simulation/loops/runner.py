@@ -18,6 +18,7 @@ from typing import Optional
 import casadi as ca
 import numpy as np
 
+from prefriction._memory import check_memory
 from prefriction.models import Oscillator
 from prefriction.signals import Constant
 from prefriction.simulation.compiled import compiled, jit_available
@@ -150,7 +151,8 @@ class Measurement:
 @dataclass(frozen=True)
 class Compensation:
     """A compensator in the compiled loop: its structure (``NoCompensation``'s interface), its
-    numbers, its initial state and the reference velocity [m/s] at the sample instants."""
+    numbers, its initial state and the reference velocity [m/s] at the sample instants (one more
+    entry, the instant after the last, makes the last sample's force the controller's there)."""
 
     structure: object
     params: np.ndarray
@@ -216,6 +218,9 @@ def run_sampled(
     eps = rtol * _CAL * math.sqrt(L.n_active / L.nx)
     Ts_n, t_end_n = fb.Ts / sc.t, t_end / sc.t
     n_s = sample_count(t_end_n, Ts_n, t_end / fb.Ts)
+    lay = LoopLayout(spec)  # before any compile: the inputs and records of every sample
+    check_memory(f"the sampled loop of {type(model).__name__}", n_s, lay.nw + lay.nrec + 12 + n_user,
+                 "sample instants", "increase Ts or split the run")
     tk = np.minimum(np.arange(n_s) * Ts_n, t_end_n)
     blk, setup, mode = _block(spec, jit)
     LL = blk.LL
@@ -251,10 +256,13 @@ def run_sampled(
     Wall[: n_s - 1, ii["active"]] = 1.0
     Wall[:n_s, ii["r"]] = np.asarray(fb.reference(tk * sc.t), dtype=float)
     Wall[: n_s - 1, ii["rn"]] = Wall[1:n_s, ii["r"]]
-    Wall[n_s - 1, ii["rn"]] = Wall[n_s - 1, ii["r"]]
+    # the last sample's force is the controller's there: the reference goes on one period (not frozen)
+    Wall[n_s - 1, ii["rn"]] = float(np.asarray(fb.reference(np.array([(tk[-1] + Ts_n) * sc.t])), dtype=float)[0])
     if compensation is not None:
-        Wall[:n_s, ii["vr"]] = compensation.velocity
-        Wall[: n_s - 1, ii["vrn"]] = compensation.velocity[1:]
+        Wall[:n_s, ii["vr"]] = compensation.velocity[:n_s]
+        Wall[: n_s - 1, ii["vrn"]] = compensation.velocity[1:n_s]
+        if len(compensation.velocity) > n_s:
+            Wall[n_s - 1, ii["vrn"]] = compensation.velocity[n_s]
     if measurement.noise is not None:
         Wall[:n_s, ii["noise"]] = measurement.noise
     xc0 = _padded(fb.xc0.reshape(1, -1), n, (1, n))[0]
