@@ -253,8 +253,9 @@ def plot_residuals(res: "FitResult", path: str | Path, show: bool) -> Path:
     ax.legend(loc="upper left", fontsize=8)
     state = "; ".join(diag.findings) if diag.findings else "no unexplained structure"
     fig.suptitle("\n".join(textwrap.wrap(f"{model_name(res.model)} residuals: {state}", 110)), fontsize=9)
-    out = Path(path)
-    fig.savefig(out, dpi=120)
+    from prefriction.plotting import write_figure
+
+    out = write_figure(fig, path)   # atomic, a link at path replaced, never followed
     if show:
         plt.show()
     plt.close(fig)
