@@ -26,7 +26,7 @@ import warnings
 __all__ = ["coverage_lines", "cost_lines", "main_rates", "success_lines"]
 
 COVERAGE_TARGET = 0.90
-"""Least fraction of the 95 % intervals that must hold the truth (issue 25)."""
+"""Least fraction of the 95 % intervals that must hold the truth."""
 SLOPE_TARGET = 1.3
 """Largest log-log slope of the force-displacement fit time against the samples."""
 
@@ -52,8 +52,8 @@ def success_lines(quick: bool) -> tuple[list[str], bool]:
     try:
         from prefriction.identify import _success
     except ImportError:
-        return ["success rate: the seeded harness prefriction.identify._success is not in this build "
-                "(issue 25, deliverable 1); table skipped"], True
+        return ["success rate: the seeded harness prefriction.identify._success is not in this build; "
+                "table skipped"], True
     fits, samples = (2, 500) if quick else (10, 1000)
     distances = (1.5, 2.0) if quick else (1.25, 1.5, 2.0)
     lines = [f"Motion fits from starts log-uniform within a factor d of the truth (every free parameter, mass "
