@@ -205,3 +205,23 @@ def test_diagnostics_of_a_static_map_fit_are_refused_by_name():
         res.diagnostics
     with pytest.raises(TypeError, match="ForceDisplacement or Motion"):
         res.plot_residuals("never.png")
+
+
+def test_motion_residuals_compared_with_the_declared_position_noise():
+    from prefriction.identify._coverage import CASES
+
+    make, n = CASES["closed-loop-encoder"]
+    rec, start, truth, kw = make(np.random.default_rng(7), n)
+    data = identify.Motion(rec.t, rec.x, rec.u, None, x_noise=1e-7, quantum=5e-8)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", identify.IdentifiabilityWarning)
+        res = identify.fit(start, data, **kw)
+    assert not res.diagnostics.structured, res.diagnostics.summary()
+    assert "positions: x_noise 1e-07 m, quantum 5e-08 m declared" in res.report()
+    # residuals three times the declared noise: the model leaves motion unexplained (eq. D4)
+    from prefriction.identify.diagnostics import diagnose
+
+    r = 3.0 * 1.0e-7 * np.random.default_rng(1).standard_normal(n)
+    d = diagnose(r, rec.x, res.names, res.stderr, res.statistics.stderr_iid, None, noise=1.0e-7)
+    assert d.structured and "times the declared measurement noise" in d.findings[0]
+    assert not diagnose(r / 3.0, rec.x, res.names, res.stderr, None, None, noise=1.0e-7).structured

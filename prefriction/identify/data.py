@@ -176,6 +176,13 @@ class Motion:
         How ``u`` acts between samples ``t[k]`` and ``t[k+1]``: ``"zoh"`` holds ``u[k]`` (what a
         digital loop applies: its output changes at the samples and is held in between);
         ``"linear"`` interpolates linearly between ``u[k]`` and ``u[k+1]``.
+    x_noise : float, default 0.0
+        Standard deviation [m] of the noise on the measured ``x`` (``>= 0``), if known.
+    quantum : float, default 0.0
+        Encoder step [m] of ``x`` (``>= 0``), if known. A Motion fit is an output-error fit (the
+        residual is the measured position minus the model's), consistent under position noise
+        and rounding without them; declared, they let the residual diagnostics compare the
+        residual level with the measurement's (``docs/identify.md#diagnostics``).
 
     Raises
     ------
@@ -183,7 +190,7 @@ class Motion:
         If an argument is not a real number or an array of them.
     ValueError
         As :class:`ForceDisplacement` for ``t``, ``x`` and sampled ``u``; also if ``mass`` is
-        not finite and positive.
+        not finite and positive, or ``x_noise`` or ``quantum`` negative or not finite.
     """
 
     t: Any
@@ -191,6 +198,8 @@ class Motion:
     u: Any = 0.0
     mass: Any = None
     hold: str = "zoh"
+    x_noise: Any = 0.0
+    quantum: Any = 0.0
 
     def __post_init__(self) -> None:
         if self.hold not in HOLDS:
@@ -213,7 +222,9 @@ class Motion:
             u = _samples("u", self.u, "N")
             _same_length(t, "u", u)
         mass = None if self.mass is None else check_positive("mass", self.mass)
-        for name, val in (("t", t), ("x", x), ("u", u), ("mass", mass)):
+        x_noise = check_nonnegative("x_noise", self.x_noise)
+        quantum = check_nonnegative("quantum", self.quantum)
+        for name, val in (("t", t), ("x", x), ("u", u), ("mass", mass), ("x_noise", x_noise), ("quantum", quantum)):
             object.__setattr__(self, name, val)
 
     def __len__(self) -> int:

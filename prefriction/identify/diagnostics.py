@@ -12,7 +12,9 @@ Three checks on the residuals ``r`` of :func:`prefriction.identify.fit`, in samp
 
 The residuals show *structure* when the runs are far too few (``z < -4``) and
 ``rho_1 > 0.3`` (a smooth misfit holds at least 30 % of their variance), or the reversal
-rms is more than twice the rest. Which estimates that misleads is read from the influence
+rms is more than twice the rest, or (a :class:`Motion` record with its position noise
+declared) the residual rms is more than twice the measurement's,
+``sqrt(x_noise^2 + quantum^2 / 12)`` (eq. D4). Which estimates that misleads is read from the influence
 ``psi_t`` of each sample on each estimate (``statistics.py``, eq. S1): an estimate is to be
 distrusted when the samples after the reversals pull it by more than 2 standard errors
 (``|sum_{t in reversal windows} psi_t| > 2 se``), or when its HAC standard error is more than
@@ -33,6 +35,8 @@ LAG1 = 0.3
 """Lag-1 autocorrelation above which the residuals hold a smooth misfit (eq. D2)."""
 SPIKE_RATIO = 2.0
 """Ratio of the rms after reversals to the rms elsewhere above which reversals spike (eq. D3)."""
+NOISE_RATIO = 2.0
+"""Residual rms over the declared measurement noise above which the model leaves signal unexplained (eq. D4)."""
 PULL = 2.0
 """Standard errors by which the reversal windows may pull an estimate before it is distrusted."""
 LAGS = 50
@@ -145,7 +149,7 @@ def _acf(r: np.ndarray) -> np.ndarray:
 
 def diagnose(residuals: np.ndarray, x: np.ndarray, names: tuple[str, ...] | list[str], stderr: np.ndarray,
              stderr_iid: np.ndarray | None, influence: np.ndarray | None,
-             reversals: np.ndarray | None = None) -> ResidualDiagnostics:
+             reversals: np.ndarray | None = None, noise: float = 0.0) -> ResidualDiagnostics:
     """The diagnostics of one fit (module text).
 
     Parameters
@@ -163,6 +167,9 @@ def diagnose(residuals: np.ndarray, x: np.ndarray, names: tuple[str, ...] | list
     reversals : numpy.ndarray, optional
         Sample indices of the reversals, if known (a Motion fit locates its own, small ones
         included); default: those of ``x`` by more than 1 % of its range.
+    noise : float, default 0.0
+        Standard deviation of the measurement error of the fitted signal, if declared (a
+        :class:`Motion` fit's positions, eq. D4); 0: not compared.
 
     Returns
     -------
@@ -188,6 +195,10 @@ def diagnose(residuals: np.ndarray, x: np.ndarray, names: tuple[str, ...] | list
     if np.isfinite(ratio) and ratio > SPIKE_RATIO:
         findings.append(f"the residuals after the {rev.size} reversals are {ratio:.1f} times the rest (rms over "
                         f"{window} samples after each): the model's reversal transient differs from the data's")
+    level = float(np.sqrt(np.mean(r ** 2)))
+    if noise > 0.0 and level > NOISE_RATIO * noise:
+        findings.append(f"the residual rms {level:.3g} is {level / noise:.1f} times the declared measurement noise "
+                        f"{noise:.3g}: the model leaves motion unexplained")
     distrust = []
     if findings:
         for i, name in enumerate(names):

@@ -76,6 +76,11 @@ def report_text(res: "FitResult", held_out: Any = None) -> str:
         rows.append(f"positions: x_noise {d.x_noise:.3g} m, quantum {d.quantum:.3g} m declared; the model follows the "
                     f"estimated path (window {d.path_window} samples, rms change {np.std(d.path - d.x):.3g} m), its "
                     f"error is in the intervals")
+    if isinstance(d, Motion) and (d.x_noise or d.quantum):
+        from prefriction.identify.positions import noise_sd
+
+        rows.append(f"positions: x_noise {d.x_noise:.3g} m, quantum {d.quantum:.3g} m declared (measurement sd "
+                    f"{noise_sd(d.x_noise, d.quantum):.3g} m; the residual sd above)")
     if st.unidentifiable:
         for n, why in st.unidentifiable:
             rows.append(f"NOT IDENTIFIABLE from these data: {n} ({why})")

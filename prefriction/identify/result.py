@@ -96,7 +96,12 @@ class FitResult:
         st = self.statistics
         times = next((np.atleast_1d(v) for k, v in self.nuisance.items() if k.startswith("reversal times")), None)
         rev = None if times is None else np.clip(np.searchsorted(self.data.t, times), 0, len(self.data.t) - 1)
-        return diagnose(self.residuals, x, self.names, self.stderr, st.stderr_iid, st.influence, rev)
+        noise = 0.0
+        if isinstance(self.data, Motion):
+            from prefriction.identify.positions import noise_sd
+
+            noise = noise_sd(self.data.x_noise, self.data.quantum)
+        return diagnose(self.residuals, x, self.names, self.stderr, st.stderr_iid, st.influence, rev, noise)
 
     @property
     def unidentifiable(self) -> tuple[str, ...]:
