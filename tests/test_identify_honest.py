@@ -84,6 +84,10 @@ def test_position_noise_arguments_are_checked():
         ForceDisplacement(t, xm, F, x_noise=-1e-9)
     with pytest.raises(ValueError, match="quantum"):
         ForceDisplacement(t, xm, F, quantum=float("nan"))
+    with pytest.raises(ValueError, match="x_noise"):
+        identify.Motion(t, xm, F, 1.0, x_noise=-1e-9)
+    with pytest.raises(TypeError, match="quantum"):
+        identify.Motion(t, xm, F, 1.0, quantum="1e-8")
 
 
 def test_coverage_fast():
