@@ -29,4 +29,5 @@ from prefriction.identify.statistics import BoundWarning, ConvergenceWarning, Id
 from prefriction.identify.validation import Validation
 
 __all__ = ["BoundWarning", "ConvergenceWarning", "FitResult", "ForceDisplacement", "ForceVelocity",
-           "IdentifiabilityWarning", "Motion", "NoisyPositionsWarning", "ResidualWarning", "StaticFriction", "Validation", "fit"]
+           "IdentifiabilityWarning", "Motion", "NoisyPositionsWarning", "ResidualWarning", "StaticFriction",
+           "Validation", "fit"]
