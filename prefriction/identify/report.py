@@ -1,27 +1,25 @@
-"""Text report and figure of a :class:`prefriction.identify.FitResult`."""
+"""Text report and figure of a :class:`prefriction.identify.FitResult` (which imports this module:
+``res`` is annotated ``Any`` here, so no import runs back up to it)."""
 
 from __future__ import annotations
 
 import textwrap
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
 from prefriction.identify.data import ForceDisplacement, ForceVelocity, Motion
 from prefriction.identify.validation import check_directory, model_name
 
-if TYPE_CHECKING:
-    from prefriction.identify.result import FitResult
-
 __all__ = ["plot_fit", "plot_residuals", "report_text"]
 
 
-def _flag(res: "FitResult", i: int) -> str:
+def _flag(res: Any, i: int) -> str:
     return f"  ({res.flags[i]})" if i < len(res.flags) and res.flags[i] else ""
 
 
-def report_text(res: "FitResult", held_out: Any = None) -> str:
+def report_text(res: Any, held_out: Any = None) -> str:
     """The text of :meth:`FitResult.report`.
 
     Parameters
@@ -103,7 +101,7 @@ def report_text(res: "FitResult", held_out: Any = None) -> str:
     return "\n".join(rows)
 
 
-def plot_fit(res: "FitResult", path: str | Path, show: bool) -> Path:
+def plot_fit(res: Any, path: str | Path, show: bool) -> Path:
     """The figure of :meth:`FitResult.plot`.
 
     Parameters
@@ -180,7 +178,7 @@ def _headroom(ax: Any, y: np.ndarray) -> None:
     ax.set_ylim(lo - 0.05 * span, hi + 0.3 * span)
 
 
-def plot_residuals(res: "FitResult", path: str | Path, show: bool) -> Path:
+def plot_residuals(res: Any, path: str | Path, show: bool) -> Path:
     """The figure of :meth:`FitResult.plot_residuals`: residuals against time with the reversals
     marked, their autocorrelation with the band of independent residuals, the residuals against
     the samples since the last reversal (spikes there are a reversal transient the model
