@@ -21,11 +21,11 @@
 from __future__ import annotations
 
 from prefriction.identify.data import ForceDisplacement, ForceVelocity, Motion
-from prefriction.identify.diagnostics import NoisyPositionsWarning, ResidualWarning
 from prefriction.identify.fit import fit
 from prefriction.identify.result import FitResult
 from prefriction.identify.static_map import StaticFriction
-from prefriction.identify.statistics import BoundWarning, ConvergenceWarning, IdentifiabilityWarning
+from prefriction.identify.statistics import (BoundWarning, ConvergenceWarning, IdentifiabilityWarning,
+                                             NoisyPositionsWarning, ResidualWarning)
 from prefriction.identify.validation import Validation
 
 __all__ = ["BoundWarning", "ConvergenceWarning", "FitResult", "ForceDisplacement", "ForceVelocity",

@@ -27,7 +27,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["NoisyPositionsWarning", "ResidualDiagnostics", "ResidualWarning", "diagnose", "reversal_indices"]
+from prefriction.identify.positions import reversal_indices
+
+__all__ = ["ResidualDiagnostics", "diagnose"]
 
 RUNS_Z = -4.0
 """Runs z-score below which the runs are too few (eq. D1)."""
@@ -41,17 +43,6 @@ PULL = 2.0
 """Standard errors by which the reversal windows may pull an estimate before it is distrusted."""
 LAGS = 50
 """Lags of the autocorrelation kept."""
-
-
-class ResidualWarning(UserWarning):
-    """The residuals of a fit show structure the model does not explain (runs, correlation,
-    spikes at reversals); the message names the estimates to distrust."""
-
-
-class NoisyPositionsWarning(UserWarning):
-    """The positions of :class:`prefriction.identify.ForceDisplacement` data turn far more often
-    than the motion reverses, and no ``x_noise`` or ``quantum`` was declared: the fit integrates
-    the model along the noise and its estimates are biased (``docs/identify.md#positions``)."""
 
 
 @dataclass(frozen=True)
@@ -106,21 +97,6 @@ class ResidualDiagnostics:
         lines.extend(f"STRUCTURE: {f}" for f in self.findings)
         lines.extend(f"DISTRUST {n}: {why}" for n, why in self.distrust)
         return "\n".join(lines)
-
-
-def reversal_indices(x: np.ndarray) -> np.ndarray:
-    """Sample indices where the motion ``x`` reverses by more than 1 % of its range.
-
-    Parameters
-    ----------
-    x : numpy.ndarray
-        Positions [m] (the estimated path of noisy data).
-    """
-    from prefriction.identify.positions import _reversals
-
-    span = float(np.max(x) - np.min(x))
-    rev = _reversals(np.asarray(x, dtype=float), 0.01 * span)
-    return np.asarray(rev[1:-1], dtype=int)
 
 
 def _runs(r: np.ndarray) -> tuple[int, float, float]:

@@ -9,12 +9,11 @@ import numpy as np
 
 from prefriction._validation import check_bool, check_count, check_positive
 from prefriction.identify.data import ForceDisplacement, ForceVelocity, Motion
-from prefriction.identify.diagnostics import NoisyPositionsWarning, ResidualWarning
 from prefriction.identify.parameters import ParameterSpace, name_list
 from prefriction.identify.result import FitResult
 from prefriction.identify.validation import model_name
-from prefriction.identify.statistics import (BoundWarning, ConvergenceWarning, IdentifiabilityWarning, at_bounds,
-                                             gauss_newton)
+from prefriction.identify.statistics import (BoundWarning, ConvergenceWarning, IdentifiabilityWarning,
+                                             NoisyPositionsWarning, ResidualWarning, at_bounds, gauss_newton)
 from prefriction.models.base import FrictionModel
 
 __all__ = ["fit"]

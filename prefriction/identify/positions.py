@@ -37,7 +37,7 @@ from scipy.ndimage import convolve1d
 from scipy.signal import savgol_coeffs, savgol_filter
 
 __all__ = ["denoise_path", "dwell_error_sd", "dwell_sets", "noise_sd", "smoothed_covariance_factor",
-           "noisy_positions_message", "turns"]
+           "noisy_positions_message", "reversal_indices", "turns"]
 
 POLYORDER = 3
 """Degree of the local polynomial (a cubic: exact on a parabola-shaped reversal)."""
@@ -235,6 +235,19 @@ def smoothed_covariance_factor(G: np.ndarray, window: int) -> np.ndarray:
     return convolve1d(G, c[::-1], axis=-1, mode="constant")
 
 
+def reversal_indices(x: np.ndarray) -> np.ndarray:
+    """Sample indices where the motion ``x`` reverses by more than 1 % of its range.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        Positions [m] (the estimated path of noisy data).
+    """
+    span = float(np.max(x) - np.min(x))
+    rev = _reversals(np.asarray(x, dtype=float), 0.01 * span)
+    return np.asarray(rev[1:-1], dtype=int)
+
+
 def turns(x: np.ndarray) -> int:
     """How often the direction of ``x`` turns (``dx`` changes sign, steps of zero skipped)."""
     dx = np.diff(x)
@@ -250,8 +263,6 @@ def noisy_positions_message(x: np.ndarray) -> str | None:
     differences (``median(|d2 x|) / 0.6745 / sqrt(6)``, robust to the motion's curvature when the
     sampling is fine), as values to declare.
     """
-    from prefriction.identify.diagnostics import reversal_indices
-
     n_turns, n_rev = turns(x), int(reversal_indices(x).size)
     if n_turns - n_rev < max(10, 2 * n_rev):
         return None

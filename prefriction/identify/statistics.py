@@ -39,8 +39,8 @@ import numpy as np
 from scipy.linalg import null_space
 from scipy.stats import t as student_t
 
-__all__ = ["BoundWarning", "ConvergenceWarning", "IdentifiabilityWarning", "Statistics", "at_bounds", "bandwidth",
-           "gauss_newton", "hac"]
+__all__ = ["BoundWarning", "ConvergenceWarning", "IdentifiabilityWarning", "NoisyPositionsWarning", "ResidualWarning",
+           "Statistics", "at_bounds", "bandwidth", "gauss_newton", "hac"]
 
 SINGULAR = 1e-12
 """Eigenvalue of the Jacobi-scaled ``N^T J^T J N`` (relative to the largest) below which a
@@ -303,3 +303,14 @@ def at_bounds(names: list[str], estimates: np.ndarray, low: np.ndarray, high: np
         lo_out[i], hi_out[i] = max(low[i], a), min(high[i], b)
         notes.append(note)
     return lo_out, hi_out, tuple(notes)
+
+
+class ResidualWarning(UserWarning):
+    """The residuals of a fit show structure the model does not explain (runs, correlation,
+    spikes at reversals); the message names the estimates to distrust."""
+
+
+class NoisyPositionsWarning(UserWarning):
+    """The positions of :class:`prefriction.identify.ForceDisplacement` data turn far more often
+    than the motion reverses, and no ``x_noise`` or ``quantum`` was declared: the fit integrates
+    the model along the noise and its estimates are biased (``docs/identify.md#positions``)."""
