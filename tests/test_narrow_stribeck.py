@@ -71,6 +71,19 @@ def test_unforced_reversals_within_tolerance(case, rtol: float) -> None:
     assert np.max(np.abs(tab.x - ref[:, 1])) <= 10 * rtol * np.max(np.abs(ref[:, 1]))
 
 
+@pytest.mark.parametrize("rtol", [1e-6, 1e-8, 1e-10])
+def test_dense_run_on_the_forced_driver_within_tolerance(case, rtol: float) -> None:
+    """The same runs with dense output (the native driver of forced and dense runs, forced.c,
+    bounds its steps near the curve as well)."""
+    p, m, v0, ref = case
+    res = pf.simulate(pf.Oscillator(pf.LuGre(*p), mass=m), v0, reversals=N_REV, rtol=rtol, dense=True)
+    tab = res.reversals
+    assert res.t is not None and res.stats.steps is not None  # dense samples, from the native driver
+    assert np.max(np.abs(tab.t / ref[:, 0] - 1.0)) <= 10 * rtol
+    assert np.max(np.abs(tab.F / ref[:, 2] - 1.0)) <= 10 * rtol
+    assert np.max(np.abs(tab.x - ref[:, 1])) <= 10 * rtol * np.max(np.abs(ref[:, 1]))
+
+
 def test_wide_curve_declares_its_scale_and_others_none() -> None:
     """The hook the driver reads: LuGre's normalised Stribeck velocity, none for Dahl."""
     model = pf.LuGre(1e5, 300.0, 0.4, 1.0, 1.5, 1e-3)

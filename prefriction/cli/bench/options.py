@@ -149,6 +149,10 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
     what.add_argument("--export", action="store_true",
                       help="instead: ns per step of the exported C code (prefriction.export) against friction_along "
                            "and FrictionStream, and the exported plant and loop; --repeats sets its passes (default 5)")
+    what.add_argument("--native", action="store_true",
+                      help="instead: every run kind of the native driver (unforced, forced, Samples, dense) against "
+                           "the plain-C and numba references written from the equations, at matched error, in the "
+                           "same run (docs/bench.md#native)")
     what.add_argument("--identify", action="store_true",
                       help="instead: success rate of Motion fits against the start distance (x1.25-x2, seeded, "
                            "per synthetic stage, time and peak memory), coverage of the 95 %% intervals, cost of "
