@@ -12,8 +12,8 @@ from prefriction.identify.data import ForceDisplacement, ForceVelocity, Motion
 from prefriction.identify.parameters import ParameterSpace, name_list
 from prefriction.identify.result import FitResult
 from prefriction.identify.validation import model_name
-from prefriction.identify.statistics import (BoundWarning, ConvergenceWarning, IdentifiabilityWarning, at_bounds,
-                                             gauss_newton)
+from prefriction.identify.statistics import (BoundWarning, ConvergenceWarning, IdentifiabilityWarning,
+                                             NoisyPositionsWarning, ResidualWarning, at_bounds, gauss_newton)
 from prefriction.models.base import FrictionModel
 
 __all__ = ["fit"]
@@ -125,6 +125,13 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
     ConvergenceWarning
         If the solver stops without converging (``max_iter``, or a Motion fit that cannot
         close the continuity of its segments); the result holds the last estimates.
+    NoisyPositionsWarning
+        For :class:`ForceDisplacement` data whose positions turn far more often than the motion
+        reverses, with neither ``x_noise`` nor ``quantum`` declared.
+    ResidualWarning
+        If the residuals show structure the model does not explain (runs with a lag-1
+        autocorrelation above 0.3, or spikes after the reversals); it names the estimates to
+        distrust (``FitResult.diagnostics``).
     IdentifiabilityWarning
         Naming every parameter the data cannot identify: a relative standard error above
         ``identifiability_limit`` (e.g. ``Fc`` from loops that never leave pre-sliding), or a
@@ -133,10 +140,12 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
 
     Notes
     -----
-    Standard errors are Gauss-Newton: ``s^2 (J^T J)^-1`` at the optimum with the residual
-    variance ``s^2 = |r|^2 / (n - p)``, nuisance variables (initial state, shooting nodes,
-    reversal times) marginalised; intervals are cut at the allowed range; see
-    ``docs/identify.md``.
+    Standard errors are the HAC (Newey-West) sandwich around the Gauss-Newton covariance
+    ``s^2 (J^T J)^-1`` (correlated residuals), never below it, nuisance variables (initial
+    state, shooting nodes, reversal times) marginalised; for :class:`ForceDisplacement` data with
+    declared ``x_noise`` or ``quantum`` the model follows the estimated true path and that path's
+    error is added (errors in variables); intervals are cut at the allowed range; see
+    ``docs/identify.md#statistics`` and ``#positions``.
 
     Examples
     --------
@@ -189,7 +198,11 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
     if offset0 is not None:
         raise ValueError(f"offset0 = {offset0!r} is for Motion data; a force-displacement offset starts at 0 "
                          f"(allowed: offset0=None)")
+    from prefriction.identify.positions import noisy_positions_message
     from prefriction.identify.structures import fit_structures, gamma_entry
+
+    if not data.noisy_positions and (why := noisy_positions_message(data.x)) is not None:
+        warnings.warn(why, NoisyPositionsWarning, stacklevel=2)
 
     scale = float(np.std(data.F)) if offset else None
 
@@ -214,7 +227,8 @@ def _fit_prescribed(model: FrictionModel, data: ForceDisplacement, free: Any, fi
     values = space.values(sol.w[:-1])
     est = np.array([values[n] for n in space.free])
     J, scale = space.physical_jacobian(sol.jacobian)
-    stats = gauss_newton(J, sol.residuals, space.free, est, scale, limit=limit)
+    stats = gauss_newton(J, sol.residuals, space.free, est, scale, limit=limit, covariance="hac",
+                         extra=sol.extra_covariance)
     nuisance = {"initial force F0 [N]": float(sol.prediction[0])}
     return _finish(space, values, est, stats, -sol.residuals, sol.prediction, data, None, nuisance, sol.message,
                    sol.success, level=6)
@@ -248,7 +262,8 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
     values = space.values(sol.w[: space.n_free])
     est = np.array([values[n] for n in space.free])
     J, scale = space.physical_jacobian(sol.jacobian)
-    stats = gauss_newton(J, sol.residuals, space.free, est, scale, constraints=sol.constraints, limit=limit)
+    stats = gauss_newton(J, sol.residuals, space.free, est, scale, constraints=sol.constraints, limit=limit,
+                         covariance="hac")
     mass = values["mass"] if data.mass is None else data.mass
     return _finish(space, values, est, stats, -sol.residuals, sol.prediction, data, mass, sol.nuisance, sol.message,
                    sol.success, start=start.steps + sol.steps)
@@ -273,6 +288,23 @@ def _finish(space: ParameterSpace, values: dict, est: np.ndarray, stats: Any, re
         warnings.warn(f"the fit of {model_name(fitted_model)} did not converge: {message}; the estimates are where "
                       f"the solver stopped (raise max_iter, or give better start values)", ConvergenceWarning,
                       stacklevel=level)
-    return FitResult(fitted_model, mass, tuple(space.free), tuple(space.units[n] for n in space.free), est,
-                     stats.stderr, low, high, stats.correlation, residuals, fitted, data, stats,
-                     nuisance, message, success=success, flags=flags, start=start)
+    res = FitResult(fitted_model, mass, tuple(space.free), tuple(space.units[n] for n in space.free), est,
+                    stats.stderr, low, high, stats.correlation, residuals, fitted, data, stats,
+                    nuisance, message, success=success, flags=flags, start=start)
+    _warn_structure(res, level)
+    return res
+
+
+def _warn_structure(res: FitResult, level: int) -> None:
+    """A :class:`ResidualWarning` if the residuals show structure (``docs/identify.md#diagnostics``)."""
+    diag = res.diagnostics
+    if not diag.structured:
+        return
+    who = "; ".join(f"{n} ({why})" for n, why in diag.distrust) if diag.distrust else \
+        "no single estimate stands out, every one may be biased"
+    noise = ", declare the position noise (x_noise, quantum)" if isinstance(res.data, ForceDisplacement) and \
+        not res.data.noisy_positions else ""
+    warnings.warn(f"the residuals of the {model_name(res.model)} fit show structure the model does not explain: "
+                  f"{'; '.join(diag.findings)}. Distrust: {who}. Try another model or structure, free the "
+                  f"parameters held{noise}, and look at res.plot_residuals() (docs/identify.md#diagnostics)",
+                  ResidualWarning, stacklevel=level + 1)

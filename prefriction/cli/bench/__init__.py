@@ -89,6 +89,10 @@ def main(argv: Optional[list[str]] = None) -> int:
         text = export_bench.run(args.repeats or 5)
         print(text)
         return 0 if text.rstrip().endswith("PASS") else 1
+    if args.native:
+        from prefriction.cli.bench import native_rows
+
+        return native_rows.main(args.quick)
     if args.identify:
         from prefriction.cli.bench import identify
 

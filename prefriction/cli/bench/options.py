@@ -38,7 +38,7 @@ examples:
   prefriction bench --compensation   PID alone against PID with each friction compensator
                                      (writes compensation_*.png to --out)
   prefriction bench --export         exported C code: ns per step against friction_along
-  prefriction bench --identify       Motion fit time and memory against the record length"""
+  prefriction bench --identify       fit success rate, interval coverage, time and memory"""
 
 
 def repeats(text: str) -> int:
@@ -149,9 +149,15 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
     what.add_argument("--export", action="store_true",
                       help="instead: ns per step of the exported C code (prefriction.export) against friction_along "
                            "and FrictionStream, and the exported plant and loop; --repeats sets its passes (default 5)")
+    what.add_argument("--native", action="store_true",
+                      help="instead: every run kind of the native driver (unforced, forced, Samples, dense) against "
+                           "the plain-C and numba references written from the equations, at matched error, in the "
+                           "same run (docs/bench.md#native)")
     what.add_argument("--identify", action="store_true",
-                      help="instead: time and peak memory of a closed-loop Motion fit against the number of "
-                           "samples (1e3, 5e3, 2.5e4; --quick: 500, 1000, 2000), each in a fresh process")
+                      help="instead: success rate of Motion fits against the start distance (x1.25-x2, seeded, "
+                           "per synthetic stage, time and peak memory), coverage of the 95 %% intervals, cost of "
+                           "force-displacement fits against the samples, and time and peak memory of a closed-loop "
+                           "Motion fit against the samples (1e3, 5e3, 2.5e4; --quick: fewer fits, 500-2000 samples)")
     args = ap.parse_args(argv)
     if args.compensation and (args.quick or args.repeats is not None):
         ap.error("--quick and --repeats do not apply to --compensation")
