@@ -148,8 +148,9 @@ def test_gms_tribometer_fit_returns_a_valid_model():
 
 @pytest.mark.slow
 def test_success_rate_over_the_stages():
-    """Issue 25's target on every stage (one start each within a factor 2, 1,000 samples): the
-    fits land within 5 % of every true parameter. The full table:
-    ``python -m prefriction.identify._success``."""
-    rows = success_table(STAGES, (2.0,), fits=1, samples=1000, seed=0)
+    """Issue 25's target on the stages whose fits take under a minute (Dahl open loop, the
+    EMPS-like LuGre closed loop, LuGre open loop; one start each within a factor 2, 1,000
+    samples): the fits land within 5 % of every true parameter. Every stage, 10 starts per
+    distance: ``python -m prefriction.identify._success``."""
+    rows = success_table((STAGES[0], STAGES[3], STAGES[4]), (2.0,), fits=1, samples=1000, seed=0)
     assert all(r.successes == r.fits for r in rows), table_text(rows)
