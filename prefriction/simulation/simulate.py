@@ -44,12 +44,11 @@ from prefriction.simulation.rest import initial_direction
 from prefriction.simulation.native.forced import linear_pieces, run_forced
 from prefriction.simulation.run import N_DENSE, Run
 from prefriction.simulation.plant import Layout, PlantSpec
-from prefriction.simulation.force_scale import applied_force_scale
+from prefriction.simulation.force_scale import MAX_AMPLITUDE, MIN_AMPLITUDE, applied_force_scale, check_amplitude
 from prefriction.simulation.budget import check_input_budget
 from prefriction._validation import check_count, check_finite, check_positive
 from prefriction.models import Oscillator, check_oscillator
-from prefriction.reversals import ReversalTable
-from prefriction.simulation.lazy_table import LazyReversalTable
+from prefriction.simulation.lazy_table import reversal_table
 from prefriction.simulation.result import RunStats, SimulationResult
 from prefriction.units import Scales
 
@@ -63,12 +62,6 @@ and ``"erk"`` (CasADi's integrator, the reference the native driver is tested ag
 _K = 2  # reversals recorded per integrator call (register length; forced or dense runs)
 _MIN_ORDER = 2  # continuous controllers are padded to this order (one plant for P, PD, PID)
 _ZERO = Constant(0.0)  # the input of a sampled loop without an input force (the hold is added)
-MIN_AMPLITUDE = 1e-150
-"""Least nonzero amplitude of the motion (normalised units) that :func:`simulate` accepts: the
-energies, ``A^2``, and the scaled states stay normal doubles."""
-MAX_AMPLITUDE = 1e100
-"""Largest amplitude of the motion (normalised units) that :func:`simulate` accepts: energies
-``A^2`` and first excursions ``~A^2 / 2`` stay far from the double-precision range."""
 MAX_REVERSALS = 10**7
 """Most reversals of one :func:`simulate` call, requested or reached by ``t_end`` (the run holds
 its table in memory: about 100 bytes per reversal at the peak, so about 1 GB;
@@ -225,7 +218,7 @@ def simulate(
         method="erk", compact=True,
     )
     force_scale = applied_force_scale(system, feedback, x0, t_end_si) / Fc if forced else 0.0
-    _check_amplitude(v0, F0, force_scale, sc)
+    check_amplitude(v0, F0, force_scale, sc)
     L = Layout(spec)
     # error control on states scaled by amplitude * eps (the plant's run-time tolerance)
     eps = min(rtol, atol) * _CAL * math.sqrt(L.n_active / L.nx)
@@ -273,7 +266,7 @@ def simulate(
     wall = time.perf_counter() - start
 
     n_rev = int(min(len(run.rev), n_target))
-    table, W_r = _reversal_table(run.rev.columns(n_rev, writable=True), system, s0, v0, F0, run.sc)
+    table, W_r = reversal_table(run.rev.columns(n_rev, writable=True), system, s0, v0, F0, run.sc)
     events = np.array(run.rev_events[:n_rev], dtype=int)
     # after the last reversal: the events up to t_end (a run stopped at its reversal has none)
     total = int(events.sum()) + (int(run.st.get("ne", 0)) if len(run.rev) <= n_rev else 0)
@@ -284,25 +277,6 @@ def simulate(
                             events=events, **extra)
 
 
-def _check_amplitude(v0: float, F0: float, force_scale: float, sc: Scales) -> None:
-    """``ValueError`` if the motion is nonzero but smaller than :data:`MIN_AMPLITUDE` (normalised
-    initial velocity ``v0`` [m/s], force ``F0`` [N] and applied force scale): its scaled states, energies and steps
-    would leave the double-precision range (a denormal ``v0 = 5e-324`` m/s gave reversal times
-    12 % wrong, ``1e-300`` m/s a failed integrator); or larger than :data:`MAX_AMPLITUDE`."""
-    if abs(v0 / sc.v) > MAX_AMPLITUDE:
-        raise ValueError(f"v0 must satisfy |v0| <= {MAX_AMPLITUDE * sc.v:.3g} m/s ({MAX_AMPLITUDE:g} velocity units "
-                         f"Fc/sqrt(m sigma): energies stay in the double-precision range), got {v0!r}")
-    if force_scale > MAX_AMPLITUDE:
-        raise ValueError(f"the applied force (input u and feedback) must stay below {MAX_AMPLITUDE * sc.F:.3g} N "
-                         f"({MAX_AMPLITUDE:g} Fc), got a force scale of {force_scale * sc.F:.3g} N")
-    amplitude = max(math.hypot(v0 / sc.v, F0 / sc.F), force_scale)
-    if 0.0 < amplitude < MIN_AMPLITUDE:
-        raise ValueError(
-            f"v0 = {v0!r} m/s and F0 = {F0!r} N (with the applied force) give a motion of "
-            f"{amplitude:.3g} normalised units, too small to simulate in double precision: the amplitude "
-            f"hypot(v0 / (Fc/sqrt(m sigma)), F0 / Fc) must be 0 or >= {MIN_AMPLITUDE:g}, that is "
-            f"|v0| >= {MIN_AMPLITUDE * sc.v:.3g} m/s or |F0| >= {MIN_AMPLITUDE * sc.F:.3g} N"
-        )
 
 
 def _sample_times(breaks: np.ndarray) -> np.ndarray:
@@ -415,23 +389,6 @@ def _sampled_loop(run: Run, xc0: np.ndarray, t_end: float, n_target: float) -> t
     return samples, u_hist
 
 
-def _reversal_table(rev: Union[list, tuple], system: Oscillator, s0: float, v0: float, F0: float,
-                    sc: Optional[Scales] = None) -> tuple[ReversalTable, np.ndarray]:
-    """The reversals as a :class:`ReversalTable` in SI (its energies ``E_p`` (3.9), ``E_d``
-    (2.10), ``E_0`` computed on first use: :class:`~prefriction.simulation.lazy_table.LazyReversalTable`),
-    and the input's work over each half-cycle [J].
-
-    ``rev``: a list of ``(t~, x~, F~, W~)`` tuples, or the four columns
-    (:meth:`~prefriction.simulation.reversal_log.ReversalLog.columns`; writable columns are
-    converted to SI in place, so that a long run holds them once); ``sc``: the system's scales,
-    if known."""
-    sc = Scales.of(system) if sc is None else sc
-    if isinstance(rev, list):
-        R = np.array(rev, dtype=float).reshape(-1, 4)
-        rev = (R[:, 0], R[:, 1], R[:, 2], R[:, 3])
-    t_r, x_r, F_r, W_r = (np.multiply(col, unit, out=col if col.flags.writeable else None)
-                          for col, unit in zip(rev, (sc.t, sc.x, sc.F, sc.E)))
-    return LazyReversalTable(t_r, x_r, F_r, W_r, system, s0, v0, F0), W_r
 
 
 def _padded(fb: LinearFeedback, order: int) -> LinearFeedback:
