@@ -13,6 +13,7 @@ from typing import Optional
 import numpy as np
 
 from prefriction.simulation.compact import advance_compact
+from prefriction.simulation.dense import SampleBuffer
 from prefriction.simulation.integrator import INTEGRATOR_FAILED, BufferedIntegrator, integrator
 from prefriction.simulation.feedback import LinearFeedback
 from prefriction.simulation.native.advance import advance_native
@@ -26,7 +27,6 @@ from prefriction.errors import SolverError
 from prefriction.models import Oscillator
 from prefriction.units import Scales
 
-N_DENSE = 16  # output times per call of the dense-output integrator
 _DIED_OUT = 1e-20  # normalised speed below which an unforced motion has died out (no reversal comes)
 _MIN_CALL = 1e-9  # relative length of a call below which a failed call is not made shorter (Run._shorten)
 
@@ -34,23 +34,23 @@ _MIN_CALL = 1e-9  # relative length of a call below which a failed call is not m
 class Run(StateIO, Rest):
     """The integration loop of one :func:`prefriction.simulate` call (normalised units inside).
 
-    ``simulate`` sets the initial state ``st``, the run constants (``snap``, ``force_scale``,
-    ``breaks``, signal kinds, ``P0``) and then drives :meth:`advance` (or
+    ``simulate`` sets the initial state ``st``, the run constants (``eps`` from the plant's
+    layout ``L``, ``snap``, ``force_scale``, ``breaks``, signal kinds, ``P0``) and then drives :meth:`advance` (or
     :func:`prefriction.simulation.dense.dense`) and :meth:`sample`; the reversals found are in
     ``rev``. Packing of the call buffers: :class:`~prefriction.simulation.state_io.StateIO`;
     rests between calls: :class:`~prefriction.simulation.rest.Rest`.
     """
 
     def __init__(self, system: Oscillator, spec: PlantSpec, fb: Optional[LinearFeedback],
-                 eps: float, jit: bool, native: bool = True, sc: Optional[Scales] = None,
-                 L: Optional[Layout] = None) -> None:
+                 eps: float, jit: bool, native: bool = True,
+                 sc: Optional[Scales] = None) -> None:
         self.system, self.spec, self.fb = system, spec, fb
         self.sc = Scales.of(system) if sc is None else sc  # (simulate has them already)
         self.model = system.friction
         self.q = self.model.runtime_params_for(self.sc)  # may depend on the mass (units)
         self.eps = eps  # run-time tolerance: states are scaled by amplitude * eps
         self.eps_native = eps  # the same for the native drivers' norm over the active states (simulate sets it)
-        self.L = Layout(spec) if L is None else L  # the same for any number of outputs per call
+        self.L = Layout(spec)  # the same for any number of outputs per call
         # a sampled controller on a plant without a hold control: its force joins the input piece
         self.hold_in_piece = fb is not None and fb.sampled and spec.fb == "none"
         # one plant: a dense run makes its single-output calls on the dense plant, padded
@@ -257,3 +257,31 @@ class Run(StateIO, Rest):
         """Current state as a sample (t~, x~, v~, F~, E_f~, xc)."""
         st = self.st
         return (st["t"], st["x"], st["v"], st["F"], st["Ef"], np.array(st["xc"], dtype=float))
+
+
+def sampled_loop(run: Run, xc0: np.ndarray, t_end: float, n_target: float) -> tuple[SampleBuffer, list]:
+    """Closed loop with a sampled controller: hold its output over each period ``Ts`` up to the
+    normalised time ``t_end`` or ``n_target`` reversals; returns the samples at ``k Ts`` and the
+    total applied force there [N]."""
+    system, feedback, sc = run.system, run.fb, run.sc
+    samples = SampleBuffer(len(xc0))
+    u_hist: list = []
+    Ts = feedback.Ts / sc.t
+    xc = xc0.copy()
+    k = 0
+    while True:
+        tk = min(k * Ts, t_end)
+        t_si = tk * sc.t
+        e = float(feedback.reference(t_si)) - run.st["x"] * sc.x
+        uk = float(feedback.C[0] @ xc + feedback.D[0, 0] * e)
+        run.st["uhold"] = uk
+        run.st["xc"] = xc.copy()
+        samples.append(run.sample())
+        u_hist.append(uk + (float(system.u(t_si)) if system.forced else 0.0))
+        if tk >= t_end * (1 - 1e-12):
+            break
+        xc = feedback.A @ xc + feedback.B[:, 0] * e
+        if run.advance(min((k + 1) * Ts, t_end), n_target):
+            break
+        k += 1
+    return samples, u_hist

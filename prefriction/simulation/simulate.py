@@ -39,11 +39,11 @@ import numpy as np
 
 from prefriction.signals import Constant, compiled_form
 from prefriction.simulation.feedback import LinearFeedback
-from prefriction.simulation.dense import SampleBuffer, dense_loop, samples_si
+from prefriction.simulation.dense import N_DENSE, SampleBuffer, dense_loop, samples_si
 from prefriction.simulation.rest import initial_direction
 from prefriction.simulation.native.forced import linear_pieces, run_forced
-from prefriction.simulation.run import N_DENSE, Run
-from prefriction.simulation.plant import Layout, PlantSpec
+from prefriction.simulation.run import Run, sampled_loop
+from prefriction.simulation.plant import PlantSpec
 from prefriction.simulation.force_scale import MAX_AMPLITUDE, MIN_AMPLITUDE, applied_force_scale, check_amplitude
 from prefriction.simulation.budget import check_input_budget
 from prefriction._validation import check_count, check_finite, check_positive
@@ -219,10 +219,9 @@ def simulate(
     )
     force_scale = applied_force_scale(system, feedback, x0, t_end_si) / Fc if forced else 0.0
     check_amplitude(v0, F0, force_scale, sc)
-    L = Layout(spec)
+    run = Run(system, spec, feedback, 0.0, jit, native=method == "native", sc=sc)
     # error control on states scaled by amplitude * eps (the plant's run-time tolerance)
-    eps = min(rtol, atol) * _CAL * math.sqrt(L.n_active / L.nx)
-    run = Run(system, spec, feedback, eps, jit, native=method == "native", sc=sc, L=L)
+    run.eps = min(rtol, atol) * _CAL * math.sqrt(run.L.n_active / run.L.nx)
     run.eps_native = min(rtol, atol) * _CAL  # the native drivers' RMS norm runs over the active states only
     run.snap = rtol
     run.P0 = run._constant_params(run.L)
@@ -246,7 +245,7 @@ def simulate(
         run_forced(run, t_end_n, n_target, None if times_si is None else times_si / sc.t,
                    samples if want_dense else None)
     elif fb_kind == "sampled":
-        samples, u_hist = _sampled_loop(run, xc0, t_end_n, n_target)
+        samples, u_hist = sampled_loop(run, xc0, t_end_n, n_target)
     elif want_dense:
         samples = dense_loop(run, None if times_si is None else times_si / sc.t, t_end_n, n_target)
     else:
@@ -359,34 +358,6 @@ def _initial_state(run: Run, x0: float, v0: float, F0: float, xc0: np.ndarray, *
     if run.L.potential:  # the branch's mechanical energy v^2 / 2 + potential - W (speed at events)
         st["Eb"] = 0.5 * st["v"] ** 2 + float(model.branch_potential(st["z"], st["m"], s0, run.q))
     return st, s0
-
-
-def _sampled_loop(run: Run, xc0: np.ndarray, t_end: float, n_target: float) -> tuple[SampleBuffer, list]:
-    """Closed loop with a sampled controller: hold its output over each period ``Ts`` up to the
-    normalised time ``t_end`` or ``n_target`` reversals; returns the samples at ``k Ts`` and the
-    total applied force there [N]."""
-    system, feedback, sc = run.system, run.fb, run.sc
-    samples = SampleBuffer(len(xc0))
-    u_hist: list = []
-    Ts = feedback.Ts / sc.t
-    xc = xc0.copy()
-    k = 0
-    while True:
-        tk = min(k * Ts, t_end)
-        t_si = tk * sc.t
-        e = float(feedback.reference(t_si)) - run.st["x"] * sc.x
-        uk = float(feedback.C[0] @ xc + feedback.D[0, 0] * e)
-        run.st["uhold"] = uk
-        run.st["xc"] = xc.copy()
-        samples.append(run.sample())
-        u_hist.append(uk + (float(system.u(t_si)) if system.forced else 0.0))
-        if tk >= t_end * (1 - 1e-12):
-            break
-        xc = feedback.A @ xc + feedback.B[:, 0] * e
-        if run.advance(min((k + 1) * Ts, t_end), n_target):
-            break
-        k += 1
-    return samples, u_hist
 
 
 
