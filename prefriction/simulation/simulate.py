@@ -23,8 +23,10 @@ factor such that the error of reversal times, positions and forces over 50 rever
 below ``rtol`` (``prefriction bench``); global errors grow linearly with the number of cycles,
 as for any one-step method.
 
-This module validates the arguments and assembles the result; the integration loop is
-:mod:`prefriction.simulation.run`, the compiled integrator and its buffers
+This module validates the arguments, builds the run and assembles the result: the run (the
+choice of driver and the integration loop, :func:`~prefriction.simulation.run.drive`) is
+:mod:`prefriction.simulation.run`, the reversal table
+:mod:`prefriction.simulation.lazy_table`, the compiled integrator and its buffers
 :mod:`prefriction.simulation.integrator`, the force scale of forced runs
 :mod:`prefriction.simulation.force_scale`.
 """
@@ -39,10 +41,9 @@ import numpy as np
 
 from prefriction.signals import Constant, compiled_form
 from prefriction.simulation.feedback import LinearFeedback
-from prefriction.simulation.dense import N_DENSE, SampleBuffer, dense_loop, samples_si
+from prefriction.simulation.dense import N_DENSE, samples_si
 from prefriction.simulation.rest import initial_direction
-from prefriction.simulation.native.forced import linear_pieces, run_forced
-from prefriction.simulation.run import Run, sampled_loop
+from prefriction.simulation.run import RAMP_ROUNDOFF, Run, check_ramps, drive
 from prefriction.simulation.plant import PlantSpec
 from prefriction.simulation.force_scale import MAX_AMPLITUDE, MIN_AMPLITUDE, applied_force_scale, check_amplitude
 from prefriction.simulation.budget import check_input_budget
@@ -66,10 +67,6 @@ MAX_REVERSALS = 10**7
 """Most reversals of one :func:`simulate` call, requested or reached by ``t_end`` (the run holds
 its table in memory: about 100 bytes per reversal at the peak, so about 1 GB;
 ``docs/simulator.md#limits``)."""
-RAMP_ROUNDOFF = 0.3
-"""Largest force error from the round-off of the time in a ramp of the input force, in units of
-the run's error level ``eps`` times the force scale (:func:`simulate` refuses steeper ramps:
-they started spurious reversal pairs at a rest, or NaN in CasADi's event transition)."""
 MAX_PERIODS = 10**7
 """Most sample periods ``t_end / Ts`` of a sampled controller (one Python step and one sample each)."""
 _CAL = 0.1  # calibration of the run-time tolerance eps: global error over 50 reversals ~ 0.7 rtol
@@ -236,21 +233,10 @@ def simulate(
         breaks.append(np.asarray(feedback.reference.breaks()) / sc.t)
     t_end_n = t_end_si / sc.t
     run.breaks = _sample_times(np.unique(np.concatenate(breaks)) if breaks else np.zeros(0))
-    _check_ramps(run, t_end_n, rtol)
+    check_ramps(run, t_end_n, rtol)
 
     start = time.perf_counter()
-    u_hist: list = []
-    if run.native_forced is not None:
-        samples = SampleBuffer(0, len(times_si) if times_si is not None else 1024) if want_dense else []
-        run_forced(run, t_end_n, n_target, None if times_si is None else times_si / sc.t,
-                   samples if want_dense else None)
-    elif fb_kind == "sampled":
-        samples, u_hist = sampled_loop(run, xc0, t_end_n, n_target)
-    elif want_dense:
-        samples = dense_loop(run, None if times_si is None else times_si / sc.t, t_end_n, n_target)
-    else:
-        samples = []
-        run.advance(t_end_n, n_target)
+    samples, u_hist = drive(run, t_end_n, n_target, None if times_si is None else times_si / sc.t, want_dense, xc0)
     if reversals is None and len(run.rev) >= n_target:
         raise ValueError(
             f"t_end = {t_end_si:.6g} s needs more than {MAX_REVERSALS:_} reversals (the reversal table is held in "
@@ -287,36 +273,6 @@ def _sample_times(breaks: np.ndarray) -> np.ndarray:
     return b[keep]
 
 
-def _check_ramps(run: Run, t_end: float, rtol: float) -> None:
-    """ValueError if a piece of a piecewise-linear input force is so steep that the round-off of
-    its time makes a force error above :data:`RAMP_ROUNDOFF` of the run's error level.
-
-    The plant evaluates a piece as ``a + b (t - t_k)`` from the normalised time ``t``, which
-    carries a round-off of about ``2^-53 t``; a slope ``b`` turns it into a force error
-    ``2^-53 |b| t``. Near a rest the net force is compared with the error level ``eps`` times the
-    force scale (:data:`prefriction.simulation.plant.EPS_REST`): a larger error started the mass
-    backwards (a spurious reversal pair), or made CasADi's event transition return NaN.
-    """
-    sig, sc = run.spec.u_sig, run.sc
-    if sig is None or sig.key != ("PiecewiseLinear",):
-        return
-    level = run.eps * max(run.force_scale, 1e-300)  # error level of the net force (normalised)
-    t = np.concatenate(([0.0], run.breaks[run.breaks < t_end], [t_end]))
-    _, slopes = linear_pieces(sig, t[:-1] * sc.t, t[1:] * sc.t)  # vectorised: one pass over the pieces
-    slopes = np.abs(slopes) * (sc.t / sc.F)  # normalised
-    errs = slopes * t[1:] * 2.0 ** -53
-    for k in np.flatnonzero(errs > RAMP_ROUNDOFF * level)[:1]:
-        ta, tb, slope, err = float(t[k]), float(t[k + 1]), float(slopes[k]), float(errs[k])
-        if err > RAMP_ROUNDOFF * level:
-            rise = abs(slope) * (tb - ta) * sc.F
-            shortest = rise / sc.F * tb * 2.0 ** -53 / (RAMP_ROUNDOFF * level) * sc.t
-            raise ValueError(
-                f"system.u ramps by {rise:.3g} N over {(tb - ta) * sc.t:.3g} s (from t = {ta * sc.t:.12g} s): at rtol = "
-                f"{rtol:g} that is too steep to simulate, because the round-off of the time there (2^-53 t) makes a "
-                f"force error of {err * sc.F:.3g} N, more than RAMP_ROUNDOFF = {RAMP_ROUNDOFF:g} times the error "
-                f"level of the net force ({level * sc.F:.3g} N) at which a resting mass starts to move. Spread the "
-                f"ramp over at least {shortest:.3g} s, loosen rtol, or drop one of its two samples (a jump)"
-            )
 
 
 def _dense_times(dense: Any, t_end: float) -> np.ndarray:
