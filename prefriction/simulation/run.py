@@ -16,11 +16,11 @@ import numpy as np
 
 from prefriction.simulation.compact import advance_compact
 from prefriction.simulation.dense import SampleBuffer, dense_loop
-from prefriction.simulation.integrator import INTEGRATOR_FAILED, BufferedIntegrator, integrator
+from prefriction.simulation.build import BuiltPlant
+from prefriction.simulation.integrator import INTEGRATOR_FAILED, BufferedIntegrator
 from prefriction.simulation.feedback import LinearFeedback
 from prefriction.simulation.native.advance import advance_native
-from prefriction.simulation.native.forced import forced_driver, linear_pieces, run_forced
-from prefriction.simulation.native.library import native_driver
+from prefriction.simulation.native.forced import linear_pieces, run_forced
 from prefriction.simulation.plant import Layout, PlantSpec
 from prefriction.simulation.rest import Rest
 from prefriction.simulation.reversal_log import ReversalLog
@@ -32,48 +32,36 @@ from prefriction.units import Scales
 _DIED_OUT = 1e-20  # normalised speed below which an unforced motion has died out (no reversal comes)
 RAMP_ROUNDOFF = 0.3
 """Largest force error from the round-off of the time in a ramp of the input force, in units of
-the run's error level ``eps`` times the force scale (:func:`prefriction.simulate` refuses steeper ramps:
-they started spurious reversal pairs at a rest, or NaN in CasADi's event transition)."""
+the run's error level ``eps`` times the force scale (:func:`prefriction.simulate` refuses
+steeper ramps: they started spurious reversal pairs at a rest, or NaN in CasADi's event
+transition)."""
 _MIN_CALL = 1e-9  # relative length of a call below which a failed call is not made shorter (Run._shorten)
 
 
 class Run(StateIO, Rest):
     """The integration loop of one :func:`prefriction.simulate` call (normalised units inside).
 
-    ``simulate`` sets the initial state ``st``, the run constants (``eps`` from the plant's
-    layout ``L``, ``snap``, ``force_scale``, ``breaks``, signal kinds, ``P0``) and then drives :meth:`advance` (or
-    :func:`prefriction.simulation.dense.dense`) and :meth:`sample`; the reversals found are in
-    ``rev``. Packing of the call buffers: :class:`~prefriction.simulation.state_io.StateIO`;
-    rests between calls: :class:`~prefriction.simulation.rest.Rest`.
+    ``simulate`` builds the ``plant`` (:func:`~prefriction.simulation.build.build_plant`), sets
+    the initial state ``st``, the run constants (``snap``,
+    ``force_scale``, ``breaks``, signal kinds, ``P0``) and then :func:`drive` runs it through
+    :meth:`advance` (or :func:`prefriction.simulation.dense.dense`) and :meth:`sample`; the
+    reversals found are in ``rev``. Packing of the call buffers:
+    :class:`~prefriction.simulation.state_io.StateIO`; rests between calls:
+    :class:`~prefriction.simulation.rest.Rest`.
     """
 
     def __init__(self, system: Oscillator, spec: PlantSpec, fb: Optional[LinearFeedback],
-                 eps: float, jit: bool, native: bool = True,
-                 sc: Optional[Scales] = None) -> None:
+                 eps: float, plant: BuiltPlant, sc: Optional[Scales] = None) -> None:
         self.system, self.spec, self.fb = system, spec, fb
         self.sc = Scales.of(system) if sc is None else sc  # (simulate has them already)
         self.model = system.friction
         self.q = self.model.runtime_params_for(self.sc)  # may depend on the mass (units)
         self.eps = eps  # run-time tolerance: states are scaled by amplitude * eps
         self.eps_native = eps  # the same for the native drivers' norm over the active states (simulate sets it)
-        self.L = Layout(spec)  # the same for any number of outputs per call
         # a sampled controller on a plant without a hold control: its force joins the input piece
         self.hold_in_piece = fb is not None and fb.sampled and spec.fb == "none"
-        # one plant: a dense run makes its single-output calls on the dense plant, padded
-        # the compact unforced model runs on the native driver where it exists (docs/simulator.md#native)
-        # forced and dense open-loop runs on the forced native driver (native/forced.py)
-        self.native, setup = native_driver(self.model) if spec.stops_at_reversal and jit and native else (None, 0.0)
-        self.native_forced = None
-        if native and jit and fb is None and not spec.stops_at_reversal:
-            self.native_forced, setup = forced_driver(self.model, spec.u_sig)
-        if self.native_forced is not None:
-            self.f1, self.setup_time = None, setup
-            self.mode = self.native_forced.info.mode if setup else "cached"
-        elif self.native is not None:
-            self.f1, self.setup_time = None, setup
-            self.mode = self.native.info.mode if setup else "cached"
-        else:
-            self.f1, self.setup_time, self.mode = integrator(spec, jit)
+        self.L, self.f1, self.native, self.native_forced = plant.L, plant.f1, plant.native, plant.native_forced
+        self.setup_time, self.mode = plant.setup_time, plant.mode
         self.calls = 0
         self.steps: Optional[int] = 0
         self.max_chunk = math.inf  # longest next call of advance (finite after a failed call)

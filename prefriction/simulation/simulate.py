@@ -23,9 +23,9 @@ factor such that the error of reversal times, positions and forces over 50 rever
 below ``rtol`` (``prefriction bench``); global errors grow linearly with the number of cycles,
 as for any one-step method.
 
-This module validates the arguments, builds the run and assembles the result: the run (the
-choice of driver and the integration loop, :func:`~prefriction.simulation.run.drive`) is
-:mod:`prefriction.simulation.run`, the reversal table
+This module validates the arguments and assembles the result: the plant (its layout and
+driver) is built in :mod:`prefriction.simulation.build`, run by
+:func:`~prefriction.simulation.run.drive` in :mod:`prefriction.simulation.run`, the reversal table
 :mod:`prefriction.simulation.lazy_table`, the compiled integrator and its buffers
 :mod:`prefriction.simulation.integrator`, the force scale of forced runs
 :mod:`prefriction.simulation.force_scale`.
@@ -47,6 +47,7 @@ from prefriction.simulation.run import RAMP_ROUNDOFF, Run, check_ramps, drive
 from prefriction.simulation.plant import PlantSpec
 from prefriction.simulation.force_scale import MAX_AMPLITUDE, MIN_AMPLITUDE, applied_force_scale, check_amplitude
 from prefriction.simulation.budget import check_input_budget
+from prefriction.simulation.build import build_plant
 from prefriction._validation import check_count, check_finite, check_positive
 from prefriction.models import Oscillator, check_oscillator
 from prefriction.simulation.lazy_table import reversal_table
@@ -216,9 +217,17 @@ def simulate(
     )
     force_scale = applied_force_scale(system, feedback, x0, t_end_si) / Fc if forced else 0.0
     check_amplitude(v0, F0, force_scale, sc)
-    run = Run(system, spec, feedback, 0.0, jit, native=method == "native", sc=sc)
+    breaks = []
+    if system.forced:
+        breaks.append(np.asarray(system.u.breaks()) / sc.t)
+    if fb_kind == "continuous":
+        breaks.append(np.asarray(feedback.reference.breaks()) / sc.t)
+    breaks = _sample_times(np.unique(np.concatenate(breaks)) if breaks else np.zeros(0))
+    t_end_n = t_end_si / sc.t
+    plant = build_plant(system.friction, spec, feedback, jit, native=method == "native")
     # error control on states scaled by amplitude * eps (the plant's run-time tolerance)
-    run.eps = min(rtol, atol) * _CAL * math.sqrt(run.L.n_active / run.L.nx)
+    eps = min(rtol, atol) * _CAL * math.sqrt(plant.L.n_active / plant.L.nx)
+    run = Run(system, spec, feedback, eps, plant, sc=sc)
     run.eps_native = min(rtol, atol) * _CAL  # the native drivers' RMS norm runs over the active states only
     run.snap = rtol
     run.P0 = run._constant_params(run.L)
@@ -226,13 +235,7 @@ def simulate(
 
     xc0 = np.array(feedback.xc0, dtype=float) if feedback is not None else np.zeros(0)
     run.st, s0 = _initial_state(run, x0, v0, F0, xc0, stops=forced or t_end is not None)
-    breaks = []
-    if system.forced:
-        breaks.append(np.asarray(system.u.breaks()) / sc.t)
-    if fb_kind == "continuous":
-        breaks.append(np.asarray(feedback.reference.breaks()) / sc.t)
-    t_end_n = t_end_si / sc.t
-    run.breaks = _sample_times(np.unique(np.concatenate(breaks)) if breaks else np.zeros(0))
+    run.breaks = breaks
     check_ramps(run, t_end_n, rtol)
 
     start = time.perf_counter()
