@@ -33,8 +33,8 @@ def andrews_lag(r: np.ndarray) -> int:
     return int(min(np.floor(1.1447 * (alpha * n) ** (1.0 / 3.0)), n // 4))
 
 
-def sandwich(J: np.ndarray, r: np.ndarray, stats: Statistics, estimates: np.ndarray, scale: np.ndarray
-             ) -> tuple[Statistics, int]:
+def sandwich(J: np.ndarray, r: np.ndarray, stats: Statistics, estimates: np.ndarray, scale: np.ndarray,
+             channels: int = 1) -> tuple[Statistics, int]:
     """``stats`` with standard errors and 95 % intervals from the sandwich (1).
 
     Parameters
@@ -48,6 +48,9 @@ def sandwich(J: np.ndarray, r: np.ndarray, stats: Statistics, estimates: np.ndar
         parameter keeps an infinite standard error).
     estimates, scale : numpy.ndarray
         Physical estimates and the scales of the columns.
+    channels : int, default 1
+        Number of signals stacked in ``r`` (each the same length, in time order): their scores at
+        the same sample are summed before the lags are taken.
 
     Returns
     -------
@@ -55,8 +58,8 @@ def sandwich(J: np.ndarray, r: np.ndarray, stats: Statistics, estimates: np.ndar
         The statistics with sandwich standard errors, and the lag used.
     """
     n, p = J.shape
-    L = andrews_lag(r)
-    g = J * r[:, None]
+    g = (J * r[:, None]).reshape(channels, n // channels, p).sum(axis=0)
+    L = andrews_lag(r.reshape(channels, -1)[0])
     S = g.T @ g
     for lag in range(1, L + 1):
         G = g[lag:].T @ g[:-lag]

@@ -7,12 +7,13 @@ friction force ``F`` is the model's force along the filtered motion (a static ma
 a dynamic model through :func:`prefriction.friction_along`), and every column of the regression
 and the force are decimated alike. The residuals
 
-    r = D(u) - m D(a) - F_off - D(F(x_f, v_f; theta)) - db_neg D(min(v_f, 0))          (1)
+    r = D(u) - m D(a) - F_off D(1) - D(F(x_f, v_f; theta))                               (1)
 
-(``D`` the border cut and decimation) are minimised over ``m``, ``F_off``, the model's
-parameters and, with ``directional=True``, a viscous coefficient for ``v < 0`` (``b_neg`` of a
-:class:`StaticFriction`, ``db_neg = b_neg - b`` added to a dynamic model; the Coulomb asymmetry
-of a dynamic model is the offset: ``s Fc + F_off`` has the levels ``Fc + F_off`` and
+(``D`` the border cut and decimation; ``D(1)`` is the decimation filter's gain at zero frequency,
+0.989, as in the reference script) are minimised over ``m``, ``F_off`` and the model's
+parameters. Direction-dependent friction: ``Fc_neg``, ``b_neg`` of a :class:`StaticFriction`
+(``directional=True``), or a :class:`prefriction.DirectionalViscous` term in a dynamic model
+whose Coulomb asymmetry is the offset (``s Fc + F_off`` has the levels ``Fc + F_off`` and
 ``Fc - F_off``). No simulation: the route cannot drift, whatever the record's length or loop.
 A linear static map (no Stribeck term) is solved in closed form (``numpy.linalg.lstsq``, the
 EMPS reference script's ``X \\ y``), otherwise ``scipy.optimize.least_squares`` (trust-region
@@ -28,7 +29,7 @@ Student-t 95 % intervals; the lag used is in ``FitResult.notes``.
 from __future__ import annotations
 
 import warnings
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 from scipy.optimize import least_squares
@@ -150,7 +151,7 @@ def fit_inverse(model: FrictionModel | StaticFriction, data: Motion, *, offset: 
     directional : bool, default False
         Direction-dependent viscous friction: ``b_neg`` of a :class:`StaticFriction` (added if
         the map has none; with ``Fc_neg`` too the map is the EMPS asymmetric model and the offset
-        must be off), or ``"db_neg"`` [N s/m] (``b_neg = b + db_neg``) added to a dynamic model.
+        must be off). A dynamic model takes a :class:`prefriction.DirectionalViscous` term instead.
     free, fixed, bounds :
         As :func:`prefriction.identify.fit`, for the model's parameters.
     mass0 : float, optional
@@ -170,8 +171,9 @@ def fit_inverse(model: FrictionModel | StaticFriction, data: Motion, *, offset: 
     Returns
     -------
     FitResult
-        Estimates (model parameters, ``mass``, ``offset``, ``db_neg``) with 95 % intervals; the
-        residuals and fitted forces are on the decimated samples (``nuisance["t"]``).
+        Estimates (model parameters, ``mass``, ``offset``) with 95 % intervals; ``data`` is the
+        friction force ``D(u) - m D(a)`` the fit explains at the decimated samples (a
+        :class:`ForceDisplacement`), ``residuals`` and ``fitted`` are on those samples [N].
 
     Raises
     ------
@@ -192,8 +194,11 @@ def fit_inverse(model: FrictionModel | StaticFriction, data: Motion, *, offset: 
             raise ValueError("offset=True with a StaticFriction having Fc_neg: an offset and a Coulomb asymmetry are "
                              "the same columns when the record never rests exactly; give offset=False or Fc_neg=None")
         problem = _StaticProblem(model, d, data, offset, mass_free, mass0, offset0)
+    elif directional:
+        raise ValueError("directional=True is for a StaticFriction map; add a prefriction.DirectionalViscous term "
+                         "to a dynamic model (pf.Dahl(...) + pf.DirectionalViscous(b, b_neg)) and fit the offset")
     else:
-        problem = _DynamicProblem(model, d, data, offset, directional, free, fixed, bounds, mass_free, mass0, offset0)
+        problem = _DynamicProblem(model, d, data, offset, free, fixed, bounds, mass_free, mass0, offset0)
     y = d.regress(data.u)
     names, scale = problem.names, problem.scale
     lo, hi = problem.bounds()
@@ -310,41 +315,31 @@ class _DynamicProblem:
     linear = False
     analytic = False
 
-    def __init__(self, model: FrictionModel, d: Derivatives, data: Motion, offset: bool, directional: bool,
-                 free: Any, fixed: Any, bounds: Any, mass_free: bool, mass0: float | None, offset0: float) -> None:
+    def __init__(self, model: FrictionModel, d: Derivatives, data: Motion, offset: bool, free: Any, fixed: Any,
+                 bounds: Any, mass_free: bool, mass0: float | None, offset0: float) -> None:
         from prefriction.identify.parameters import ParameterSpace, name_list
 
         fscale = max(float(np.std(data.u)), 1e-300)
         self.space = ParameterSpace(model, name_list("free", free), name_list("fixed", fixed), bounds,
                                     mass=mass0 if mass_free else None, offset=fscale if offset else None)
-        self.d, self.mass_known, self.directional = d, data.mass, directional
-        self.names = list(self.space.free) + (["db_neg"] if directional else [])
-        self.scale = np.concatenate([self.space.scale, [max(abs(float(np.mean(np.abs(data.u)))) /
-                                                           max(float(np.std(d.v)), 1e-300), 1e-300)]
-                                     if directional else []])
-        theta0 = self.space.theta0.copy()
+        self.d, self.mass_known = d, data.mass
+        self.names, self.scale = list(self.space.free), self.space.scale
+        self.theta0 = self.space.theta0.copy()
         if offset:
-            theta0[self.space.free.index("offset")] = offset0 / fscale
-        self.theta0 = np.concatenate([theta0, [0.0] if directional else []])
-        self.units = [self.space.units[n] for n in self.space.free] + (["N s/m"] if directional else [])
-        self._a, self._vneg = d.regress(d.a), d.regress(np.minimum(d.v, 0.0))
-        self._one = d.regress(np.ones_like(d.a))
+            self.theta0[self.space.free.index("offset")] = offset0 / fscale
+        self.units = [self.space.units[n] for n in self.space.free]
+        self._a, self._one = d.regress(d.a), d.regress(np.ones_like(d.a))
         self.acceleration = self._a
-        self._along: Callable[[FrictionModel], np.ndarray] = self._friction
 
     def _friction(self, model: FrictionModel) -> np.ndarray:
         from prefriction.along import friction_along
         return self.d.regress(friction_along(model, self.d.t, self.d.x, v=self.d.v).F)
 
-    def _split(self, theta: np.ndarray) -> tuple[dict[str, float], float]:
-        k = self.space.n_free
-        return self.space.values(theta[:k]), (float(theta[k] * self.scale[k]) if self.directional else 0.0)
-
     def force(self, theta: np.ndarray) -> np.ndarray:
-        vals, db = self._split(theta)
-        m = vals["mass"] if "mass" in vals and self.mass_known is None else self.mass_known
+        vals = self.space.values(theta)
+        m = vals["mass"] if self.mass_known is None else self.mass_known
         F = self._friction(self.space.build(vals))
-        return m * self._a + F + vals.get("offset", 0.0) * self._one + db * self._vneg
+        return m * self._a + F + vals.get("offset", 0.0) * self._one
 
     def jacobian(self, theta: np.ndarray) -> np.ndarray:
         f0 = self.force(theta)
@@ -357,9 +352,7 @@ class _DynamicProblem:
         return J
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        lo, hi = self.space.theta_bounds()
-        extra = [-np.inf] if self.directional else []
-        return np.concatenate([lo, extra]), np.concatenate([hi, [np.inf] * len(extra)])
+        return self.space.theta_bounds()
 
     def limits(self) -> tuple[dict, dict, dict, dict]:
         sp = self.space
@@ -367,10 +360,8 @@ class _DynamicProblem:
         hi = {n: sp.high[n] for n in sp.free}
         why_lo = {n: sp.why_low.get(n, "the declared range") for n in sp.free}
         why_hi = {n: sp.why_high.get(n, "the declared range") for n in sp.free}
-        if self.directional:
-            lo["db_neg"], hi["db_neg"], why_lo["db_neg"], why_hi["db_neg"] = -np.inf, np.inf, "", ""
         return lo, hi, why_lo, why_hi
 
     def build(self, theta: np.ndarray) -> tuple[FrictionModel, float]:
-        vals, _ = self._split(theta)
+        vals = self.space.values(theta)
         return self.space.build(vals), float(vals["mass"] if self.mass_known is None else self.mass_known)
