@@ -135,7 +135,8 @@ def _loop_function(model: FrictionModel, loop: DigitalLoop, space: Any, n_sub: i
     applied = uh[nd - 1] if nd else u
     y1 = step(ca.vertcat(y, s), applied, applied, loop.dt, pp)
     cont = ca.vertcat(y, hist, uh)
-    cont1 = ca.vertcat(y1[:ny], y[0], hist[:nt - 1], *([u, uh[:nd - 1]] if nd else []))
+    cont1 = ca.vertcat(y1[:ny], y[0], *[hist[j] for j in range(nt - 1)],
+                       *([u] + [uh[j] for j in range(nd - 1)] if nd else []))
     S = ca.SX.sym("S", cont.numel(), nth)
     S1 = ca.mtimes(ca.jacobian(cont1, cont), S) + ca.jacobian(cont1, theta)
     out = ca.vertcat(y[0], u)

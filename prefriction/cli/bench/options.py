@@ -38,7 +38,8 @@ examples:
   prefriction bench --compensation   PID alone against PID with each friction compensator
                                      (writes compensation_*.png to --out)
   prefriction bench --export         exported C code: ns per step against friction_along
-  prefriction bench --identify       Motion fit time and memory against the record length"""
+  prefriction bench --identify       Motion fit time and memory against the record length
+  prefriction bench --emps DIR       identification routes on the EMPS benchmark files in DIR"""
 
 
 def repeats(text: str) -> int:
@@ -152,6 +153,9 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
     what.add_argument("--identify", action="store_true",
                       help="instead: time and peak memory of a closed-loop Motion fit against the number of "
                            "samples (1e3, 5e3, 2.5e4; --quick: 500, 1000, 2000), each in a fresh process")
+    what.add_argument("--emps", default=None, metavar="DIR",
+                      help="instead: the identification routes on the EMPS benchmark files in DIR (DATA_EMPS.mat, "
+                           "DATA_EMPS_PULSES.mat; not shipped), docs/identify.md#emps")
     args = ap.parse_args(argv)
     if args.compensation and (args.quick or args.repeats is not None):
         ap.error("--quick and --repeats do not apply to --compensation")
