@@ -24,6 +24,7 @@ scores, since closed-loop residuals are strongly correlated in time.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import warnings
 from dataclasses import dataclass
@@ -43,6 +44,9 @@ from prefriction.models.base import FrictionModel
 __all__ = ["DigitalLoop", "fit_closed_loop", "simulate_closed_loop"]
 
 _CACHE: dict[Any, tuple[ca.Function, int]] = {}
+COMPILE_FROM = 5000
+"""Records of this many samples or more run the loop's step compiled (``prefriction.simulation.compiled``);
+shorter ones interpreted (the compilation would take longer than it saves)."""
 
 
 @dataclass(frozen=True)
@@ -152,11 +156,13 @@ class _Simulator:
 
     def __init__(self, model: FrictionModel, loop: DigitalLoop, space: Any, n: int, n_sub: int,
                  mass_free: bool) -> None:
-        key = (model.structure_key(), loop, tuple(space.free), tuple(space.fixed), n_sub, mass_free)
+        key = (model.structure_key(), loop, tuple(space.free), tuple(space.fixed), n_sub, mass_free,
+               n >= COMPILE_FROM)
         if key not in _CACHE:
             from prefriction.simulation.compiled import compiled
             f, nc = _loop_function(model, loop, space, n_sub, mass_free)
-            _CACHE[key] = (compiled(f, "closed-loop fit step")[0], nc)
+            # compiling costs about 10 s once per structure and saves about 150 us a sample per evaluation
+            _CACHE[key] = (compiled(f, "closed-loop fit step")[0] if n >= COMPILE_FROM else f, nc)
         f, self.nc = _CACHE[key]
         self.acc = f.mapaccum("loop_record", n - 1)
         self.model, self.loop, self.space, self.n = model, loop, space, n
@@ -326,7 +332,8 @@ def fit_closed_loop(model: FrictionModel, data: Motion, loop: DigitalLoop, refer
     est = theta * space.scale
     names = list(space.free)
     stats = gauss_newton(J, rr, names, est, space.scale, limit=identifiability_limit)
-    stats, lag = sandwich(J, rr, stats, est, space.scale, channels=2 if forces else 1)
+    stats, lag = sandwich(J, rr, stats, est, space.scale, channels=2 if forces else 1, names=names,
+                          limit=identifiability_limit)
     for name, reason in stats.unidentifiable:
         warnings.warn(f"the data cannot identify {name}: {reason}; fix it or excite it", IdentifiabilityWarning,
                       stacklevel=2)
@@ -338,9 +345,12 @@ def fit_closed_loop(model: FrictionModel, data: Motion, loop: DigitalLoop, refer
     vals = space.values(theta)
     fitted_mass = vals["mass"] if data.mass is None else float(data.mass)
     x_sim, u_sim, _, _ = sim.run(theta, float(data.x[0]), r, e, mass)
-    notes = (f"closed-loop output error: positions{' and forces' if forces else ''}, channel weights "
-             f"{w[0]:.3g} m and {w[1]:.3g} N; Newey-West standard errors, lag {lag}",)
+    stats = dataclasses.replace(stats, sigma_hat=float(np.sqrt(np.sum(rx ** 2) / stats.dof)))
+    notes = ("route: closed-loop output error",
+             f"fitted to positions{' and forces' if forces else ''} with channel weights {w[0]:.3g} m and "
+             f"{w[1]:.3g} N (the residual sd shown is of the positions; forces: rms {np.sqrt(np.mean(ru ** 2)):.4g} N)",
+             f"Newey-West standard errors, lag {lag}")
     return FitResult(space.build(vals), fitted_mass, tuple(names), tuple(space.units[n] for n in names), est,
                      stats.stderr, low, high, stats.correlation, xm - x_sim, x_sim, data, stats,
-                     {"route": "closed-loop", "force": u_sim, "force_rms": float(np.sqrt(np.mean(ru ** 2)))},
+                     {"force": u_sim, "force_rms": float(np.sqrt(np.mean(ru ** 2)))},
                      f"least_squares: {sol.message}", success=bool(sol.status > 0), flags=flags, notes=notes)

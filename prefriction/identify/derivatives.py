@@ -8,7 +8,7 @@ models of EMPS*, 2019, ``Script_IDIM_LS.m``; ``docs/identify.md#inverse-model``)
    ``x_f = filtfilt(x)``;
 2. central differences ``v_k = (x_f[k+1] - x_f[k-1]) / (2 dt)`` and ``a_k`` the same of ``v``
    (one-sided at the ends);
-3. the first ``border`` samples dropped (the filter's start transient);
+3. the first ``border`` samples dropped (the filter's start transient; ``tail`` at the end);
 4. decimation of every column of the regression and of the force by ``step``: a Chebyshev type I
    low-pass of order 8 at ``0.8 / step`` of the Nyquist frequency, run forwards and backwards,
    then every ``step``-th sample ending at the last one (MATLAB's ``decimate``). The decimation
@@ -75,6 +75,8 @@ class Derivatives:
         Decimation factor.
     border : int
         Samples dropped at the start.
+    tail : int
+        Samples dropped at the end.
     noise : float
         Estimated position noise [m] (standard deviation of ``x - x_f`` at ``fs / 4``).
     """
@@ -88,11 +90,12 @@ class Derivatives:
     step: int
     border: int
     noise: float
+    tail: int = 0
 
     @property
     def keep(self) -> slice:
-        """The samples after the border."""
-        return slice(self.border, None)
+        """The samples after the border and before the tail."""
+        return slice(self.border, self.t.size - self.tail)
 
     def regress(self, column: np.ndarray) -> np.ndarray:
         """A signal at every sample, border dropped and decimated (a column of the regression)."""
@@ -101,11 +104,12 @@ class Derivatives:
     def summary(self) -> str:
         """One line: the filter and decimation used."""
         return (f"Butterworth order {self.order} at {self.cutoff:.4g} Hz (zero phase), central differences, "
-                f"first {self.border} samples dropped, decimation by {self.step}; position noise {self.noise:.3g} m")
+                f"first {self.border}{f' and last {self.tail}' if self.tail else ''} samples dropped, decimation by "
+                f"{self.step}; position noise {self.noise:.3g} m")
 
 
 def derivatives(t: Any, x: Any, *, cutoff: float | None = None, order: int = 4, step: int | None = None,
-                border: int | None = None) -> Derivatives:
+                border: int | None = None, tail: int = 0) -> Derivatives:
     """Velocity and acceleration of sampled positions by the inverse-model recipe (module docstring).
 
     Parameters
@@ -122,6 +126,9 @@ def derivatives(t: Any, x: Any, *, cutoff: float | None = None, order: int = 4, 
         Decimation factor, 1 to 100; default ``round(fs / cutoff)``.
     border : int, optional
         Samples dropped at the start; default ``5 fs / cutoff - 1``.
+    tail : int, default 0
+        Samples dropped at the end (the reference scripts keep them: EMPS ends at rest; a record
+        that ends in motion needs ``tail = border``).
 
     Returns
     -------
@@ -157,10 +164,11 @@ def derivatives(t: Any, x: Any, *, cutoff: float | None = None, order: int = 4, 
         raise ValueError(f"cutoff must be below the Nyquist frequency {fs / 2.0:.6g} Hz, got {cutoff!r}")
     step = int(max(1, round(fs / cutoff))) if step is None else check_count("step", step, 1, 100, "decimation factor")
     border = int(round(5.0 * fs / cutoff)) - 1 if border is None else check_count("border", border, 0)
-    if x.size < border + 10 * step:
-        raise ValueError(f"the record has {x.size} samples: at least border + 10 step = {border + 10 * step} "
-                         f"are needed (lower border or step)")
+    tail = check_count("tail", tail, 0)
+    if x.size < border + tail + 10 * step:
+        raise ValueError(f"the record has {x.size} samples: at least border + tail + 10 step = "
+                         f"{border + tail + 10 * step} are needed (lower border, tail or step)")
     b, a = signal.butter(order, 2.0 * cutoff / fs)
     xf = filtfilt(b, a, x)
     v = _central(xf, dt)
-    return Derivatives(t, xf, v, _central(v, dt), float(cutoff), order, step, border, noise)
+    return Derivatives(t, xf, v, _central(v, dt), float(cutoff), order, step, border, noise, tail)

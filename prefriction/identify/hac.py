@@ -34,7 +34,7 @@ def andrews_lag(r: np.ndarray) -> int:
 
 
 def sandwich(J: np.ndarray, r: np.ndarray, stats: Statistics, estimates: np.ndarray, scale: np.ndarray,
-             channels: int = 1) -> tuple[Statistics, int]:
+             channels: int = 1, names: list[str] | None = None, limit: float = 0.5) -> tuple[Statistics, int]:
     """``stats`` with standard errors and 95 % intervals from the sandwich (1).
 
     Parameters
@@ -51,6 +51,11 @@ def sandwich(J: np.ndarray, r: np.ndarray, stats: Statistics, estimates: np.ndar
     channels : int, default 1
         Number of signals stacked in ``r`` (each the same length, in time order): their scores at
         the same sample are summed before the lags are taken.
+    names : list of str, optional
+        The parameters' names: the relative-standard-error findings are redone with the sandwich's
+        standard errors (``limit`` as in :func:`prefriction.identify.statistics.gauss_newton`).
+    limit : float, default 0.5
+        Relative standard error above which a parameter is reported as not identifiable.
 
     Returns
     -------
@@ -73,5 +78,14 @@ def sandwich(J: np.ndarray, r: np.ndarray, stats: Statistics, estimates: np.ndar
         corr = cov / np.outer(se, se)
     corr[~np.isfinite(corr)] = np.nan
     np.fill_diagonal(corr, 1.0)
+    unident = stats.unidentifiable
+    if names is not None:
+        kept = [(n, why) for n, why in unident if not why.startswith("relative standard error")]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            rse = se / np.abs(estimates)
+        flagged = {n for n, _ in kept}
+        kept += [(n, f"relative standard error {100.0 * rse[i]:.3g} % > {100.0 * limit:.3g} %")
+                 for i, n in enumerate(names) if n not in flagged and not rse[i] <= limit]
+        unident = tuple(sorted(kept, key=lambda item: names.index(item[0])))
     return dataclasses.replace(stats, stderr=se, low=estimates - tq * se, high=estimates + tq * se,
-                               correlation=corr), L
+                               correlation=corr, unidentifiable=unident), L

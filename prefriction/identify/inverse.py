@@ -42,7 +42,7 @@ from prefriction.identify.static_map import StaticFriction
 from prefriction.identify.statistics import IdentifiabilityWarning, at_bounds, gauss_newton
 from prefriction.models.base import FrictionModel
 
-__all__ = ["fit_inverse", "inverse_start", "static_inverse"]
+__all__ = ["applied", "fit_inverse", "inverse_start", "static_inverse"]
 
 
 def _check(model: Any, data: Any) -> None:
@@ -55,6 +55,25 @@ def _check(model: Any, data: Any) -> None:
     if data.free_decay:
         raise ValueError("the inverse-model route needs the applied force: data.u is zero everywhere (a free decay "
                          "cannot separate the mass from the friction; use identify.fit)")
+
+
+def applied(data: Motion, delay: float) -> Motion:
+    """``data`` with its force delayed by ``delay`` samples (0 to 4, linear between samples).
+
+    The force balance at sample ``k`` (central differences) sees the force held over the two
+    intervals around it: a loop that computes ``u_k`` from ``x_k`` and holds it over
+    ``[t_k, t_k+1]`` acts, on average, half a sample late (``delay = 0.5``), one that applies it a
+    sample later 1.5 samples late. The EMPS reference script aligns ``u_k`` with ``a_k``
+    (``delay = 0``, the default, to reproduce it).
+    """
+    delay = float(delay)
+    if not 0.0 <= delay <= 4.0:
+        raise ValueError(f"delay must be in [0, 4] samples, got {delay!r}")
+    if delay == 0.0:
+        return data
+    k = np.arange(len(data)) - delay
+    u = np.interp(k, np.arange(len(data)), data.u)   # held at u[0] before the record
+    return Motion(data.t, data.x, u, data.mass, hold=data.hold)
 
 
 def static_inverse(data: Motion, deriv: Derivatives | None = None, *, directional: bool = False,
@@ -94,8 +113,8 @@ def static_inverse(data: Motion, deriv: Derivatives | None = None, *, directiona
     return out
 
 
-def inverse_start(model: FrictionModel | StaticFriction, data: Motion, deriv: Derivatives | None = None
-                  ) -> tuple[Any, float, float]:
+def inverse_start(model: FrictionModel | StaticFriction, data: Motion, deriv: Derivatives | None = None,
+                  delay: float = 0.0) -> tuple[Any, float, float]:
     """Start values for any route from the closed-form inverse model (:func:`static_inverse`).
 
     The model's Coulomb level ``Fc`` (``Fs`` in the same proportion) and its viscous coefficient
@@ -103,13 +122,15 @@ def inverse_start(model: FrictionModel | StaticFriction, data: Motion, deriv: De
     ``sigma2``) take the inverse model's values where they come out positive; other parameters
     (stiffnesses, ``gamma``) keep the model's values.
 
+    ``delay`` is the loop's delay in samples (:func:`applied`).
+
     Returns
     -------
     (model, float, float)
         The start model, the mass [kg] and the offset [N].
     """
     _check(model, data)
-    est = static_inverse(data, deriv)
+    est = static_inverse(applied(data, delay), deriv)
     Fc, b = est["Fc"], est["b"]
     if isinstance(model, StaticFriction):
         vals = {}
@@ -136,7 +157,7 @@ def inverse_start(model: FrictionModel | StaticFriction, data: Motion, deriv: De
 def fit_inverse(model: FrictionModel | StaticFriction, data: Motion, *, offset: bool = True,
                 directional: bool = False, free: Any = None, fixed: Any = None, bounds: dict | None = None,
                 mass0: float | None = None, offset0: float = 0.0, deriv: Derivatives | None = None,
-                max_iter: int = 200, tol: float = 1e-10, identifiability_limit: float = 0.5) -> FitResult:
+                delay: float = 0.0, max_iter: int = 200, tol: float = 1e-10, identifiability_limit: float = 0.5) -> FitResult:
     """Fit mass, offset and friction to a driven-mass record by the inverse model (1).
 
     Parameters
@@ -161,6 +182,10 @@ def fit_inverse(model: FrictionModel | StaticFriction, data: Motion, *, offset: 
     deriv : Derivatives, optional
         Filtered derivatives (:func:`prefriction.identify.derivatives.derivatives`); default from
         the record's sample rate and noise.
+    delay : float, default 0.0
+        Samples the recorded force is shifted by before the balance (:func:`applied`): 0.5 for a
+        force held over the sample after the one it was computed at, 1.5 if it is applied a
+        sample later; 0 as the EMPS reference script.
     max_iter : int, default 200
         Most function evaluations of the solver.
     tol : float, default 1e-10
@@ -181,8 +206,9 @@ def fit_inverse(model: FrictionModel | StaticFriction, data: Motion, *, offset: 
         For a model or data of the wrong kind, a free decay, unknown names or bad bounds.
     """
     _check(model, data)
+    data = applied(data, delay)
     d = derivatives(data.t, data.x) if deriv is None else deriv
-    notes = [d.summary()]
+    notes = [d.summary()] + ([f"force delayed by {delay:g} sample(s)"] if delay else [])
     mass_free = data.mass is None
     if mass_free and mass0 is None:
         mass0 = static_inverse(data, d, offset=offset)["mass"]
@@ -216,10 +242,10 @@ def fit_inverse(model: FrictionModel | StaticFriction, data: Motion, *, offset: 
     J = problem.jacobian(theta)
     est = theta * scale
     stats = gauss_newton(J, r, names, est, scale, limit=identifiability_limit)
+    stats, lag = sandwich(J, r, stats, est, scale, names=names, limit=identifiability_limit)
     for name, reason in stats.unidentifiable:
         warnings.warn(f"the data cannot identify {name}: {reason}; fix it or excite it", IdentifiabilityWarning,
                       stacklevel=2)
-    stats, lag = sandwich(J, r, stats, est, scale)
     low, high, flags = at_bounds(names, est, stats.low, stats.high, scale, *problem.limits())
     rho = float(np.corrcoef(r[:-1], r[1:])[0, 1]) if r.size > 3 else float("nan")
     notes.append(f"residual lag-1 autocorrelation {rho:.3f} after decimation: Newey-West standard errors, lag {lag}")
@@ -230,8 +256,7 @@ def fit_inverse(model: FrictionModel | StaticFriction, data: Motion, *, offset: 
     force = ForceDisplacement(d.regress(d.t), d.regress(d.x), y - mass * problem.acceleration)
     return FitResult(fitted_model, mass, tuple(names), tuple(problem.units), est, stats.stderr, low, high,
                      stats.correlation, -r, y + r - mass * problem.acceleration, force, stats,
-                     {"route": "inverse", "derivatives": d, "record": data}, message, success=success,
-                     flags=flags, notes=tuple(notes))
+                     {}, message, success=success, flags=flags, notes=tuple(["route: inverse model"] + notes))
 
 
 class _StaticProblem:

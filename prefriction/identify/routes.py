@@ -7,8 +7,8 @@ reference, and a model error of a fraction of a percent integrates to millimetre
 while the positions hardly depend on the friction (the EMPS benchmark's description says so).
 :func:`recommend` measures the drift without fitting anything: the closed-form inverse model
 (:func:`prefriction.identify.inverse.static_inverse`: mass, Coulomb, viscous, offset) is
-replayed open loop with the recorded force (semi-implicit Euler per sample, sticking when the
-force stays inside the Coulomb band), and the *horizon* is the number of samples before the
+replayed open loop with the recorded force held over each sample (each interval in closed form,
+sticking when the force stays inside the Coulomb band), and the *horizon* is the number of samples before the
 replay leaves the measured positions by more than the tolerance ``10 s_x + 1e-3 ptp(x)``
 (``s_x`` the position noise). A horizon shorter than an eighth of the record marks a record
 whose force does not carry its motion: fit the force balance
@@ -63,22 +63,38 @@ class Recommendation:
 
 
 def _replay(t: np.ndarray, u: np.ndarray, x0: float, est: dict[str, float]) -> np.ndarray:
-    """Open-loop positions [m] of ``m a + b v + Fc sign(v) + F_off = u`` (semi-implicit Euler, sticking)."""
+    """Open-loop positions [m] of ``m a + b v + Fc sign(v) + F_off = u``, ``u`` held over each sample.
+
+    Each interval in closed form, ``v(h) = v0 e^(-b h / m) + (f / m) phi(h)`` with
+    ``phi(h) = (1 - e^(-b h / m)) m / b`` (``h`` for ``b = 0``), ``f = u - F_off - Fc s``; a
+    velocity that would change sign stops at zero (the mass sticks while ``|u - F_off| <= Fc``).
+    """
     m, b, Fc, off = est["mass"], max(est["b"], 0.0), max(est["Fc"], 0.0), est["offset"]
+    a = b / m
     x = np.empty(t.size)
     x[0], v = x0, 0.0
-    dt = np.diff(t)
+
+    def phis(h: float) -> tuple[float, float]:
+        phi = -np.expm1(-a * h) / a if a > 0.0 else h
+        return phi, ((h - phi) / a if a > 0.0 else 0.5 * h * h)
+
     for k in range(t.size - 1):
-        f = u[k] - off
-        if v == 0.0 and abs(f) <= Fc:
-            x[k + 1] = x[k]
-            continue
-        s = np.sign(v) if v != 0.0 else np.sign(f)
-        vn = v + dt[k] * (f - b * v - Fc * s) / m
-        if v != 0.0 and vn * v < 0.0:
-            vn = 0.0
-        v = vn
-        x[k + 1] = x[k] + dt[k] * v
+        h, drive, pos = float(t[k + 1] - t[k]), float(u[k]) - off, float(x[k])
+        for _ in range(2):   # a stop inside the interval, then the rest of it
+            if v == 0.0 and abs(drive) <= Fc:
+                break
+            s = np.sign(v) if v != 0.0 else np.sign(drive)
+            f = (drive - Fc * s) / m
+            phi, psi = phis(h)
+            v1 = v * np.exp(-a * h) + f * phi
+            if v1 * s >= 0.0:
+                pos, v = pos + v * phi + f * psi, v1
+                break
+            tau = np.log1p(-v * a / f) / a if a > 0.0 else -v / f   # the closed form's stop time
+            tau = min(max(float(tau), 0.0), h) if np.isfinite(tau) else 0.0
+            phi, psi = phis(tau)
+            pos, v, h = pos + v * phi + f * psi, 0.0, h - tau
+        x[k + 1] = pos
     return x
 
 
@@ -115,7 +131,8 @@ def recommend(data: Motion, *, controller_known: bool = False) -> Recommendation
     from prefriction.identify.inverse import static_inverse
 
     try:
-        d = derivatives(data.t, data.x)
+        d0 = derivatives(data.t, data.x)
+        d = derivatives(data.t, data.x, tail=d0.border)
     except ValueError as exc:
         return Recommendation("motion", f"the inverse model's filters do not apply ({exc})", n, n, 0.0)
     est = static_inverse(data, d)
