@@ -32,7 +32,6 @@ from typing import Any, Sequence
 
 import casadi as ca
 import numpy as np
-from scipy.optimize import least_squares
 
 from prefriction._validation import check_count, check_positive
 from prefriction.identify.data import Motion
@@ -273,6 +272,7 @@ def fit_closed_loop(model: FrictionModel, data: Motion, loop: DigitalLoop, refer
         For arguments of the wrong kind or out of range (named).
     """
     from prefriction.identify.parameters import ParameterSpace, name_list
+    from scipy.optimize import least_squares
 
     if not isinstance(model, FrictionModel):
         raise TypeError(f"model must be a prefriction.FrictionModel, got {type(model).__name__}")

@@ -32,7 +32,6 @@ import warnings
 from typing import Any
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from prefriction.identify.data import ForceDisplacement, Motion
 from prefriction.identify.hac import sandwich
@@ -205,6 +204,8 @@ def fit_inverse(model: FrictionModel | StaticFriction, data: Motion, *, offset: 
     TypeError, ValueError
         For a model or data of the wrong kind, a free decay, unknown names or bad bounds.
     """
+    from scipy.optimize import least_squares
+
     _check(model, data)
     data = applied(data, delay)
     d = derivatives(data.t, data.x) if deriv is None else deriv
