@@ -76,8 +76,8 @@ def test_closed_loop_simulation_follows_the_scipy_loop(record):
     model = TRUE + pf.DirectionalViscous(STAGE.b, STAGE.b_neg)
     x, u = identify.simulate_closed_loop(model, LOOP, data.t, ref, mass=STAGE.mass, offset=STAGE.offset)
     # the record's encoder rounds to 5e-8 m and the loop feeds it back: agreement at that level
-    assert np.max(np.abs(x - data.x[:-1])) < 4 * STAGE.quantum
-    assert np.sqrt(np.mean((u - data.u[:-1]) ** 2)) < 0.01 * np.std(data.u)
+    assert np.max(np.abs(x - data.x)) < 4 * STAGE.quantum
+    assert np.sqrt(np.mean((u - data.u) ** 2)) < 0.01 * np.std(data.u)
 
 
 def test_closed_loop_route_recovers_the_truth_from_the_inverse_start(record):

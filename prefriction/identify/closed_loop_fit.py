@@ -163,7 +163,7 @@ class _Simulator:
             # compiling costs about 10 s once per structure and saves about 150 us a sample per evaluation
             _CACHE[key] = (compiled(f, "closed-loop fit step")[0] if n >= COMPILE_FROM else f, nc)
         f, self.nc = _CACHE[key]
-        self.acc = f.mapaccum("loop_record", n - 1)
+        self.acc = f.mapaccum("loop_record", n)
         self.model, self.loop, self.space, self.n = model, loop, space, n
 
     def run(self, theta: np.ndarray, x0: float, r: np.ndarray, e: np.ndarray, mass: float
@@ -175,7 +175,7 @@ class _Simulator:
         nz, nt, nd, nth = self.model.n_states, len(self.loop.taps), self.loop.delay, self.space.n_free
         cont = np.concatenate(([x0, 0.0], np.asarray(z0, dtype=float)[:nz], np.full(nt, x0), np.zeros(nd)))
         c0 = np.concatenate((cont, [1.0], np.zeros(self.nc * nth)))
-        _, O = self.acc(c0, r[None, :-1], e[None, :-1], theta, self.space.scale, self.space.fixed_values(), mass)
+        _, O = self.acc(c0, r[None, :], e[None, :], theta, self.space.scale, self.space.fixed_values(), mass)
         O = np.asarray(O)
         return O[0], O[1], O[2:2 + nth].T, O[2 + nth:2 + 2 * nth].T
 
@@ -206,7 +206,7 @@ def simulate_closed_loop(model: FrictionModel, loop: DigitalLoop, t: Any, r: Any
     Returns
     -------
     (numpy.ndarray, numpy.ndarray)
-        Positions and forces at the samples but the last.
+        Positions and forces at every sample.
     """
     from prefriction.identify.parameters import ParameterSpace
 
@@ -298,7 +298,7 @@ def fit_closed_loop(model: FrictionModel, data: Motion, loop: DigitalLoop, refer
     if offset:
         theta0[space.free.index("offset")] = offset0 / fscale
     mass = float(data.mass) if data.mass is not None else 0.0
-    xm, um = data.x[:-1], data.u[:-1]
+    xm, um = data.x, data.u
 
     memo: dict[bytes, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = {}
 

@@ -20,7 +20,8 @@ Defaults from the sample rate ``fs = 1 / dt`` and the noise: ``fc = fs / 10`` (E
 ``fs / 4``) would give an acceleration noise above 1 % of the acceleration's RMS: white noise
 through an ideal low-pass at ``fc`` and two derivatives has the standard deviation
 ``s_a = (2 pi)^2 s_x sqrt(2 fc^5 / (5 fs))``; ``step = round(fs / fc)`` (EMPS: 10, the
-scripts' ``round(0.8 fnyq / (0.4 fc))``); ``border = 5 fs / fc - 1`` (EMPS: 49).
+scripts' ``round(0.8 fnyq / (0.4 fc))``); ``border = 5 fs / fc - 1`` (EMPS: 49); no
+``tail`` (as the scripts; give ``tail = border`` for a record that ends in a fast move).
 """
 
 from __future__ import annotations
@@ -127,8 +128,8 @@ def derivatives(t: Any, x: Any, *, cutoff: float | None = None, order: int = 4, 
     border : int, optional
         Samples dropped at the start; default ``5 fs / cutoff - 1``.
     tail : int, default 0
-        Samples dropped at the end (the reference scripts keep them: EMPS ends at rest; a record
-        that ends in motion needs ``tail = border``).
+        Samples dropped at the end (the reference scripts keep them; a record that ends in a fast
+        move is better cut by ``border``: the filter's end transient).
 
     Returns
     -------
