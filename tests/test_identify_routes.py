@@ -148,6 +148,8 @@ def test_bad_arguments_are_named(record):
         identify.fit_inverse(pf.Dahl(sigma=1e6, Fc=10.0), data, directional=True)
     with pytest.raises(ValueError, match="offset=True with a StaticFriction having Fc_neg"):
         identify.fit_inverse(identify.StaticFriction(Fc=1.0, Fc_neg=1.0), data)
+    with pytest.raises(ValueError, match="fitted whole in closed form"):
+        identify.fit_inverse(identify.StaticFriction(Fc=1.0, b=1.0), data, fixed=["b"])
     with pytest.raises(ValueError, match="free decay"):
         identify.fit_inverse(identify.StaticFriction(Fc=1.0), identify.Motion(data.t, data.x, 0.0 * data.u, None))
     with pytest.raises(ValueError, match="reference must be finite"):
@@ -158,6 +160,27 @@ def test_bad_arguments_are_named(record):
         identify.DigitalLoop(1e-3, 1.0, 1.0, taps=())
     with pytest.raises(ValueError, match="delay"):
         identify.DigitalLoop(1e-3, 1.0, 1.0, delay=9)
+
+
+def test_emps_loader_reads_own_files_and_refuses_links(tmp_path):
+    from scipy.io import savemat
+
+    from prefriction.identify.emps import load
+
+    n = 50
+    mat = {"t": np.arange(n) * 1e-3, "qm": np.zeros(n), "qg": np.zeros(n), "vir": np.ones(n), "gtau": 35.0,
+           "kp": 160.0, "kv": 243.0}
+    savemat(tmp_path / "DATA_EMPS.mat", mat)
+    savemat(tmp_path / "DATA_EMPS_PULSES.mat", mat)
+    est, pulses = load(tmp_path)
+    assert est.u == pytest.approx(35.0 * np.ones(n)) and pulses.kv == 243.0
+    (tmp_path / "other").mkdir()
+    os.symlink(tmp_path / "DATA_EMPS.mat", tmp_path / "other" / "DATA_EMPS.mat")
+    savemat(tmp_path / "other" / "DATA_EMPS_PULSES.mat", mat)
+    with pytest.raises(ValueError, match="not a link"):
+        load(tmp_path / "other")
+    with pytest.raises(ValueError, match="does not exist"):
+        load(tmp_path / "missing")
 
 
 EMPS_DIR = os.environ.get("PREFRICTION_EMPS_DIR")

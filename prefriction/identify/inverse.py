@@ -173,7 +173,8 @@ def fit_inverse(model: FrictionModel | StaticFriction, data: Motion, *, offset: 
         the map has none; with ``Fc_neg`` too the map is the EMPS asymmetric model and the offset
         must be off). A dynamic model takes a :class:`prefriction.DirectionalViscous` term instead.
     free, fixed, bounds :
-        As :func:`prefriction.identify.fit`, for the model's parameters.
+        As :func:`prefriction.identify.fit`, for a dynamic model's parameters (a
+        :class:`StaticFriction` map is fitted whole).
     mass0 : float, optional
         Start of a fitted mass [kg]; default the closed-form inverse model's (said in the notes).
     offset0 : float, default 0.0
@@ -215,6 +216,10 @@ def fit_inverse(model: FrictionModel | StaticFriction, data: Motion, *, offset: 
         mass0 = static_inverse(data, d, offset=offset)["mass"]
         notes.append(f"mass started at the closed-form inverse model's {mass0:.6g} kg")
     if isinstance(model, StaticFriction):
+        given = [n for n, v in (("free", free), ("fixed", fixed), ("bounds", bounds)) if v is not None]
+        if given:
+            raise ValueError(f"{', '.join(given)} apply to a dynamic model; a StaticFriction map is fitted whole in "
+                             f"closed form (drop a term by leaving it out of the map, e.g. Fc_neg=None)")
         if directional and model.b_neg is None:
             model = model.replace({"b_neg": model.b})
         if offset and model.Fc_neg is not None:
