@@ -45,6 +45,25 @@ def test_decimation_keeps_the_last_sample_and_the_chebyshev_gain():
     assert y == pytest.approx(10.0 ** (-0.1 / 20.0), rel=1e-6)
 
 
+def test_sandwich_gives_the_long_run_spread_of_a_mean_of_ar1_noise():
+    from prefriction.identify.hac import sandwich
+    from prefriction.identify.statistics import gauss_newton
+
+    rho, n = 0.7, 40_000
+    e = np.random.default_rng(5).standard_normal(n)
+    r = np.empty(n)
+    r[0] = e[0]
+    for k in range(1, n):
+        r[k] = rho * r[k - 1] + np.sqrt(1.0 - rho ** 2) * e[k]   # unit variance
+    J = np.ones((n, 1))
+    r = r - r.mean()                                            # the residuals of fitting the mean
+    gn = gauss_newton(J, r, ["mean"], np.array([1.0]), np.array([1.0]))
+    hac, lag = sandwich(J, r, gn, np.array([1.0]), np.array([1.0]))
+    # the mean of n samples of unit-variance AR(1) noise: variance (1 + rho) / (1 - rho) / n
+    assert gn.stderr[0] == pytest.approx(1.0 / np.sqrt(n), rel=0.05)
+    assert hac.stderr[0] == pytest.approx(np.sqrt((1.0 + rho) / (1.0 - rho) / n), rel=0.15) and lag > 10
+
+
 def test_derivatives_of_a_slow_sine_and_the_default_filter():
     t = np.arange(4000) * 1e-3
     d = derivatives(t, 0.1 * np.sin(2.0 * np.pi * t))
