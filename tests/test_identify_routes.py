@@ -99,6 +99,38 @@ def test_closed_loop_simulation_follows_the_scipy_loop(record):
     assert np.sqrt(np.mean((u - data.u) ** 2)) < 0.01 * np.std(data.u)
 
 
+def test_linear_controller_law_and_fit_against_python_control():
+    import control
+
+    from prefriction.controllers import pd
+
+    dt, n, m, b, off = 1e-3, 600, 2.0, 40.0, 0.5
+    C = pd(4.0e4, 300.0)
+    loop = identify.DigitalLoop.from_controller(C, dt)
+    Cd = C.c2d(dt)   # python-control's zero-order-hold discretisation, run as a state space here
+    A, B, Cm, D = (np.asarray(M, dtype=float) for M in (Cd.A, Cd.B, Cd.C, Cd.D))
+    r = reference_moves(n, dt, np.random.default_rng(2), stroke=0.01)
+    x, u = np.empty(n), np.empty(n)
+    xc, pos, v = np.zeros(A.shape[0]), r[0], 0.0
+    a = b / m
+    phi, ea = -np.expm1(-a * dt) / a, np.exp(-a * dt)
+    for k in range(n):   # the stage m x'' + b x' + off = u in closed form over each held sample
+        x[k] = pos
+        err = r[k] - pos
+        u[k] = float((Cm @ xc)[0] + D[0, 0] * err)
+        xc = A @ xc + B[:, 0] * err
+        f = (u[k] - off) / m
+        pos, v = pos + v * phi + f * (dt - phi) / a, v * ea + f * phi
+    assert np.allclose(loop.force(r, x), u, rtol=1e-9, atol=1e-9 * np.abs(u).max())
+    assert isinstance(identify.DigitalLoop.from_controller(control.tf([1.0], [1.0, 1.0]), dt), identify.DigitalLoop)
+    res = identify.fit_closed_loop(pf.Viscous(20.0), identify.Motion(np.arange(n) * dt, x, u, None), loop, r,
+                                   mass0=1.5, offset0=0.0)
+    for name, value in {"b": b, "mass": m, "offset": off}.items():
+        assert res.estimate(name) == pytest.approx(value, rel=1e-6), res.report()
+    with pytest.raises(ValueError, match="sample time"):
+        identify.DigitalLoop.from_controller(control.c2d(C.ss(), 2e-3), dt)
+
+
 def test_closed_loop_route_recovers_the_truth_from_the_inverse_start(record):
     data, ref = record
     start = pf.Dahl(sigma=1.0e6, Fc=10.0) + pf.DirectionalViscous(100.0, 100.0)

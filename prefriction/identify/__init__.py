@@ -19,8 +19,9 @@
 
 from __future__ import annotations
 
-from prefriction.identify.closed_loop_fit import DigitalLoop, fit_closed_loop, simulate_closed_loop
+from prefriction.identify.closed_loop_fit import fit_closed_loop, simulate_closed_loop
 from prefriction.identify.data import ForceDisplacement, ForceVelocity, Motion
+from prefriction.identify.digital_loop import DigitalLoop
 from prefriction.identify.fit import fit
 from prefriction.identify.inverse import fit_inverse, inverse_start
 from prefriction.identify.routes import Recommendation, recommend

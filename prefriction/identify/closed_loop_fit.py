@@ -6,7 +6,9 @@ measured: at each sample ``k`` the loop reads the simulated position ``x_k``, co
     u_k = Kp (r_k - x_k) - Kd sum_j c_j (x_{k-j} - x_{k-j-1}) / dt + e_k,   |u_k| <= u_max      (1)
 
 (``r`` the recorded reference, ``c_j`` the velocity filter's taps, ``e`` an optional recorded
-additive force, e.g. EMPS's pulses) and applies ``u_{k-d}`` (``d`` samples of delay) held over the
+additive force, e.g. EMPS's pulses), or any linear law on the error ``r - x``
+(:class:`prefriction.identify.DigitalLoop`, e.g. from a :class:`prefriction.controllers.PID`),
+and applies ``u_{k-d}`` (``d`` samples of delay) held over the
 next sample interval to the stage ``m x'' + F + F_off = u`` (2.1) with any friction model
 (one sample of :func:`prefriction.identify.motion_step.step_function`: Runge-Kutta sub-steps
 cut at the reversals). The feedback keeps the simulation on the record, so it cannot drift
@@ -27,7 +29,6 @@ from __future__ import annotations
 import dataclasses
 import math
 import warnings
-from dataclasses import dataclass
 from typing import Any, Sequence
 
 import casadi as ca
@@ -35,12 +36,13 @@ import numpy as np
 
 from prefriction._validation import check_count, check_positive
 from prefriction.identify.data import Motion
+from prefriction.identify.digital_loop import DigitalLoop
 from prefriction.identify.hac import sandwich
 from prefriction.identify.result import FitResult
 from prefriction.identify.statistics import IdentifiabilityWarning, at_bounds, gauss_newton
 from prefriction.models.base import FrictionModel
 
-__all__ = ["DigitalLoop", "fit_closed_loop", "simulate_closed_loop"]
+__all__ = ["fit_closed_loop", "simulate_closed_loop"]
 
 _CACHE: dict[Any, tuple[ca.Function, int]] = {}
 COMPILE_FROM = 5000
@@ -48,67 +50,28 @@ COMPILE_FROM = 5000
 shorter ones interpreted (the compilation would take longer than it saves)."""
 
 
-@dataclass(frozen=True)
-class DigitalLoop:
-    """A sampled position loop (1): PD on the measured position with a filtered velocity.
+def _controller(loop: DigitalLoop, x: Any, mem: Any, r: Any, e: Any) -> tuple[Any, list[Any]]:
+    """The force at a sample and the controller's memory after it (CasADi SX).
 
-    Parameters
-    ----------
-    dt : float
-        Sample interval [s].
-    Kp : float
-        Position gain [N/m].
-    Kd : float
-        Velocity gain [N s/m].
-    taps : tuple of float, default (1.0,)
-        Velocity filter: ``v_k = sum_j taps[j] (x_{k-j} - x_{k-j-1}) / dt`` (EMPS: ``(0.5, 0.5)``).
-    delay : int, default 0
-        Samples between computing a force and applying it (0 to 4).
-    limit : float, default inf
-        Saturation of the force [N].
-
-    Examples
-    --------
-    >>> from prefriction.identify.closed_loop_fit import DigitalLoop
-    >>> loop = DigitalLoop.emps(kp=160.18, kv=243.45, gtau=35.15)
-    >>> round(loop.Kp), round(loop.Kd, 1), loop.taps
-    (1370773, 8557.3, (0.5, 0.5))
+    Memory: the law (1)'s last ``len(taps)`` positions; the law (2)'s last ``len(num) - 1`` errors
+    and ``len(den) - 1`` unsaturated outputs.
     """
+    if not loop.linear:
+        xs = [x] + [mem[j] for j in range(len(loop.taps))]
+        v = sum(c * (xs[j] - xs[j + 1]) for j, c in enumerate(loop.taps)) / loop.dt
+        return loop.Kp * (r - x) - loop.Kd * v + e, xs[:len(loop.taps)]
+    nb, na = len(loop.num) - 1, len(loop.den) - 1
+    eps = [r - x] + [mem[j] for j in range(nb)]
+    outs = [mem[nb + j] for j in range(na)]
+    lin = (sum(b * ej for b, ej in zip(loop.num, eps)) - sum(a * uj for a, uj in zip(loop.den[1:], outs))) / loop.den[0]
+    return lin + e, eps[:nb] + ([lin] + outs[:na - 1] if na else [])
 
-    dt: float
-    Kp: float
-    Kd: float
-    taps: tuple[float, ...] = (1.0,)
-    delay: int = 0
-    limit: float = math.inf
 
-    def __post_init__(self) -> None:
-        check_positive("dt", self.dt)
-        for name in ("Kp", "Kd"):
-            if not (math.isfinite(getattr(self, name)) and getattr(self, name) >= 0.0):
-                raise ValueError(f"{name} must be finite and >= 0, got {getattr(self, name)!r}")
-        if not 1 <= len(self.taps) <= 8 or not all(math.isfinite(c) for c in self.taps):
-            raise ValueError(f"taps must hold 1 to 8 finite numbers, got {self.taps!r}")
-        object.__setattr__(self, "taps", tuple(float(c) for c in self.taps))
-        check_count("delay", self.delay, 0, 4, "samples")
-        if not self.limit > 0.0:
-            raise ValueError(f"limit must be > 0 (inf: no saturation), got {self.limit!r}")
-
-    @classmethod
-    def emps(cls, kp: float, kv: float, gtau: float, dt: float = 1e-3, volts: float = 10.0) -> "DigitalLoop":
-        """The EMPS loop: ``vir = kv (kp (qg - qm) - v)`` [V], ``u = gtau vir`` [N], ``|vir| <= 10`` V, the
-        velocity the mean of the last two backward differences (Janot et al. 2019; the Simulink
-        model's ``filterq1 = [0.5 0.5]``)."""
-        return cls(dt, gtau * kv * kp, gtau * kv, (0.5, 0.5), 0, gtau * volts)
-
-    def force(self, r: np.ndarray, x: np.ndarray, extra: np.ndarray | None = None) -> np.ndarray:
-        """The loop's force (1) [N] computed from recorded positions ``x`` (before any delay);
-        the first samples use the first position as the earlier ones."""
-        n = len(self.taps)
-        xp = np.concatenate((np.full(n, x[0]), x))
-        v = sum(c * (xp[n - j:xp.size - j] - xp[n - j - 1:xp.size - j - 1]) for j, c in enumerate(self.taps)) / self.dt
-        u = self.Kp * (r - x) - self.Kd * v + (0.0 if extra is None else extra)
-        return np.clip(u, -self.limit, self.limit)
+def _memory(loop: DigitalLoop, x0: float) -> np.ndarray:
+    """The controller's memory before the record: at rest at ``x0``, no error, no force."""
+    if not loop.linear:
+        return np.full(len(loop.taps), x0)
+    return np.zeros(len(loop.num) + len(loop.den) - 2)
 
 
 def _loop_function(model: FrictionModel, loop: DigitalLoop, space: Any, n_sub: int, mass_free: bool
@@ -116,30 +79,25 @@ def _loop_function(model: FrictionModel, loop: DigitalLoop, space: Any, n_sub: i
     """One sample of the loop with forward sensitivities: ``(c, r, e, theta, scale, fixed, mass) -> c+, out``."""
     from prefriction.identify.motion_step import _units_function, step_function
 
-    nz = model.n_states
-    ny = 2 + nz
-    nt, nd = len(loop.taps), loop.delay
+    ny, nd, nm = 2 + model.n_states, loop.delay, _memory(loop, 0.0).size
     step = step_function(model, n_sub)
     units = _units_function(model, space, mass_free)
     nth = space.n_free
     y = ca.SX.sym("y", ny)
     s = ca.SX.sym("s")
-    hist = ca.SX.sym("hist", nt)     # x_{k-1}, ..., x_{k-nt}
+    mem = ca.SX.sym("mem", nm)       # the controller's memory
     uh = ca.SX.sym("uh", nd)         # u_{k-1}, ..., u_{k-d}
     r, e = ca.SX.sym("r"), ca.SX.sym("e")
     theta, scale = ca.SX.sym("theta", nth), ca.SX.sym("scale", nth)
     fixed, mass = ca.SX.sym("fixed", len(space.fixed)), ca.SX.sym("mass")
     pp = units(theta, scale, fixed, mass)
-    xs = ca.vertcat(y[0], hist)
-    v = sum(c * (xs[j] - xs[j + 1]) for j, c in enumerate(loop.taps)) / loop.dt
-    u = loop.Kp * (r - y[0]) - loop.Kd * v + e
+    u, mem1 = _controller(loop, y[0], mem, r, e)
     if math.isfinite(loop.limit):
         u = ca.fmin(ca.fmax(u, -loop.limit), loop.limit)
     applied = uh[nd - 1] if nd else u
     y1 = step(ca.vertcat(y, s), applied, applied, loop.dt, pp)
-    cont = ca.vertcat(y, hist, uh)
-    cont1 = ca.vertcat(y1[:ny], y[0], *[hist[j] for j in range(nt - 1)],
-                       *([u] + [uh[j] for j in range(nd - 1)] if nd else []))
+    cont = ca.vertcat(y, mem, uh)
+    cont1 = ca.vertcat(y1[:ny], *mem1, *([u] + [uh[j] for j in range(nd - 1)] if nd else []))
     S = ca.SX.sym("S", cont.numel(), nth)
     S1 = ca.mtimes(ca.jacobian(cont1, cont), S) + ca.jacobian(cont1, theta)
     out = ca.vertcat(y[0], u)
@@ -172,8 +130,8 @@ class _Simulator:
         vals = self.space.values(theta)
         start = self.space.build(vals)
         z0, _ = start.initial_state(0.0, 1.0)
-        nz, nt, nd, nth = self.model.n_states, len(self.loop.taps), self.loop.delay, self.space.n_free
-        cont = np.concatenate(([x0, 0.0], np.asarray(z0, dtype=float)[:nz], np.full(nt, x0), np.zeros(nd)))
+        nz, nd, nth = self.model.n_states, self.loop.delay, self.space.n_free
+        cont = np.concatenate(([x0, 0.0], np.asarray(z0, dtype=float)[:nz], _memory(self.loop, x0), np.zeros(nd)))
         c0 = np.concatenate((cont, [1.0], np.zeros(self.nc * nth)))
         _, O = self.acc(c0, r[None, :], e[None, :], theta, self.space.scale, self.space.fixed_values(), mass)
         O = np.asarray(O)

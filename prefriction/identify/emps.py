@@ -195,7 +195,8 @@ def benchmark(directory: str | os.PathLike, *, starts: tuple[float, ...] = (1.0,
     import warnings
 
     import prefriction as pf
-    from prefriction.identify.closed_loop_fit import DigitalLoop, fit_closed_loop
+    from prefriction.identify.closed_loop_fit import fit_closed_loop
+    from prefriction.identify.digital_loop import DigitalLoop
     from prefriction.identify.inverse import fit_inverse
     from prefriction.identify.routes import recommend
     from prefriction.identify.static_map import StaticFriction
