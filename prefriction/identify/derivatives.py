@@ -26,6 +26,7 @@ scripts' ``round(0.8 fnyq / (0.4 fc))``); ``border = 5 fs / fc - 1`` (EMPS: 49);
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 from typing import Any
 
@@ -42,16 +43,23 @@ def filtfilt(b: np.ndarray, a: np.ndarray, x: np.ndarray) -> np.ndarray:
     return signal.filtfilt(b, a, x, padtype="odd", padlen=3 * (max(len(a), len(b)) - 1))
 
 
+@functools.lru_cache(maxsize=16)
+def _cheby(step: int) -> tuple[np.ndarray, np.ndarray]:
+    return signal.cheby1(8, 0.05, 0.8 / step)
+
+
 def decimate(x: np.ndarray, step: int) -> np.ndarray:
     """``x`` low-passed (Chebyshev I, order 8, ripple 0.05 dB, cut-off ``0.8 / step`` of Nyquist,
-    zero phase) and every ``step``-th sample kept, ending at the last (MATLAB's ``decimate``)."""
+    zero phase) and every ``step``-th sample kept, ending at the last (MATLAB's ``decimate``);
+    along the first axis of a 2-D ``x`` (columns)."""
     x = np.asarray(x, dtype=float)
     if step == 1:
         return x.copy()
-    b, a = signal.cheby1(8, 0.05, 0.8 / step)
-    y = filtfilt(b, a, x)
-    n_out = -(-x.size // step)
-    return y[step - (step * n_out - x.size) - 1::step]
+    b, a = _cheby(step)
+    y = signal.filtfilt(b, a, x, axis=0, padtype="odd", padlen=3 * (max(len(a), len(b)) - 1))
+    n = x.shape[0]
+    n_out = -(-n // step)
+    return y[step - (step * n_out - n) - 1::step]
 
 
 def _central(y: np.ndarray, dt: float) -> np.ndarray:
@@ -99,7 +107,7 @@ class Derivatives:
         return slice(self.border, self.t.size - self.tail)
 
     def regress(self, column: np.ndarray) -> np.ndarray:
-        """A signal at every sample, border dropped and decimated (a column of the regression)."""
+        """A signal at every sample (or columns of them), border dropped and decimated."""
         return decimate(np.asarray(column, dtype=float)[self.keep], self.step)
 
     def summary(self) -> str:

@@ -106,7 +106,7 @@ def static_inverse(data: Motion, deriv: Derivatives | None = None, *, directiona
     else:
         names = ["mass", "b", "Fc"] + (["offset"] if offset else [])
         cols = [d.a, d.v, s] + ([np.ones_like(s)] if offset else [])
-    X = np.column_stack([d.regress(c) for c in cols])
+    X = d.regress(np.column_stack(cols))
     beta = np.linalg.lstsq(X, d.regress(data.u), rcond=None)[0]
     out = {"offset": 0.0, **{n: float(b) for n, b in zip(names, beta)}}
     return out
@@ -212,7 +212,10 @@ def fit_inverse(model: FrictionModel | StaticFriction, data: Motion, *, offset: 
     d = derivatives(data.t, data.x) if deriv is None else deriv
     notes = [d.summary()] + ([f"force delayed by {delay:g} sample(s)"] if delay else [])
     mass_free = data.mass is None
-    if mass_free and mass0 is None:
+    closed_form = isinstance(model, StaticFriction) and model.Fs is None
+    if mass_free and mass0 is None and closed_form:
+        mass0 = 1.0   # only the scale of the mass column: the closed form needs no start
+    elif mass_free and mass0 is None:
         mass0 = static_inverse(data, d, offset=offset)["mass"]
         notes.append(f"mass started at the closed-form inverse model's {mass0:.6g} kg")
     if isinstance(model, StaticFriction):
@@ -297,7 +300,7 @@ class _StaticProblem:
         F, Jm = self._map(vals).force_and_jacobian(self.d.v)
         key = tuple(np.round(theta, 15))
         if key not in self._cache:
-            self._cache = {key: np.column_stack([self.d.regress(c) for c in np.column_stack([F, Jm]).T])}
+            self._cache = {key: self.d.regress(np.column_stack([F, Jm]))}
         return self._cache[key][:, 0], self._cache[key][:, 1:]
 
     def force(self, theta: np.ndarray) -> np.ndarray:
