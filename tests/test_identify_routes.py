@@ -237,19 +237,36 @@ def test_emps_loader_reads_own_files_and_refuses_links(tmp_path):
 EMPS_DIR = os.environ.get("PREFRICTION_EMPS_DIR")
 
 
+@pytest.mark.skipif(not EMPS_DIR, reason="PREFRICTION_EMPS_DIR does not name a directory with the EMPS files")
+def test_emps_inverse_model_reproduced_and_dahl_holds_it_from_every_start():
+    from prefriction.identify.emps import PUBLISHED, load, open_loop_rmse
+
+    est, pulses = load(EMPS_DIR)
+    data = est.motion()
+    res = identify.fit_inverse(identify.StaticFriction(Fc=1.0, b=1.0), data)
+    for name, value in PUBLISHED.items():  # Script_IDIM_LS.m's numbers, every printed digit
+        assert round(res.estimate(name), 4) == pytest.approx(value, abs=1e-12)
+    assert identify.recommend(data).route == "inverse"
+    P = PUBLISHED
+    for f in (1.0, 0.5, 2.0):
+        model = pf.Dahl(sigma=f * 5e6, Fc=f * P["Fc"]) + pf.Viscous(f * P["b"])
+        fit = identify.fit_inverse(model, data, fixed=["gamma"], mass0=f * P["mass"], offset0=f * P["offset"])
+        for name, value in P.items():
+            lo, hi = fit.interval(name)
+            assert lo <= value <= hi, (f, name, fit.report())
+    assert open_loop_rmse(fit, pulses) < open_loop_rmse(res, pulses)
+
+
 @pytest.mark.slow
 @pytest.mark.skipif(not EMPS_DIR, reason="PREFRICTION_EMPS_DIR does not name a directory with the EMPS files")
 def test_emps_routes_hold_the_published_values():
-    from prefriction.identify.emps import PUBLISHED, benchmark, load
+    from prefriction.identify.emps import benchmark
 
-    est, _ = load(EMPS_DIR)
-    res = identify.fit_inverse(identify.StaticFriction(Fc=1.0, b=1.0), est.motion())
-    for name, value in PUBLISHED.items():  # Script_IDIM_LS.m's numbers, every printed digit
-        assert round(res.estimate(name), 4) == pytest.approx(value, abs=1e-12)
     rows = benchmark(EMPS_DIR)
     published = next(r for r in rows if r.route == "published")
-    dynamic = [r for r in rows if r.model == "Dahl + Viscous"]
-    assert {r.start for r in dynamic if r.route == "inverse"} == {"1 x", "0.5 x", "2 x"}
+    dynamic = [r for r in rows if r.model.startswith("Dahl + Viscous")]
+    assert {(r.route, r.start) for r in dynamic} == {(route, f) for route in ("inverse", "closed-loop")
+                                                     for f in ("1 x", "0.5 x", "2 x")}
     for r in dynamic:
         assert all(r.holds().values()), r
     assert min(r.rmse for r in dynamic) < published.rmse
