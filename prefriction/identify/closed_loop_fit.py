@@ -139,7 +139,8 @@ class _Simulator:
 
 
 def simulate_closed_loop(model: FrictionModel, loop: DigitalLoop, t: Any, r: Any, *, mass: float, offset: float = 0.0,
-                         x0: float | None = None, extra: Any = None, substeps: int = 2) -> tuple[np.ndarray, np.ndarray]:
+                         x0: float | None = None, extra: Any = None, substeps: int = 2
+                         ) -> tuple[np.ndarray, np.ndarray]:
     """Positions [m] and forces [N] of ``model`` on a mass in ``loop`` following the reference ``r``.
 
     Parameters

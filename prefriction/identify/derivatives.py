@@ -151,7 +151,8 @@ def derivatives(t: Any, x: Any, *, cutoff: float | None = None, order: int = 4, 
     t = np.asarray(t, dtype=float)
     x = np.asarray(x, dtype=float)
     if t.ndim != 1 or x.shape != t.shape or t.size < 20:
-        raise ValueError(f"t and x must be 1-D of the same length, at least 20 samples, got shapes {t.shape} and {x.shape}")
+        raise ValueError(f"t and x must be 1-D of the same length, at least 20 samples, got shapes {t.shape} and "
+                         f"{x.shape}")
     dts = np.diff(t)
     dt = float(np.mean(dts))
     if not dt > 0 or np.ptp(dts) > 1e-3 * dt:

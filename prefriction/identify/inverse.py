@@ -156,7 +156,8 @@ def inverse_start(model: FrictionModel | StaticFriction, data: Motion, deriv: De
 def fit_inverse(model: FrictionModel | StaticFriction, data: Motion, *, offset: bool = True,
                 directional: bool = False, free: Any = None, fixed: Any = None, bounds: dict | None = None,
                 mass0: float | None = None, offset0: float = 0.0, deriv: Derivatives | None = None,
-                delay: float = 0.0, max_iter: int = 200, tol: float = 1e-10, identifiability_limit: float = 0.5) -> FitResult:
+                delay: float = 0.0, max_iter: int = 200, tol: float = 1e-10,
+                identifiability_limit: float = 0.5) -> FitResult:
     """Fit mass, offset and friction to a driven-mass record by the inverse model (1).
 
     Parameters
