@@ -207,6 +207,10 @@ def test_bad_arguments_are_named(record):
         identify.fit_closed_loop(TRUE, data, LOOP, ref[:-1], mass0=95.0)
     with pytest.raises(ValueError, match="give mass0"):
         identify.fit_closed_loop(TRUE, data, LOOP, ref)
+    with pytest.raises(ValueError, match="tol must be in"):
+        identify.fit_inverse(identify.StaticFriction(Fc=1.0), data, tol=1.0)
+    with pytest.raises(ValueError, match="max_iter"):
+        identify.fit_closed_loop(TRUE, data, LOOP, ref, mass0=95.0, max_iter=0)
     with pytest.raises(ValueError, match="taps"):
         identify.DigitalLoop(1e-3, 1.0, 1.0, taps=())
     with pytest.raises(ValueError, match="delay"):

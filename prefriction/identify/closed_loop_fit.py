@@ -39,7 +39,7 @@ from prefriction.identify.data import Motion
 from prefriction.identify.digital_loop import DigitalLoop
 from prefriction.identify.hac import sandwich
 from prefriction.identify.result import FitResult
-from prefriction.identify.statistics import IdentifiabilityWarning, at_bounds, gauss_newton
+from prefriction.identify.statistics import ConvergenceWarning, IdentifiabilityWarning, at_bounds, gauss_newton
 from prefriction.models.base import FrictionModel
 
 __all__ = ["fit_closed_loop", "simulate_closed_loop"]
@@ -237,6 +237,9 @@ def fit_closed_loop(model: FrictionModel, data: Motion, loop: DigitalLoop, refer
         raise TypeError(f"model must be a prefriction.FrictionModel, got {type(model).__name__}")
     if not isinstance(data, Motion):
         raise TypeError(f"data must be prefriction.identify.Motion, got {type(data).__name__}")
+    from prefriction.identify.inverse import _check_solver
+
+    _check_solver(max_iter, tol, identifiability_limit)
     if not isinstance(loop, DigitalLoop):
         raise TypeError(f"loop must be a DigitalLoop (the known controller), got {type(loop).__name__}")
     r = np.asarray(reference, dtype=float)
@@ -301,6 +304,9 @@ def fit_closed_loop(model: FrictionModel, data: Motion, loop: DigitalLoop, refer
     low, high, flags = at_bounds(names, est, stats.low, stats.high, space.scale, lows, highs,
                                  {n: space.why_low.get(n, "the declared range") for n in names},
                                  {n: space.why_high.get(n, "the declared range") for n in names})
+    if not sol.status > 0:
+        warnings.warn(f"fit_closed_loop stopped without converging ({sol.message}); the estimates are its last: "
+                      f"raise max_iter or start closer (identify.inverse_start)", ConvergenceWarning, stacklevel=2)
     vals = space.values(theta)
     fitted_mass = vals["mass"] if data.mass is None else float(data.mass)
     x_sim, u_sim, _, _ = sim.run(theta, float(data.x[0]), r, e, mass)

@@ -38,7 +38,7 @@ from prefriction.identify.hac import sandwich
 from prefriction.identify.derivatives import Derivatives, derivatives
 from prefriction.identify.result import FitResult
 from prefriction.identify.static_map import StaticFriction
-from prefriction.identify.statistics import IdentifiabilityWarning, at_bounds, gauss_newton
+from prefriction.identify.statistics import ConvergenceWarning, IdentifiabilityWarning, at_bounds, gauss_newton
 from prefriction.models.base import FrictionModel
 
 __all__ = ["applied", "fit_inverse", "inverse_start", "static_inverse"]
@@ -73,6 +73,17 @@ def applied(data: Motion, delay: float) -> Motion:
     k = np.arange(len(data)) - delay
     u = np.interp(k, np.arange(len(data)), data.u)   # held at u[0] before the record
     return Motion(data.t, data.x, u, data.mass, hold=data.hold)
+
+
+def _check_solver(max_iter: Any, tol: Any, limit: Any) -> None:
+    """The solver options' ranges, as :func:`prefriction.identify.fit` checks them."""
+    from prefriction._validation import check_count, check_positive
+    from prefriction.identify.fit import MAX_ITER, TOL_RANGE
+
+    check_count("max_iter", max_iter, 1, MAX_ITER, "solver iterations")
+    if not TOL_RANGE[0] <= check_positive("tol", tol) <= TOL_RANGE[1]:
+        raise ValueError(f"tol must be in [{TOL_RANGE[0]:g}, {TOL_RANGE[1]:g}], got {tol!r}")
+    check_positive("identifiability_limit", limit)
 
 
 def static_inverse(data: Motion, deriv: Derivatives | None = None, *, directional: bool = False,
@@ -209,6 +220,7 @@ def fit_inverse(model: FrictionModel | StaticFriction, data: Motion, *, offset: 
     from scipy.optimize import least_squares
 
     _check(model, data)
+    _check_solver(max_iter, tol, identifiability_limit)
     data = applied(data, delay)
     d = derivatives(data.t, data.x) if deriv is None else deriv
     notes = [d.summary()] + ([f"force delayed by {delay:g} sample(s)"] if delay else [])
@@ -261,6 +273,8 @@ def fit_inverse(model: FrictionModel | StaticFriction, data: Motion, *, offset: 
     notes.append(f"residual lag-1 autocorrelation {rho:.3f} after decimation: Newey-West standard errors, lag {lag}")
     if not success:
         notes.append(f"the solver stopped without converging ({message}); the estimates are its last")
+        warnings.warn(f"fit_inverse stopped without converging ({message}); raise max_iter or start closer "
+                      f"(inverse_start)", ConvergenceWarning, stacklevel=2)
     fitted_model, mass = problem.build(theta)
     # the data of the result: the friction force the fit explains, u - m a, at the decimated samples [N]
     force = ForceDisplacement(d.regress(d.t), d.regress(d.x), y - mass * problem.acceleration)
