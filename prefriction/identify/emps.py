@@ -1,4 +1,4 @@
-"""The EMPS benchmark as an opt-in check of the identification routes (``docs/identify.md#emps``).
+"""The EMPS benchmark as an opt-in check of the identification routes (``docs/identify_closed_loop.md#emps``).
 
 EMPS (Janot, Gautier and Brunot, *Data set and reference models of EMPS*, Workshop on Nonlinear
 System Identification Benchmarks, 2019): a 95 kg ball-screw stage under a PD position loop at
@@ -14,7 +14,9 @@ position, RMSE after a 20-sample warm-up, against the published rigid-body inver
 same replay. Rigid-body models are replayed by classical Runge-Kutta with 10 steps per sample
 (as the reference Simulink model: ode45, largest step ``dt / 10``), friction models by
 :func:`prefriction.identify.motion_predict.predict_motion` (both from rest at the first
-measured position, the force held over each sample).
+measured position, the force held over each sample). And by the drift-free check of
+``Simulation_EMPS_Validation.m``: the model inside the loop following the pulses record's
+reference with its pulses (:func:`loop_rmse`).
 """
 
 from __future__ import annotations
