@@ -292,7 +292,7 @@ class _Published:
 
 def format_table(rows: list[Row]) -> str:
     """A Markdown table of the rows: estimates [95 % interval] of M, Fv, Fc, offset, the metric, the time."""
-    head = ("| route | model | start | M [kg] | Fv [N s/m] | Fc [N] | offset [N] | pulses RMSE [mm] | in the loop [mm] "
+    head = ("| route | model | start | M [kg] | Fv [N s/m] | Fc [N] | offset [N] | pulses RMSE [mm] | in the loop [um] "
             "| time [s] |\n|---|---|---|---|---|---|---|---|---|---|")
     lines = [head]
     for r in rows:
@@ -306,7 +306,7 @@ def format_table(rows: list[Row]) -> str:
             ok = "" if not comparable else (" ✓" if lo <= PUBLISHED[n] <= hi else " ✗")
             cells.append(f"{v:.4f}" if r.route == "published" else f"{v:.4g} [{lo:.4g}, {hi:.4g}]{ok}")
         rmse = "-" if not np.isfinite(r.rmse) else f"{1e3 * r.rmse:.3f}"
-        in_loop = "-" if not np.isfinite(r.loop_rmse) else f"{1e6 * r.loop_rmse:.2f} um"
+        in_loop = "-" if not np.isfinite(r.loop_rmse) else f"{1e6 * r.loop_rmse:.2f}"
         sec = "-" if r.seconds == 0.0 else f"{r.seconds:.1f}"
         extra = [f"{n} {r.estimates[n][0]:.4g} [{r.estimates[n][1]:.4g}, {r.estimates[n][2]:.4g}]"
                  for n in ("sigma", "b_neg", "Fc_neg") if n in r.estimates]
