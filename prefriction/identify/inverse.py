@@ -286,11 +286,9 @@ def fit_inverse(model: FrictionModel | StaticFriction, data: Motion, *, offset: 
 class _StaticProblem:
     """Residual columns of a static map (analytic Jacobian; linear without a Stribeck term)."""
 
-    analytic = True
-
     def __init__(self, model: StaticFriction, d: Derivatives, data: Motion, offset: bool, mass_free: bool,
                  mass0: float | None, offset0: float) -> None:
-        self.model, self.d, self.mass_free, self.offset = model, d, mass_free, offset
+        self.model, self.d, self.mass_free = model, d, mass_free
         self.mass_known = data.mass
         self.names = (["mass"] if mass_free else []) + list(model.names) + (["offset"] if offset else [])
         start = {**model.values(), "mass": mass0, "offset": offset0}
@@ -362,7 +360,6 @@ class _DynamicProblem:
     """Residual (1) of a dynamic model along the filtered motion (finite-difference Jacobian)."""
 
     linear = False
-    analytic = False
 
     def __init__(self, model: FrictionModel, d: Derivatives, data: Motion, offset: bool, free: Any, fixed: Any,
                  bounds: Any, mass_free: bool, mass0: float | None, offset0: float) -> None:
