@@ -138,6 +138,21 @@ class _Simulator:
         return O[0], O[1], O[2:2 + nth].T, O[2 + nth:2 + 2 * nth].T
 
 
+def _series(name: str, value: Any, n: int, unit: str) -> np.ndarray:
+    """A finite 1-D array of ``n`` samples, or a ValueError naming it."""
+    arr = np.asarray(value, dtype=float)
+    if arr.shape != (n,) or not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} must be finite [{unit}] with one value per sample ({n}), got shape {arr.shape}")
+    return arr
+
+
+def _check_spacing(t: np.ndarray, loop: DigitalLoop) -> None:
+    dts = np.diff(t)
+    if dts.size == 0 or np.max(np.abs(dts - loop.dt)) > 1e-3 * loop.dt:
+        raise ValueError(f"the sample interval of t ({dts.min(initial=0.0):.6g} to {dts.max(initial=0.0):.6g} s) "
+                         f"is not loop.dt = {loop.dt!r} s")
+
+
 def simulate_closed_loop(model: FrictionModel, loop: DigitalLoop, t: Any, r: Any, *, mass: float, offset: float = 0.0,
                          x0: float | None = None, extra: Any = None, substeps: int = 2
                          ) -> tuple[np.ndarray, np.ndarray]:
@@ -169,8 +184,12 @@ def simulate_closed_loop(model: FrictionModel, loop: DigitalLoop, t: Any, r: Any
     """
     from prefriction.identify.parameters import ParameterSpace
 
-    r = np.asarray(r, dtype=float)
-    e = np.zeros_like(r) if extra is None else np.asarray(extra, dtype=float)
+    if not isinstance(loop, DigitalLoop):
+        raise TypeError(f"loop must be a DigitalLoop (the known controller), got {type(loop).__name__}")
+    t = np.asarray(t, dtype=float)
+    r = _series("r", r, t.size, "m")
+    _check_spacing(t, loop)
+    e = np.zeros_like(r) if extra is None else _series("extra", extra, t.size, "N")
     space = ParameterSpace(model, None, None, None, offset=1.0)
     sim = _Simulator(model, loop, space, r.size, check_count("substeps", substeps, 1, 64), False)
     theta = space.theta0.copy()
@@ -242,16 +261,11 @@ def fit_closed_loop(model: FrictionModel, data: Motion, loop: DigitalLoop, refer
     _check_solver(max_iter, tol, identifiability_limit)
     if not isinstance(loop, DigitalLoop):
         raise TypeError(f"loop must be a DigitalLoop (the known controller), got {type(loop).__name__}")
-    r = np.asarray(reference, dtype=float)
-    if r.shape != data.t.shape or not np.all(np.isfinite(r)):
-        raise ValueError(f"reference must be finite with one value per sample ({data.t.size}), got shape {r.shape}")
-    dts = np.diff(data.t)
-    if np.max(np.abs(dts - loop.dt)) > 1e-3 * loop.dt:
-        raise ValueError(f"the record's sample interval ({dts.min():.6g} to {dts.max():.6g} s) is not loop.dt = "
-                         f"{loop.dt!r} s")
+    r = _series("reference", reference, data.t.size, "m")
+    _check_spacing(data.t, loop)
     if data.mass is None and mass0 is None:
         raise ValueError("data.mass is None: give mass0 (e.g. from identify.inverse.inverse_start)")
-    e = np.zeros_like(r) if extra is None else np.asarray(extra, dtype=float)
+    e = np.zeros_like(r) if extra is None else _series("extra", extra, data.t.size, "N")
     fscale = max(float(np.std(data.u)), 1e-300)
     space = ParameterSpace(model, name_list("free", free), name_list("fixed", fixed), bounds,
                            mass=mass0 if data.mass is None else None, offset=fscale if offset else None)
