@@ -161,6 +161,8 @@ def test_inverse_route_recovers_the_truth(record):
         assert lo <= TRUTH[name] <= hi, (name, res.report())
     assert res.statistics.sigma_hat < rigid.statistics.sigma_hat  # the presliding model explains more
     assert isinstance(res.data, identify.ForceDisplacement) and "Newey-West" in res.notes[-1]
+    via_fit = identify.fit(identify.StaticFriction(Fc=1.0, b=1.0), data, offset=True)   # dispatched to the route
+    assert via_fit.notes[0] == "route: inverse model" and via_fit.names == ("mass", "Fc", "b", "offset")
 
 
 def test_recommend_names_the_route():
