@@ -239,6 +239,8 @@ def design_pd(
         raise ValueError(
             f"wn must be >= sqrt(sigma/m) = {math.sqrt(k / m):.6g} rad/s for a pre-sliding PD design "
             f"(kp = m wn^2 - sigma >= 0), got wn={wn!r}"
+            f"; wn is in rad/s (2 pi f for a bandwidth of f Hz). For a slower loop design on the sliding "
+            f"linearisation 1/(m s^2), which has no lower limit: regime=\"sliding\""
         )
     ctrl = PID(kp=kp, kd=2.0 * zeta * wn * m, tau=1.0 / (N * wn))
     warn_if_unstable(closed_loop(system, ctrl, regime=regime, warn=False), what=f"PD design ({regime})", stacklevel=2)
@@ -289,6 +291,8 @@ def design_pid(
         raise ValueError(
             f"wn must be >= sqrt(sigma / (m (1 + 2 zeta alpha))) = {wmin:.6g} rad/s for a pre-sliding "
             f"PID design (kp >= 0), got wn={wn!r}"
+            f"; wn is in rad/s (2 pi f for a bandwidth of f Hz). For a slower loop design on the sliding "
+            f"linearisation 1/(m s^2), which has no lower limit: regime=\"sliding\""
         )
     ctrl = PID(
         kp=kp, ki=m * alpha * wn ** 3, kd=m * (2.0 * zeta + alpha) * wn, tau=1.0 / (N * wn),

@@ -259,7 +259,7 @@ def simulate_loop(
         else:
             comp = None
             if compensator is not None:
-                tk = Ts * np.arange(n_samples)
+                tk = Ts * np.arange(n_samples + 1)  # one past the end: the last sample's force
                 params, state0 = compensator.numbers(system.mass, Ts, x0)
                 comp = Compensation(compensator.structure(), params, state0,
                                     reference_velocity(reference, tk, _evaluate(reference, tk), Ts))

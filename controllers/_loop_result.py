@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Optional
 
 import control
@@ -151,11 +152,18 @@ class LoopResult:
 
     @property
     def settling_time(self) -> float:
-        """Settling time [s] into a 2 % band (:meth:`settling_time_within` with ``band = 0.02``)."""
+        """Settling time [s] into a 2 % band of the reference's travel (:meth:`settling_time_within`
+        with ``band = 0.02``)."""
         return self.settling_time_within(0.02)
 
     def settling_time_within(self, band: float) -> float:
-        """First time [s] after which ``x`` stays within ``band`` of the step around its final value.
+        """First time [s] after which the error ``|r - x|`` stays within ``band`` of the reference's travel.
+
+        Measured against the reference, not the final position: the travel is
+        ``max |r(t) - x(0)|`` over the run (a step's height, a move's distance, a sine's peak
+        excursion from the start), and the loop has settled once ``|r - x| <= band * travel`` at
+        every later output sample. A PD loop that stops short of the target by more than the
+        band never settles; a tracking loop settles once its error stays small.
 
         Parameters
         ----------
@@ -165,18 +173,36 @@ class LoopResult:
         Returns
         -------
         float
-            The time [s]; the step is ``|x[-1] - x[0]|`` (not the reference: a PD loop with
-            friction stops short); ``nan`` if the position does not move.
+            The time [s]; ``inf`` if the error is outside the band at the last output sample
+            (not settled within the run), ``nan`` if the reference never leaves ``x(0)``.
         """
         band = check_positive("band", band)
-        step = abs(self.x[-1] - self.x[0])
-        if step == 0.0:
+        travel = float(np.max(np.abs(self.reference - self.x[0])))
+        if travel == 0.0:
             return math.nan
-        outside = np.nonzero(np.abs(self.x - self.x[-1]) > band * step)[0]
+        outside = np.nonzero(np.abs(self.error) > band * travel)[0]
         if outside.size == 0:
             return float(self.t[0])
-        k = outside[-1] + 1
-        return float(self.t[min(k, len(self.t) - 1)])
+        if outside[-1] == len(self.t) - 1:
+            return math.inf
+        return float(self.t[outside[-1] + 1])
+
+    def plot(self, path: "str | Path" = "loop.png") -> Path:
+        """Reference and position, the tracking error and the forces against time, saved to ``path``.
+
+        Parameters
+        ----------
+        path : str or Path, default "loop.png"
+            Image file to write (the format from the suffix).
+
+        Returns
+        -------
+        Path
+            The file written.
+        """
+        from prefriction._result_plots import plot_loop
+
+        return plot_loop(self, path)
 
     def __reduce__(self) -> tuple:
         """Pickle the controller as its matrices (python-control's StateSpace holds a lambda)."""
@@ -199,7 +225,7 @@ class LoopResult:
             f"closed loop ({kind}), t_end = {self.t[-1]:.6g} s, {len(self.t)} output samples",
             f"  reference at t_end      {self.reference[-1]: .6e} m",
             f"  position at t_end       {self.x[-1]: .6e} m",
-            f"  settling time (2 %)     {self.settling_time:.6g} s",
+            f"  settling time (2 %)     {self.settling_time:.6g} s  (|r - x| within 2 % of the reference's travel)",
             f"  residual error r - x    {self.residual_error: .6e} m",
         ]
         if self.error_bound is not None:

@@ -13,6 +13,7 @@ import prefriction.optimal.problem
 import prefriction.optimal.references
 import prefriction.signals.hold
 import prefriction.symbolic.branch
+import prefriction.symbolic.model
 import prefriction.symbolic.plant
 
 def _blocks(page: str) -> list[tuple[str, str]]:
@@ -37,10 +38,10 @@ def test_doc_block_prints_what_the_page_shows(page, k, code, shown):
 
 
 def test_every_page_has_its_blocks():
-    assert len(_blocks("symbolic.md")) == 3 and len(_blocks("optimal.md")) == 3
+    assert len(_blocks("symbolic.md")) == 4 and len(_blocks("optimal.md")) == 3
 
 
-@pytest.mark.parametrize("module", [prefriction.symbolic.branch, prefriction.symbolic.plant, prefriction.signals.hold,
+@pytest.mark.parametrize("module", [prefriction.symbolic.branch, prefriction.symbolic.model, prefriction.symbolic.plant, prefriction.signals.hold,
                                     prefriction.optimal.problem, prefriction.optimal.references])
 def test_docstring_examples(module):
     result = doctest.testmod(module, optionflags=doctest.ELLIPSIS)

@@ -77,7 +77,11 @@ class FrictionObserver(Compensator):
     ``x3^``. Design (the dominant, slowest pole): the poles at rest (``beta = 0``) are
     ``-p`` and ``-p_fast``: ``l1 = p + p_fast``, ``l2 = sigma - m p p_fast``. The eigenvalues
     of ``M(t)`` stay real and negative for every ``beta`` in ``[0, (sqrt(p_fast) -
-    sqrt(p))^2]``, i.e. up to the speed :attr:`max_velocity`.
+    sqrt(p))^2]``, i.e. up to the speed :attr:`max_velocity`, and again for ``beta >=
+    (sqrt(p_fast) + sqrt(p))^2``; in the band between they are a complex pair with a negative real
+    part. No condition on how fast ``beta(t)`` varies (which the stability of the time-varying
+    error system needs) is computed or checked. The equations are reconstructed from the papers'
+    abstracts, not taken from them (``docs/compensation.md#friction-observer``).
 
     Assumptions (stated as in the abstract of the 2025 paper; the paper's equation numbers
     could not be read here, see ``docs/compensation.md``): only the displacement is measured;

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Optional
 
 import numpy as np
@@ -76,6 +77,23 @@ class PointToPointResult:
         if self.replay is not None:
             lines.append(self.replay.summary())
         return "\n".join(lines)
+
+    def plot(self, path: "str | Path" = "move.png") -> "Path":
+        """The planned position, velocity and force (and the replay through the simulator), saved to ``path``.
+
+        Parameters
+        ----------
+        path : str or Path, default "move.png"
+            Image file to write (the format from the suffix).
+
+        Returns
+        -------
+        Path
+            The file written.
+        """
+        from prefriction._result_plots import plot_move
+
+        return plot_move(self, path)
 
     def __repr__(self) -> str:
         miss = "" if self.replay is None else f", miss={self.replay.x_error:.3g} m"

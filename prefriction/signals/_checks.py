@@ -31,3 +31,21 @@ def number(name: str, value: Any, unit: str, rule: str = "", ok: Callable[[float
 def time_end(t_end: Any) -> float:
     """``t_end`` [s] of a signal's :meth:`~prefriction.signals.Signal.bound` as a float ``>= 0``."""
     return number("t_end", t_end, "s", ">= 0", lambda v: v >= 0.0)
+
+
+def hertz(name: str, value: Any, rule: str, ok: Callable[[float], bool]) -> float:
+    """A frequency in Hz (``number`` with the unit), refusing a value in rad/s by mistake.
+
+    Signals take cycles per second (Hz); controller designs and python-control take rad/s. A value
+    that is exactly ``2 pi`` times a number with at most two decimals (``2 * math.pi * 150``,
+    942.4778 "Hz"; up to 2 pi 1e4, where such a coincidence is still telling) is almost surely an
+    angular frequency passed where Hz belong: refused, with both readings
+    (``docs/conventions.md#frequencies``).
+    """
+    v = number(name, value, "Hz", rule, ok)
+    cycles = v / (2.0 * math.pi) * 100.0
+    if 0.0 < cycles <= 1e6 and round(cycles) > 0 and abs(cycles - round(cycles)) <= 1e-11 * cycles:
+        raise ValueError(f"{name}={v!r} Hz is 2 pi x {round(cycles) / 100:g}: it looks like an angular frequency "
+                         f"[rad/s]. Signals take Hz (cycles per second): pass {name}={round(cycles) / 100:g} for "
+                         f"{round(cycles) / 100:g} Hz, or {name}={v!r} / (2 * math.pi) if {v!r} rad/s was meant")
+    return v

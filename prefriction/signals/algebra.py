@@ -79,6 +79,11 @@ class Sum(Signal):
         value = sum(np.asarray(term(t), dtype=float) for term in self.terms)
         return float(value) if np.ndim(value) == 0 else value
 
+    def velocity(self, t: Any) -> Union[float, np.ndarray]:
+        """Time derivative [signal units / s] at the time(s) ``t`` [s]: the sum of the terms' (:meth:`Signal.velocity`)."""
+        value = sum(np.asarray(term.velocity(t), dtype=float) for term in self.terms)
+        return float(value) if np.ndim(value) == 0 else value
+
     def breaks(self) -> np.ndarray:
         """Union of the terms' breaks: sorted unique times [s]."""
         return np.unique(np.concatenate([np.zeros(0)] + [term.breaks() for term in self.terms]))

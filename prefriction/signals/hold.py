@@ -90,6 +90,11 @@ class ZeroOrderHold(LinearPieces):
         value = self._value(check_real_array("t", t, "s"))
         return float(value) if np.ndim(value) == 0 else value
 
+    def velocity(self, t: Any) -> Union[float, np.ndarray]:
+        """0 [signal units / s] at every time ``t`` [s]: the held values jump, they do not slope."""
+        value = np.zeros(np.shape(check_real_array("t", t, "s")))
+        return float(value) if value.ndim == 0 else value
+
     def breaks(self) -> np.ndarray:
         """Copy of the switching times :attr:`t` [s], where the value jumps."""
         return self._t.copy()

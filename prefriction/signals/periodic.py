@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from prefriction.signals._checks import UNIT, number, time_end
+from prefriction.signals._checks import UNIT, hertz, number, time_end
 from prefriction.signals.base import Analytic
 
 __all__ = ["Chirp", "Sine"]
@@ -21,7 +21,8 @@ class Sine(Analytic):
     amplitude : float
         Amplitude [signal units].
     frequency : float
-        Frequency [Hz], ``> 0``.
+        Frequency [Hz] (cycles per second, not rad/s: ``docs/conventions.md#frequencies``), ``> 0``;
+        a value of exactly ``2 pi`` times a round number is refused as a likely angular frequency.
     phase : float, optional
         Phase at ``t = 0`` [rad], default 0.
     offset : float, optional
@@ -34,7 +35,7 @@ class Sine(Analytic):
     def __init__(self, amplitude: float, frequency: float, phase: float = 0.0, offset: float = 0.0) -> None:
         self._set(
             amplitude=number("amplitude", amplitude, UNIT),
-            frequency=number("frequency", frequency, "Hz", "> 0", lambda v: v > 0.0),
+            frequency=hertz("frequency", frequency, "> 0", lambda v: v > 0.0),
             phase=number("phase", phase, "rad"),
             offset=number("offset", offset, UNIT),
         )
@@ -72,8 +73,8 @@ class Chirp(Analytic):
     def __init__(self, amplitude: float, f0: float, f1: float, duration: float) -> None:
         self._set(
             amplitude=number("amplitude", amplitude, UNIT),
-            f0=number("f0", f0, "Hz", ">= 0", lambda v: v >= 0.0),
-            f1=number("f1", f1, "Hz", ">= 0", lambda v: v >= 0.0),
+            f0=hertz("f0", f0, ">= 0", lambda v: v >= 0.0),
+            f1=hertz("f1", f1, ">= 0", lambda v: v >= 0.0),
             duration=number("duration", duration, "s", "> 0", lambda v: v > 0.0),
         )
         if self.f0 == 0.0 and self.f1 == 0.0:

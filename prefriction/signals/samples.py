@@ -135,6 +135,14 @@ class Samples(LinearPieces):
         value = np.interp(check_real_array("t", t, "s"), self._t, self._u)
         return float(value) if np.ndim(value) == 0 else value
 
+    def velocity(self, t: Any) -> Union[float, np.ndarray]:
+        """Slope [signal units / s] of the line after each time ``t`` [s] (0 outside the samples), vectorised."""
+        tt = np.asarray(check_real_array("t", t, "s"), dtype=float)
+        ts, us = self._t, self._u
+        k = np.clip(np.searchsorted(ts, tt, side="right") - 1, 0, ts.size - 2)
+        value = np.where((tt >= ts[0]) & (tt < ts[-1]), (us[k + 1] - us[k]) / (ts[k + 1] - ts[k]), 0.0)
+        return float(value) if value.ndim == 0 else value
+
     def breaks(self) -> np.ndarray:
         """Copy of the sample times :attr:`t` [s], where the slope jumps."""
         return self._t.copy()

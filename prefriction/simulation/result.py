@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Optional
 
 import numpy as np
@@ -123,3 +124,20 @@ class SimulationResult:
                 f"{self.message}, {self.stats.wall_time * 1e3:.3g} ms, jit {self.stats.jit})")
 
     __str__ = summary
+
+    def plot(self, path: "str | Path" = "simulation.png") -> "Path":
+        """The position against time and the friction loop (dense runs), the force at the reversals against their number, saved to ``path``.
+
+        Parameters
+        ----------
+        path : str or Path, default "simulation.png"
+            Image file to write (the format from the suffix).
+
+        Returns
+        -------
+        Path
+            The file written.
+        """
+        from prefriction._result_plots import plot_simulation
+
+        return plot_simulation(self, path)

@@ -22,6 +22,7 @@ import pickle
 import time
 import warnings
 from numbers import Real
+from pathlib import Path
 from typing import Any, Hashable, Iterable, Optional, Sequence, Sized, Union
 
 import numpy as np
@@ -90,6 +91,78 @@ class SweepResult(list):
         """The outcome in words (as ``OdeResult.message``)."""
         return _failure_message(self) if self.failed else f"all {len(self)} runs succeeded"
 
+    @property
+    def n_reversals(self) -> np.ndarray:
+        """Number of reversals of each run (0 for a failed run), an int array of length ``len(self)``."""
+        return np.array([0 if isinstance(r, BaseException) else len(r.reversals) for r in self], dtype=int)
+
+    def reversal_array(self, field: str) -> np.ndarray:
+        """One column of every run's reversal table as one array, a row per run.
+
+        Parameters
+        ----------
+        field : {"t", "x", "F", "E_p", "E_d"}
+            Reversal times [s], positions [m], forces [N], potential energies or dissipations [J]
+            (:class:`prefriction.ReversalTable`).
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape ``(len(self), max(n_reversals))``; rows of shorter runs padded with NaN, a
+            failed run's row all NaN.
+
+        Raises
+        ------
+        ValueError
+            If ``field`` is not one of the reversal table's columns.
+        """
+        if field not in _REVERSAL_FIELDS:
+            raise ValueError(f"field must be one of {_REVERSAL_FIELDS}, got {field!r}")
+        rows = [None if isinstance(r, BaseException) else getattr(r.reversals, field) for r in self]
+        return _padded_rows(rows)
+
+    def sample_array(self, field: str) -> np.ndarray:
+        """One sampled field of every run (``dense=`` or ``t_eval``-style output) as one array.
+
+        Parameters
+        ----------
+        field : {"t", "x", "v", "F", "E_k", "E_f", "u"}
+            A sample field of :class:`prefriction.SimulationResult`.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape ``(len(self), max samples)``, padded with NaN (a failed run: all NaN).
+
+        Raises
+        ------
+        ValueError
+            If ``field`` is not a sample field, or no run has samples (sweep with ``dense=...``).
+        """
+        if field not in _SAMPLE_FIELDS:
+            raise ValueError(f"field must be one of {_SAMPLE_FIELDS}, got {field!r}")
+        rows = [None if isinstance(r, BaseException) else getattr(r, field) for r in self]
+        if all(row is None for row in rows):
+            raise ValueError(f"no run has the samples {field!r}: sweep with dense=True or an array of times")
+        return _padded_rows(rows)
+
+    def plot(self, path: "str | Path" = "sweep.png") -> "Path":
+        """Each run's reversal amplitudes and every run's last one, saved to ``path``.
+
+        Parameters
+        ----------
+        path : str or Path, default "sweep.png"
+            Image file to write (the format from the suffix).
+
+        Returns
+        -------
+        Path
+            The file written.
+        """
+        from prefriction._result_plots import plot_sweep
+
+        return plot_sweep(self, path)
+
     def summary(self) -> str:
         """One line of counts and wall time, then one line per failed run (at most 10).
 
@@ -105,6 +178,20 @@ class SweepResult(list):
         if len(self.failed) > _MAX_LISTED:
             lines.append(f"  ... and {len(self.failed) - _MAX_LISTED} more")
         return "\n".join(lines)
+
+
+_REVERSAL_FIELDS = ("t", "x", "F", "E_p", "E_d")
+_SAMPLE_FIELDS = ("t", "x", "v", "F", "E_k", "E_f", "u")
+
+
+def _padded_rows(rows: list) -> np.ndarray:
+    """Rows of different lengths (``None``: a row of NaN) as one float array padded with NaN."""
+    width = max((len(r) for r in rows if r is not None), default=0)
+    out = np.full((len(rows), width), np.nan)
+    for i, row in enumerate(rows):
+        if row is not None:
+            out[i, :len(row)] = row
+    return out
 
 
 def sweep(

@@ -150,7 +150,8 @@ class Measurement:
 @dataclass(frozen=True)
 class Compensation:
     """A compensator in the compiled loop: its structure (``NoCompensation``'s interface), its
-    numbers, its initial state and the reference velocity [m/s] at the sample instants."""
+    numbers, its initial state and the reference velocity [m/s] at the sample instants (one more
+    entry, the instant after the last, makes the last sample's force the controller's there)."""
 
     structure: object
     params: np.ndarray
@@ -251,10 +252,13 @@ def run_sampled(
     Wall[: n_s - 1, ii["active"]] = 1.0
     Wall[:n_s, ii["r"]] = np.asarray(fb.reference(tk * sc.t), dtype=float)
     Wall[: n_s - 1, ii["rn"]] = Wall[1:n_s, ii["r"]]
-    Wall[n_s - 1, ii["rn"]] = Wall[n_s - 1, ii["r"]]
+    # the last sample's force is the controller's there: the reference goes on one period (not frozen)
+    Wall[n_s - 1, ii["rn"]] = float(np.asarray(fb.reference(np.array([(tk[-1] + Ts_n) * sc.t])), dtype=float)[0])
     if compensation is not None:
-        Wall[:n_s, ii["vr"]] = compensation.velocity
-        Wall[: n_s - 1, ii["vrn"]] = compensation.velocity[1:]
+        Wall[:n_s, ii["vr"]] = compensation.velocity[:n_s]
+        Wall[: n_s - 1, ii["vrn"]] = compensation.velocity[1:n_s]
+        if len(compensation.velocity) > n_s:
+            Wall[n_s - 1, ii["vrn"]] = compensation.velocity[n_s]
     if measurement.noise is not None:
         Wall[:n_s, ii["noise"]] = measurement.noise
     xc0 = _padded(fb.xc0.reshape(1, -1), n, (1, n))[0]
