@@ -18,6 +18,7 @@ import warnings
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
+from scipy.signal import lfilter
 
 import prefriction as pf
 from prefriction import identify
@@ -51,10 +52,7 @@ def test_sandwich_gives_the_long_run_spread_of_a_mean_of_ar1_noise():
 
     rho, n = 0.7, 40_000
     e = np.random.default_rng(5).standard_normal(n)
-    r = np.empty(n)
-    r[0] = e[0]
-    for k in range(1, n):
-        r[k] = rho * r[k - 1] + np.sqrt(1.0 - rho ** 2) * e[k]   # unit variance
+    r = lfilter([np.sqrt(1.0 - rho ** 2)], [1.0, -rho], e)   # r_k = rho r_k-1 + sqrt(1 - rho^2) e_k: unit variance
     J = np.ones((n, 1))
     r = r - r.mean()                                            # the residuals of fitting the mean
     gn = gauss_newton(J, r, ["mean"], np.array([1.0]), np.array([1.0]))
