@@ -24,8 +24,9 @@ from typing import Optional
 import control
 import numpy as np
 
-from prefriction._validation import check_bool, check_interval, check_positive
+from prefriction._validation import check_bool, check_count, check_interval, check_positive
 from prefriction.models import Oscillator
+from prefriction.simulation.loops.compiled_loop import MAX_DELAY
 
 from ._pid import PID
 
@@ -124,13 +125,17 @@ def _plant(m: float, k: float, Ts: Optional[float]) -> control.StateSpace:
 
 
 def closed_loop(
-    system: Oscillator, controller: "PID | control.LTI", *, regime: str = "presliding", warn: bool = True
+    system: Oscillator, controller: "PID | control.LTI", *, regime: str = "presliding", warn: bool = True,
+    delay: int = 0,
 ) -> control.StateSpace:
     """Linear closed loop from the reference ``r`` [m] to the position ``x`` [m].
 
-    ``T = P C / (1 + P C)`` built with ``control.feedback``. A discrete controller (``dt > 0``)
-    is closed around the ZOH-discretised plant, exact at the sample instants. If the loop is
-    not asymptotically stable a :class:`UnstableLoopWarning` lists its poles (``warn=True``).
+    ``T = P C / (1 + P C z^-d)`` built with ``control.feedback``. A discrete controller
+    (``dt > 0``) is closed around the ZOH-discretised plant, exact at the sample instants; a
+    measurement delay of ``d`` samples is the exact discrete delay ``z^-d`` in the feedback
+    path (the controller sees ``x(t_{k-d})``, as :func:`controllers.simulate_loop` with
+    ``delay=d``). If the loop is not asymptotically stable a :class:`UnstableLoopWarning` lists
+    its poles (``warn=True``).
 
     Parameters
     ----------
@@ -142,6 +147,8 @@ def closed_loop(
         Linearisation of the plant: ``1/(m s^2 + sigma)`` or ``1/(m s^2)``.
     warn : bool, default True
         Warn with the poles if the closed loop is unstable.
+    delay : int, default 0
+        Measurement delay in whole samples, ``0 <= delay <= 8`` (a discrete controller only).
 
     Returns
     -------
@@ -154,15 +161,23 @@ def closed_loop(
         ``system`` is not an Oscillator, ``controller`` no PID or SISO LTI, ``warn`` not
         ``True`` or ``False``.
     ValueError
-        ``regime`` unknown, or a discrete controller without a sample time.
+        ``regime`` unknown, a discrete controller without a sample time, ``delay`` outside
+        ``[0, 8]`` or a delay with a continuous controller.
     """
     warn = check_bool("warn", warn)
+    delay = check_count("delay", delay, 0, MAX_DELAY, why="the measurement buffer of the compiled loop")
     C = as_lti(controller)
     Ts = _sample_time(C)
+    if delay and Ts is None:
+        raise ValueError(f"delay={delay!r} samples needs a discrete controller (dt > 0); the controller is continuous")
     P = linear_plant(system, regime, Ts)
-    T = control.feedback(P * C, 1)
+    H = 1 if not delay else control.tf([1.0], [1.0] + [0.0] * delay, Ts)  # z^-d
+    T = control.ss(control.feedback(P * C, H))
     if warn:
-        warn_if_unstable(T, what=f"linear {regime} closed loop", stacklevel=2)
+        what = f"linear {regime} closed loop" + (f" with the measurement delay of {delay} samples "
+                                                  f"({delay * Ts:.6g} s, z^-{delay}; a shorter delay or a "
+                                                  f"lower bandwidth restores the phase it costs)" if delay else "")
+        warn_if_unstable(T, what=what, stacklevel=2)
     return T
 
 

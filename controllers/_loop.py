@@ -19,7 +19,8 @@ import control
 import numpy as np
 
 import prefriction
-from prefriction._validation import check_count, check_nonnegative, check_positive, check_real_array, check_signal
+from prefriction._validation import (check_count, check_finite, check_nonnegative, check_positive, check_real_array,
+                                     check_signal)
 from prefriction.models import Oscillator
 from prefriction.signals import Signal
 from prefriction.simulation.feedback import LinearFeedback, sample_count
@@ -175,7 +176,8 @@ def simulate_loop(
     mismatch : (float, float), optional
         Factors ``(stiffness, coulomb)`` applied to the compensator's friction model
         (:func:`controllers.compensators.scaled_model`): the compensator's model differs from
-        the plant's. No effect on the model-free :class:`DisturbanceObserver`.
+        the plant's; each factor finite and ``> 0``. Refused with the model-free
+        :class:`DisturbanceObserver` (it has no model to scale).
 
     Returns
     -------
@@ -192,7 +194,9 @@ def simulate_loop(
         ``[0, t_end]``; ``xc0`` of the wrong length or not finite; a compensator or a
         measurement option with a continuous controller or an oscillator with its own input
         force; negative ``quantization`` or ``noise_rms``; ``delay`` outside ``[0, 8]``;
-        ``mismatch`` without a compensator; a disturbance observer's bandwidth above ``pi / Ts``.
+        ``mismatch`` without a compensator, with a disturbance observer, or with a factor that is not
+        finite and positive; non-finite ``x0`` or ``v0``, ``|F0|`` above the model's
+        ``max_hysteretic_force``; a disturbance observer's bandwidth above ``pi / Ts``.
     TypeError
         Wrong argument types, unknown keyword arguments, a reference callable that cannot be
         traced in a continuous loop, a compensator that is not one of the four kinds.
@@ -211,13 +215,9 @@ def simulate_loop(
     if compensator is not None and not isinstance(compensator, Compensator):
         raise TypeError(f"compensator must be a controllers.Feedforward, LuGreObserver, FrictionObserver or "
                         f"DisturbanceObserver, got {compensator!r} of type {type(compensator).__name__}")
+    x0, v0, F0 = _check_start(system, x0, v0, F0)
     if mismatch is not None:
-        if compensator is None:
-            raise ValueError(f"mismatch needs a compensator (it scales the compensator's model), got mismatch={mismatch!r}")
-        if not (isinstance(mismatch, tuple) and len(mismatch) == 2):
-            raise TypeError(f"mismatch must be a tuple (stiffness, coulomb) of factors, got {mismatch!r}")
-        if hasattr(compensator, "model"):
-            compensator = compensator.with_model(scaled_model(compensator.model, *mismatch))
+        compensator = _mismatched(compensator, mismatch)
     special = compensator is not None or measurement.quantization > 0.0 or noise_rms > 0.0 or measurement.delay != 0
     reference = _check_reference(reference)
     if Ts is not None:
@@ -238,7 +238,7 @@ def simulate_loop(
     if special and (Ts is None or system.forced):
         raise ValueError("a compensator, quantization, noise_rms and delay need a sampled controller (Ts or a "
                          "discrete controller) and an oscillator without its own input force (system.u = None)")
-    closed_loop(system, C, regime="presliding", warn=True)
+    closed_loop(system, C, regime="presliding", warn=True, delay=measurement.delay if Ts is not None else 0)
     fb_reference = reference
     stats = None
     extra: dict = {}
@@ -285,6 +285,31 @@ def simulate_loop(
         simulation=sim, loop_stats=stats, compensator=compensator,
         measured=extra.get("y"), compensation=extra.get("comp"),
     )
+
+
+def _check_start(system: Oscillator, x0: Any, v0: Any, F0: Any) -> tuple[float, float, float]:
+    """``x0`` [m], ``v0`` [m/s] finite and ``|F0|`` [N] within the model's largest force at rest
+    (as :func:`prefriction.simulate`; a compensator's initial state is built from them)."""
+    x0, v0, F0 = check_finite("x0", x0), check_finite("v0", v0), check_finite("F0", F0)
+    F_max = system.friction.max_hysteretic_force
+    if not abs(F0) <= F_max:
+        raise ValueError(f"F0 must lie in [-{F_max!r}, {F_max!r}] N (the model's max_hysteretic_force, "
+                         f"{type(system.friction).__name__}), got {F0!r}")
+    return x0, v0, F0
+
+
+def _mismatched(compensator: Optional[Compensator], mismatch: Any) -> Compensator:
+    """The compensator with its model scaled by ``mismatch = (stiffness, coulomb)``, checked."""
+    if compensator is None:
+        raise ValueError(f"mismatch needs a compensator (it scales the compensator's model), got mismatch={mismatch!r}")
+    if not (isinstance(mismatch, tuple) and len(mismatch) == 2):
+        raise TypeError(f"mismatch must be a tuple (stiffness, coulomb) of factors, got {mismatch!r}")
+    if not hasattr(compensator, "model"):
+        raise ValueError(f"mismatch scales a compensator's friction model, and the {type(compensator).__name__} has "
+                         f"none (it is model-free): omit mismatch, got mismatch={mismatch!r}")
+    factors = [check_positive(f"mismatch[{i}] (the {what} factor)", f) for i, (what, f)
+               in enumerate(zip(("stiffness", "coulomb"), mismatch))]
+    return compensator.with_model(scaled_model(compensator.model, *factors))
 
 
 def _measurement_options(quantization: Any, noise_rms: Any, seed: Any, delay: Any) -> tuple[Measurement, float]:

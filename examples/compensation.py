@@ -49,7 +49,7 @@ def main(outdir: "str | Path" = ".", quick: bool = False) -> dict:
     out = {}
     for ax, (cond, opts) in zip(axes, (("nominal", {}), ("mismatch", {"mismatch": (1.2, 0.8)}))):
         for name, comp in compensators(model).items():
-            kw = opts if comp is not None else {}
+            kw = opts if hasattr(comp, "model") else {}  # the disturbance observer has no model to scale
             res = controllers.simulate_loop(system, pid, SINE, t_end, Ts=TS, compensator=comp, **kw)
             near = (res.t >= 1.0) & (res.t <= 1.1)
             out[(cond, name)] = {"rms": float(np.sqrt(np.mean(res.error ** 2))),

@@ -7,6 +7,8 @@ global state behind.
 
 from __future__ import annotations
 
+import io
+import os
 import sys
 from pathlib import Path
 from typing import Optional, Sequence, Union
@@ -101,10 +103,43 @@ def add_note(fig: Figure, text: str, *, lines: int = 1) -> None:
 def save(fig: Figure, outdir: PathLike, name: str, *, dpi: int = 130) -> Path:
     """Save ``fig`` as ``outdir/name`` (PNG), creating ``outdir`` if needed; return the path."""
     out = Path(outdir)
-    out.mkdir(parents=True, exist_ok=True)
-    path = out / name
-    fig.savefig(path, dpi=dpi)
-    return path
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ValueError(f"outdir {str(out)!r} cannot be created ({exc.strerror or exc})") from exc
+    return write_figure(fig, out / name, dpi=dpi, argument="outdir")
+
+
+def write_figure(fig: Figure, path: object, *, dpi: int = 120, argument: str = "path") -> Path:
+    """Write ``fig`` to the file ``path`` (format from its suffix, PNG if none); return the path.
+
+    The image is rendered in memory and written atomically (a new temporary file renamed over
+    the destination, :func:`prefriction._safe_files.write_atomic`), so a link at ``path`` is
+    replaced, never followed. ``TypeError``/``ValueError`` naming ``argument`` for a path that
+    is not one, is empty, or whose directory is missing or not writable.
+    """
+    from prefriction import _safe_files as safe
+
+    if not isinstance(path, (str, os.PathLike)):
+        raise TypeError(f"{argument} must be a str or pathlib.Path, got {type(path).__name__} {path!r}")
+    out = Path(path)
+    if str(path) == "" or out.name == "":
+        raise ValueError(f"{argument} must name a file, got {str(path)!r}")
+    if os.path.isdir(out) and not os.path.islink(out):
+        raise ValueError(f"{argument} must name a file, got the directory {str(out)!r}")
+    fmt = out.suffix[1:].lower() or "png"
+    buf = io.BytesIO()
+    try:
+        fig.savefig(buf, format=fmt, dpi=dpi)
+    except ValueError as exc:
+        raise ValueError(f"{argument} {str(out)!r}: matplotlib cannot write the format {fmt!r} ({exc})") from exc
+    if not os.path.isdir(out.parent if str(out.parent) else "."):
+        raise ValueError(f"{argument} {str(out)!r}: the directory {str(out.parent)!r} does not exist")
+    try:
+        safe.write_atomic(out, buf.getvalue(), 0o644)
+    except OSError as exc:
+        raise ValueError(f"{argument} {str(out)!r} cannot be written ({exc.strerror or exc})") from exc
+    return out
 
 
 def script_args(

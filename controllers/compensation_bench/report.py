@@ -35,7 +35,7 @@ def run_cases() -> list[dict[str, Any]]:
             for cname, opts in CONDITIONS.items():
                 _progress(f"compensation bench: {pname}, {task.name}, {cname}")
                 for comp_name, comp in compensators(model).items():
-                    o = dict(opts) if comp is not None else {k: v for k, v in opts.items() if k != "mismatch"}
+                    o = dict(opts) if hasattr(comp, "model") else {k: v for k, v in opts.items() if k != "mismatch"}
                     res = simulate_loop(system, pid, task.reference, task.t_end, Ts=TS, compensator=comp, **o)
                     rows.append({"plant": pname, "task": task.name, "condition": cname, "controller": comp_name,
                                  **measures(res, task), "result": res if task.name == "sine" else None})

@@ -108,6 +108,7 @@ class AlongResult:
         for ax in (ax1, ax2):
             ax.grid(alpha=0.3)
         fig.suptitle(f"{type(self.model).__name__} along the motion ({self.t.size} samples)", fontsize=10)
-        out = Path(path)
-        fig.savefig(out, dpi=120)
+        from prefriction.plotting import write_figure
+
+        out = write_figure(fig, path)
         return out

@@ -9,6 +9,7 @@ import numpy as np
 
 from prefriction._validation import check_count, check_finite
 from prefriction.along.engine import Units, stepper
+from prefriction._memory import check_memory
 from prefriction.along.motion import Motion
 from prefriction.along.result import AlongResult
 from prefriction.models.base import FrictionModel
@@ -78,7 +79,8 @@ def friction_along(model: FrictionModel, t: Any, x: Any, *, F0: float = 0.0, v: 
         If ``model`` is not a FrictionModel or an array is not real.
     ValueError
         If the arrays are not 1-D, have other lengths than ``t``, fewer than 2 or more than
-        2e7 samples, non-finite entries, ``t`` is not strictly increasing, ``F0`` is out of range
+        2e7 samples, more samples than fit in 4 GiB with the model's state
+        (:func:`prefriction._memory.check_memory`), non-finite entries, ``t`` is not strictly increasing, ``F0`` is out of range
         or ``substeps`` not in [1, 64].
     prefriction.SolverError
         If the model's force is not finite at a sample (named).
@@ -94,6 +96,10 @@ def friction_along(model: FrictionModel, t: Any, x: Any, *, F0: float = 0.0, v: 
     model = check_model(model)
     motion = Motion.of(t, x, v)
     substeps = check_count("substeps", substeps, 1, 64)
+    k = model.n_states + model.n_flags  # the state of every sample, kept three times at the peak
+    check_memory(f"friction_along of {type(model).__name__} ({k} states and flags per sample)", motion.t.size,
+                 16 + 3 * k, "samples", "pass fewer samples, or feed the record through prefriction.FrictionStream "
+                 "(one sample at a time, in constant memory)")
     F0, X0 = initial_state(model, F0, motion.s0)
     run = stepper(model, substeps)
     start = time.perf_counter()

@@ -69,6 +69,38 @@ class FrictionStream:
         self.reversals = 0
         """Reversals so far."""
 
+    _STATE = ("model", "x", "t", "substeps", "F0", "_started", "_s", "F", "events", "reversals")
+
+    def __getstate__(self) -> dict:
+        """What a copy or a pickle holds: the numbers and the model's state (not the compiled step)."""
+        state = {k: getattr(self, k) for k in self._STATE}
+        state["_w"] = self._step.inputs[0].copy()
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        """Rebuild the stream from :meth:`__getstate__`: its own step buffers, the model's state copied."""
+        for k in self._STATE:
+            setattr(self, k, state[k])
+        self._step = stepper(self.model, self.substeps).buffered()
+        self._step.inputs[6][:] = np.asarray(self.model.runtime_params(), dtype=float)
+        self._step.inputs[0][:] = state["_w"]
+        self._units = Units.of(self.model)
+
+    def __copy__(self) -> "FrictionStream":
+        """An independent stream at the same sample (its own state: stepping one leaves the other)."""
+        new = FrictionStream.__new__(FrictionStream)
+        new.__setstate__(self.__getstate__())
+        return new
+
+    def __deepcopy__(self, memo: dict) -> "FrictionStream":
+        import copy
+
+        state = self.__getstate__()
+        state["model"] = copy.deepcopy(self.model, memo)
+        new = FrictionStream.__new__(FrictionStream)
+        new.__setstate__(state)
+        return new
+
     def __repr__(self) -> str:
         return (f"FrictionStream({type(self.model).__name__}: t = {self.t:.6g} s, x = {self.x:.6g} m, "
                 f"F = {self.F:.6g} N, {self.reversals} reversals, {self.events} events)")

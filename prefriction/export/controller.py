@@ -22,9 +22,9 @@ from typing import Any, Optional
 import casadi as ca
 import numpy as np
 
-from prefriction._validation import check_positive, check_real
+from prefriction._validation import check_finite, check_positive, check_real
 
-from ._codegen import c_text, check_name, directory_of, work_sizes
+from ._codegen import c_text, check_name, check_sample_time, comment_text, directory_of, work_sizes, write_export
 from .source import CSource
 
 __all__ = ["controller_function", "controller_initial_state", "controller_source"]
@@ -94,10 +94,10 @@ class _Law:
 
 
 def _law(controller: Any, Ts: Any, compensator: Any, mass: Any, x0: Any, discretization: Any) -> _Law:
-    Ts = check_positive("Ts", Ts)
+    Ts = check_sample_time(Ts)
     if mass is not None:
         mass = check_positive("mass", mass)
-    x0 = check_real("x0", x0)
+    x0 = check_finite("x0", x0)
     if discretization not in ("zoh", "foh", "tustin", "bilinear", "euler", "backward_diff", "gbt", "impulse", "matched"):
         raise ValueError(f"discretization must be a control.c2d method such as 'zoh' or 'tustin', got {discretization!r}")
     return _Law(controller, Ts, compensator, mass, x0, discretization)
@@ -281,15 +281,13 @@ def controller_source(controller: Any, name: str, directory: Any, *, Ts: float, 
     sz = work_sizes(fun)
     comp = "no compensator" if compensator is None else type(compensator).__name__
     kind = str(controller) if "\n" not in str(controller) else f"{type(controller).__name__} of order {law.n}"
-    what = f"{kind} at Ts = {Ts!r} s with {comp}"
+    what = comment_text(f"{kind} at Ts = {Ts!r} s with {comp}")
     limit = "" if law.u_max is None else f", limited to +-{law.u_max!r} N"
     header = _HEADER.format(name=name, what=what, x0=float(x0), Ts=Ts, limit=limit, guard=f"{name.upper()}_H", n=n)
     initial = ", ".join(repr(float(v)) for v in law.initial())
     body = c_text({f"{name}_sample": fun}, f"{name}_casadi") + _WRAPPER.format(
         name=name, n=n, initial=initial, sz_arg=max(sz[0], 3), sz_res=max(sz[1], 2), sz_iw=max(sz[2], 1),
         sz_w=max(sz[3], 1))
-    h_path, c_path = path / f"{name}.h", path / f"{name}.c"
-    h_path.write_text(header)
-    c_path.write_text(body)
+    h_path, c_path, digest = write_export(path, name, header, body)
     options = {"Ts": Ts, "compensator": compensator, "mass": mass, "x0": float(x0), "discretization": discretization}
-    return CSource(name, h_path, c_path, "controller", what, fun, n, controller, options)
+    return CSource(name, h_path, c_path, "controller", what, fun, n, controller, options, digest)

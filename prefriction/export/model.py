@@ -30,7 +30,7 @@ from prefriction._validation import check_count, check_positive
 from prefriction.along.step import has_exact_step, interval_function
 from prefriction.models.base import FrictionModel
 
-from ._codegen import c_text, check_name, directory_of, work_sizes
+from ._codegen import c_text, check_name, check_sample_time, comment_text, directory_of, work_sizes, write_export
 from .source import CSource
 
 __all__ = ["c_source", "sample_function"]
@@ -55,7 +55,7 @@ def _sample_time(model: FrictionModel, Ts: Optional[float]) -> Optional[float]:
                 f"[s], 0 < Ts < inf"
             )
         return None
-    return check_positive("Ts", Ts)
+    return check_sample_time(Ts)
 
 
 def sample_function(model: FrictionModel, *, Ts: Optional[float] = None, n_sub: int = 16) -> ca.Function:
@@ -229,17 +229,15 @@ def c_source(model: FrictionModel, name: str, directory: Any, *, Ts: Optional[fl
     sampling = (f"Sample time Ts = {Ts!r} s: the velocity over an interval is (x - x_prev) / Ts."
                 if Ts is not None else "Rate-independent: the force depends on the positions alone.")
     stepping = "exact step" if has_exact_step(model) else f"{n_sub} RK4 sub-steps"
-    what = f"{_describe(model)}, {'Ts = %r s' % Ts if Ts is not None else 'rate-independent'}, {stepping}"
+    what = comment_text(f"{_describe(model)}, {'Ts = %r s' % Ts if Ts is not None else 'rate-independent'}, {stepping}")
     header = _HEADER.format(name=name, what=what, sampling=sampling, nz1=nz1, i_s=n - 2, i_x=n - 1,
                             guard=f"{name.upper()}_H", n=n)
     virgin = ", ".join(repr(v) for v in virgin_state(model, 0.0))
     body = c_text({step: fun}, f"{name}_casadi") + _WRAPPER.format(
         name=name, n=n, virgin=virgin, i_x=n - 1, sz_arg=max(sz_arg, 2), sz_res=max(sz_res, 2),
         sz_iw1=max(sz_iw, 1), sz_w1=max(sz_w, 1), step=step)
-    h_path, c_path = path / f"{name}.h", path / f"{name}.c"
-    h_path.write_text(header)
-    c_path.write_text(body)
-    return CSource(name, h_path, c_path, "model", what, fun, n, model, {"Ts": Ts, "n_sub": n_sub})
+    h_path, c_path, digest = write_export(path, name, header, body)
+    return CSource(name, h_path, c_path, "model", what, fun, n, model, {"Ts": Ts, "n_sub": n_sub}, digest)
 
 
 def _describe(model: FrictionModel) -> str:

@@ -27,7 +27,7 @@ from prefriction.simulation.loops.records import plant_state
 from prefriction.simulation.simulate import _CAL
 from prefriction.units import Scales
 
-from ._codegen import c_text, check_name, directory_of, work_sizes
+from ._codegen import c_text, check_name, check_sample_time, comment_text, directory_of, work_sizes, write_export
 from .source import CSource
 
 __all__ = ["plant_function", "plant_initial_state", "plant_source"]
@@ -162,7 +162,7 @@ def plant_initial_state(system: Oscillator, Ts: float, x0: float = 0.0, v0: floa
 
 def _period(system: Any, Ts: Any, rtol: Any, force_scale: Any) -> _Period:
     system = _system(system)
-    Ts = check_positive("Ts", Ts)
+    Ts = check_sample_time(Ts)
     rtol = check_positive("rtol", rtol)
     if not rtol < 1.0:
         raise ValueError(f"rtol must be in (0, 1), got {rtol!r}")
@@ -311,18 +311,16 @@ def plant_source(system: Oscillator, name: str, directory: Any, *, Ts: float, F0
     n = per.LL.nS
     sizes = work_sizes(fun)
     isz = work_sizes(initial)
-    what = (f"{type(system.friction).__name__} stage of {system.mass:.6g} kg, Ts = {Ts!r} s, rtol = {rtol!r}, "
-            f"period with every reversal located")
+    what = comment_text(f"{type(system.friction).__name__} stage of {system.mass:.6g} kg, Ts = {Ts!r} s, "
+                        f"rtol = {rtol!r}, period with every reversal located")
     header = _HEADER.format(name=name, what=what, Ts=Ts, nstop=int(NSTOP), F0=F0, guard=f"{name.upper()}_H", n=n)
     body = (c_text({f"{name}_period": fun, f"{name}_initial": initial}, f"{name}_casadi")
             + _WRAPPER.format(name=name, n=n, sz_arg=max(isz[0], 2), sz_res=max(isz[1], 2), sz_iw0=max(isz[2], 1),
                               sz_w0=max(isz[3], 1), sz_arg1=max(sizes[0], 3), sz_res1=max(sizes[1], 2),
                               sz_iw1=max(sizes[2], 1), sz_w1=max(sizes[3], 1)))
-    h_path, c_path = path / f"{name}.h", path / f"{name}.c"
-    h_path.write_text(header)
-    c_path.write_text(body)
+    h_path, c_path, digest = write_export(path, name, header, body)
     options = {"Ts": per.Ts, "F0": F0, "rtol": rtol, "force_scale": force_scale}
-    return CSource(name, h_path, c_path, "plant", what, fun, n, system, options)
+    return CSource(name, h_path, c_path, "plant", what, fun, n, system, options, digest)
 
 
 def _initial_function(per: _Period, F0: float) -> ca.Function:

@@ -9,7 +9,9 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
-from prefriction._validation import check_count, check_real_array
+from prefriction._validation import check_count, check_finite, check_real_array
+from prefriction.simulation.simulate import MAX_AMPLITUDE
+from prefriction.units import Scales
 
 from .plant import plant_initial_state
 from .run import c_driver, compile_and_run
@@ -68,6 +70,20 @@ def _args(source: Any, u: Any) -> tuple[CSource, np.ndarray]:
     return source, u
 
 
+def _start(source: CSource, x0: Any, v0: Any) -> tuple[float, float]:
+    """``x0`` [m] and ``v0`` [m/s] checked: finite, at most :data:`~prefriction.simulation.simulate.MAX_AMPLITUDE`
+    in the stage's units (``ValueError`` naming the argument)."""
+    sc = Scales.of(source.model)
+    out = []
+    for name, value, unit, scale in (("x0", x0, "m", sc.x), ("v0", v0, "m/s", sc.v)):
+        value = check_finite(name, value)
+        if not abs(value) <= MAX_AMPLITUDE * scale:
+            raise ValueError(f"{name} must satisfy |{name}| <= {MAX_AMPLITUDE * scale:.3g} {unit} ({MAX_AMPLITUDE:g} "
+                             f"of the stage's units: its states stay in the double-precision range), got {value!r}")
+        out.append(value)
+    return out[0], out[1]
+
+
 def run_plant_c(source: CSource, u: Any, x0: float = 0.0, v0: float = 0.0, *, rounds: int = 1,
                 optimize: bool = True) -> PlantRun:
     """Compile the exported plant with a driver and hold each force ``u[k]`` [N] over period ``k``.
@@ -98,8 +114,9 @@ def run_plant_c(source: CSource, u: Any, x0: float = 0.0, v0: float = 0.0, *, ro
         If the code does not compile or the program fails.
     """
     source, u = _args(source, u)
+    x0, v0 = _start(source, x0, v0)
     rounds = check_count("rounds", rounds, 1, 1000)
-    data = np.concatenate([[float(x0), float(v0)], u])
+    data = np.concatenate([[x0, v0], u])
     out, ns = compile_and_run(source, _DRIVER, data, 4 * u.size, rounds, optimize)
     out = out.reshape(-1, 4)
     return PlantRun(out[:, 0], out[:, 1], out[:, 2], out[:, 3].astype(int), ns)
@@ -123,6 +140,7 @@ def evaluate_plant(source: CSource, u: Any, x0: float = 0.0, v0: float = 0.0) ->
         The state after each period (``ns_per_step`` NaN).
     """
     source, u = _args(source, u)
+    x0, v0 = _start(source, x0, v0)
     fun = source.function
     o = source.options
     w0 = plant_initial_state(source.model, o["Ts"], x0, v0, F0=o["F0"], rtol=o["rtol"], force_scale=o["force_scale"])

@@ -11,6 +11,7 @@ import hashlib
 import shutil
 import subprocess
 import tempfile
+import threading
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -178,20 +179,29 @@ def run_c(source: CSource, x: Any, *, rounds: int = 1, optimize: bool = True) ->
 def compile_and_run(source: CSource | list[CSource], driver: str, data: np.ndarray, n_out: int,
                     rounds: int, optimize: bool = True) -> tuple[np.ndarray, float]:
     """Compile ``driver`` with the export(s) (``NAME`` in it replaced by the first one's name),
-    run it on the doubles ``data``; the ``n_out`` doubles it writes and the time per step [ns] it prints."""
+    run it on the doubles ``data``; the ``n_out`` doubles it writes and the time per step [ns] it prints.
+
+    The exports' files are read once, without following links, and must still hold what each
+    export wrote (:meth:`CSource.texts`, ``ValueError`` otherwise); those bytes are compiled from
+    a private temporary directory of this call, so a file changed meanwhile cannot enter the
+    program and no header of the exports' directory can stand in for a system header.
+    Safe to call from several threads.
+    """
     sources = source if isinstance(source, list) else [source]
     source = sources[0]
+    texts = [src.texts() for src in sources]
     cc = gcc()
     if cc is None:
         raise FileNotFoundError(f"running {source.name} needs gcc on the PATH to compile the exported code; install gcc")
     flags = (*CFLAGS, "-O2" if check_bool("optimize", optimize) else "-O0")
-    objects = [_object(cc, src, flags) for src in sources]
+    objects = [_object(cc, src.name, h, c, flags) for src, (h, c) in zip(sources, texts)]
     with tempfile.TemporaryDirectory(prefix="pf-export-") as tmp:
         d = Path(tmp)
+        for src, (h, _c) in zip(sources, texts):
+            (d / f"{src.name}.h").write_bytes(h)
         (d / "driver.c").write_text(driver.replace("NAME", source.name))
         exe = d / "driver"
-        incs = [a for src in sources for a in ("-I", str(src.header.parent))]
-        cmd = [cc, *flags, *incs, str(d / "driver.c"), *map(str, objects), "-lm", "-o", str(exe)]
+        cmd = [cc, *flags, str(d / "driver.c"), *map(str, objects), "-lm", "-o", str(exe)]
         _gcc(cmd, "the driver of " + source.name)
         np.ascontiguousarray(data, dtype=float).tofile(d / "in.bin")
         done = subprocess.run([str(exe), str(d / "in.bin"), str(d / "out.bin"), str(data.size), str(rounds)],
@@ -210,23 +220,31 @@ def _gcc(cmd: list[str], what: str) -> None:
         raise RuntimeError(f"gcc failed to compile {what}:\n{done.stderr.strip()}")
 
 
-def _object(cc: str, source: CSource, flags: tuple[str, ...]) -> Path:
-    """The object file of an export, compiled once per process and content (the generated plant
-    takes seconds at ``-O2``)."""
-    global _OBJ_DIR
-    text = source.source.read_bytes() + source.header.read_bytes()
-    key = hashlib.sha256(text + repr(flags).encode()).hexdigest()[:20]
-    if _OBJ_DIR is None:
-        _OBJ_DIR = tempfile.TemporaryDirectory(prefix="pf-export-obj-")
-    obj = Path(_OBJ_DIR.name) / f"{source.name}-{key}.o"
-    if not obj.exists():
-        part = obj.with_suffix(".part.o")
-        _gcc([cc, *flags, "-c", str(source.source), "-I", str(source.header.parent), "-o", str(part)], str(source.source))
-        part.replace(obj)
+_OBJ_LOCK = threading.Lock()
+_OBJ_DIR: list[tempfile.TemporaryDirectory] = []
+
+
+def _object(cc: str, name: str, header: bytes, body: bytes, flags: tuple[str, ...]) -> Path:
+    """The object file of an export's texts, compiled once per process and content (the generated
+    plant takes seconds at ``-O2``), in a private directory of this process.
+
+    One thread compiles at a time (the first use in a process raced on the shared directory);
+    each compile writes into a directory of its own and renames the object into place.
+    """
+    key = hashlib.sha256(hashlib.sha256(header).digest() + hashlib.sha256(body).digest()
+                         + repr(flags).encode()).hexdigest()[:20]
+    with _OBJ_LOCK:
+        if not _OBJ_DIR:
+            _OBJ_DIR.append(tempfile.TemporaryDirectory(prefix="pf-export-obj-"))
+        obj = Path(_OBJ_DIR[0].name) / f"{name}-{key}.o"
+        if not obj.exists():
+            with tempfile.TemporaryDirectory(dir=_OBJ_DIR[0].name) as tmp:
+                d = Path(tmp)
+                (d / f"{name}.h").write_bytes(header)
+                (d / f"{name}.c").write_bytes(body)
+                _gcc([cc, *flags, "-c", str(d / f"{name}.c"), "-o", str(d / "part.o")], f"{name}.c")
+                (d / "part.o").replace(obj)
     return obj
-
-
-_OBJ_DIR: tempfile.TemporaryDirectory | None = None
 
 
 def evaluate(source: CSource, x: Any) -> np.ndarray:

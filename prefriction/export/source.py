@@ -8,6 +8,8 @@ from typing import Any
 
 import casadi as ca
 
+from prefriction import _safe_files as safe
+
 __all__ = ["CSource"]
 
 
@@ -36,6 +38,10 @@ class CSource:
         The exported friction model (kind ``"model"``) or stage (kind ``"plant"``).
     options : dict
         The export's keyword values (``Ts``, ``n_sub``, ``F0``, ``rtol``, ``force_scale``, ...).
+    digest : str
+        SHA-256 of the header and source as written: what this handle exported. Running it
+        (:func:`prefriction.export.run_c`, ...) refuses files that no longer hold it
+        (:meth:`texts`), e.g. after another export of the same name into the same directory.
     """
 
     name: str
@@ -47,6 +53,32 @@ class CSource:
     state_size: int
     model: Any = field(default=None, repr=False)
     options: dict = field(default_factory=dict, repr=False)
+    digest: str = field(default="", repr=False)
+
+    MAX_BYTES = 1 << 28
+    """Largest header or source [bytes] :meth:`texts` reads."""
+
+    def texts(self) -> tuple[bytes, bytes]:
+        """The header and source bytes as this export wrote them, read without following a link.
+
+        Raises
+        ------
+        ValueError
+            If either file is a link, missing, or no longer holds what this export wrote
+            (changed, or written again by another export: export again to run it).
+        """
+        from ._codegen import digest
+
+        try:
+            data = safe.read_nofollow(self.header, self.MAX_BYTES), safe.read_nofollow(self.source, self.MAX_BYTES)
+        except OSError as exc:
+            raise ValueError(f"source: the files of the export {self.name!r} cannot be read "
+                             f"({getattr(exc, 'strerror', None) or exc}); export again") from exc
+        if digest(*data) != self.digest:
+            raise ValueError(f"source: {self.header} and {self.source} no longer hold what this export of "
+                             f"{self.name!r} wrote ({self.what}): they were changed or written again by another "
+                             f"export; export again to run it")
+        return data
 
     def __repr__(self) -> str:
         return f"CSource({self.name!r}, {self.kind}: {self.what}; {self.header.name} + {self.source.name} in {self.source.parent})"

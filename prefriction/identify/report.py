@@ -127,8 +127,9 @@ def plot_fit(res: "FitResult", path: str | Path, show: bool) -> Path:
     est = ", ".join(f"{n} = {v:.4g}" + ("" if u in ("", "-") else f" {u}")  # dimensionless: no unit
                      for n, v, u in zip(res.names, res.estimates, res.units))
     ax1.set_title("\n".join(textwrap.wrap(f"{name} fit: {est}", 100)), fontsize=9)  # long sums wrap
-    out = Path(path)
-    fig.savefig(out, dpi=120)
+    from prefriction.plotting import write_figure
+
+    out = write_figure(fig, path)
     if show:
         plt.show()
     plt.close(fig)

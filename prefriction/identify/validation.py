@@ -252,8 +252,9 @@ class Validation:
         for ax in (ax1, ax2):
             ax.grid(alpha=0.3)
         ax2.set_title(f"rms {self.rms * k:.3g} {unit}, fit {self.fit_percent:.1f} %", fontsize=9)
-        out = Path(path)
-        fig.savefig(out, dpi=120)
+        from prefriction.plotting import write_figure
+
+        out = write_figure(fig, path)
         plt.close(fig)
         return out
 

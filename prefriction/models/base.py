@@ -174,6 +174,18 @@ class FrictionModel(ABC):
         """
         return []
 
+    def velocity_scale(self, q: Any) -> Any:
+        """Normalised velocity below which the force changes sharply with the speed (a Stribeck
+        velocity ``vs~``), or ``None`` (the default: no such scale).
+
+        A Runge-Kutta step that crosses ``|v~| < vs~`` without a stage inside it cannot see the
+        curve in its error estimate; the native driver therefore bounds its steps near the curve
+        so that the speed changes by at most ``vs~ / 2`` per step within ``3 vs~`` of zero
+        (``docs/simulator.md#narrow-stribeck``). ``q`` are the run-time numbers (floats or
+        CasADi symbols).
+        """
+        return None
+
     def on_event(self, k: int, z: Sequence[Any], m: Sequence[Any], s: Any, q: Any) -> tuple[list[Any], list[Any]]:
         """State ``(z, m)`` just after in-branch event ``k``."""
         raise NotImplementedError(f"{type(self).__name__} has no in-branch events")

@@ -231,6 +231,10 @@ class GMS(StribeckCurve, ParallelElements):
         the virgin curve may end above ``Fc``; the initial force stays within ``Fc``."""
         return math.copysign(min(abs(f0), 1.0), f0)
 
+    def velocity_scale(self, q: Any) -> Any:
+        """The normalised Stribeck velocity ``vs~ = 1 / q[3N + 1]`` (:meth:`FrictionModel.velocity_scale`)."""
+        return 1.0 / q[3 * self.n_elements + 1]
+
     def rate(self, z: Sequence[Any], m: Sequence[Any], v: Any, s: Any, q: Any) -> list[Any]:
         n = self.n_elements
         S = self._S(v, q, 3 * n)

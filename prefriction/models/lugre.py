@@ -152,6 +152,10 @@ class LuGre(FrictionModel):
         r = v / q[3]
         return 1.0 + q[2] * _exp(-(r * r))
 
+    def velocity_scale(self, q: Any) -> Any:
+        """The normalised Stribeck velocity ``vs~ = q[3]`` (:meth:`FrictionModel.velocity_scale`)."""
+        return q[3]
+
     def rate(self, z: Sequence[Any], m: Sequence[Any], v: Any, s: Any, q: Any) -> list[Any]:
         return [v * (1.0 - s * z[0] / self.stribeck(v, q))]
 

@@ -11,6 +11,7 @@ from collections import Counter
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Hashable, Optional, Sequence
 
+import casadi as ca
 import numpy as np
 
 from prefriction.models.base import FrictionModel
@@ -18,9 +19,13 @@ from prefriction.models.base import FrictionModel
 if TYPE_CHECKING:
     from prefriction.units import Scales
 
-__all__ = ["MAX_MODELS", "Parallel", "local_names", "qualified_names"]
+__all__ = ["MAX_MODELS", "MAX_STATES", "Parallel", "local_names", "qualified_names"]
 
 MAX_MODELS = 16
+MAX_STATES = 256
+"""Most continuous states a sum of models may hold in all (each model's own limit, e.g. 100
+elements, held per term only: ten 100-element Maxwell-slip models took 106 s to compile for a
+1,001-sample run). Generated code and compile time grow with the states."""
 """Most models in one sum."""
 
 
@@ -133,6 +138,12 @@ class Parallel(FrictionModel):
             raise TypeError("models must not contain a Parallel (use Parallel.of or +, which flatten sums)")
         if not 1 <= len(self.models) <= MAX_MODELS:
             raise ValueError(f"models must hold 1 to {MAX_MODELS} friction models, got {len(self.models)}")
+        total = sum(int(m.n_states) for m in self.models)
+        if total > MAX_STATES:
+            raise ValueError(f"models must hold at most {MAX_STATES} states in all (MAX_STATES: the generated code "
+                             f"and its compile time grow with them), got {total} in "
+                             f"{[f'{type(m).__name__}: {m.n_states}' for m in self.models]}; merge the terms into "
+                             f"one model (e.g. one MaxwellSlip with all the elements, up to its own limit)")
 
     @classmethod
     def of(cls, *models: FrictionModel) -> "Parallel":
@@ -252,6 +263,17 @@ class Parallel(FrictionModel):
         for model, z_i, m_i, v_i, _tau, phi, q_i in self._parts(z, m, v, q):
             total = total + phi * model.force(z_i, m_i, v_i, s, q_i)
         return total
+
+    def velocity_scale(self, q: Any) -> Any:
+        """The least of the models' velocity scales in the sum's units (``vs~_i phi_i / tau_i``),
+        or None if no model has one (:meth:`FrictionModel.velocity_scale`)."""
+        out = None
+        for model, _z, _m, _v, tau, phi, q_i in self._parts([], [], None, q):
+            vs = model.velocity_scale(q_i)
+            if vs is not None:
+                vs = vs * phi / tau
+                out = vs if out is None else (min(out, vs) if isinstance(out + vs, float) else ca.fmin(out, vs))
+        return out
 
     def events(self, z: Sequence[Any], m: Sequence[Any], v: Any, s: Any, q: Any) -> list[Any]:
         out: list[Any] = []

@@ -97,6 +97,27 @@ class PointToPoint(Signal):
             times = t0 + np.array([0.0, tj, tj + tc, 2.0 * tj + tc, t1, t1 + tj, t1 + tj + tc, t1 + 2.0 * tj + tc])
             jumps = sgn * jm * np.array([1.0, -1.0, -1.0, 1.0, -1.0, 1.0, 1.0, -1.0])
         self._set(distance=d, v_max=v, a_max=a, j_max=jm, start=t0, position=x0, _times=times, _jumps=jumps)
+        self._check_end()
+
+    END_RTOL = 1e-8
+    """How close [relative to ``distance``] the profile's series must land on the target."""
+
+    def _check_end(self) -> None:
+        """``ValueError`` if the series cannot be evaluated in double precision: the limits so far
+        apart in scale from the distance (or the distance so small) that its terms cancel, e.g.
+        ``PointToPoint(1e-5, 1e100, 1e100, j_max=1e100)`` ended at 3.5e9 m, ``distance=1e-310`` at 1.1e-95 m."""
+        from prefriction.signals._ops import NumpyOps
+
+        end = float(self._series(np.asarray(self._times[-1]), self.params(), NumpyOps, 0))
+        target = self.position + self.distance
+        if not (math.isfinite(end) and abs(end - target) <= self.END_RTOL * abs(self.distance)
+                + 4.0 * np.spacing(abs(target))):
+            raise ValueError(
+                f"PointToPoint(distance={self.distance!r}, v_max={self.v_max!r}, a_max={self.a_max!r}, "
+                f"j_max={self.j_max!r}) cannot be evaluated in double precision: its switch times "
+                f"{self._times[1] - self.start:.3g} s and jumps {abs(self._jumps[0]):.3g} differ so much in scale that "
+                f"the profile ends at {end!r} m instead of {target!r} m. Give limits the move reaches (v_max, a_max "
+                f"and j_max of the order of distance over the move's time and its powers) and |distance| >= 1e-200 m")
 
     @property
     def key(self) -> Hashable:

@@ -87,7 +87,9 @@ def advance_compact(self: "Run", t_target: float, n_target: float) -> bool:
         A = max(math.hypot(v, F), 1e-300)
         Fmax = abs(F) if grow == 1.0 else max(Fmax, abs(F))  # the largest force of the branch (call starts)
         Ax = max(A, 0.5 * A * A, min(abs(x), 1.0)) * eps
-        AF = min(A, 1.0) * eps
+        # a state that carries the travel (Dahl's log-gap) is held to its own size, as the native
+        # driver does (docs/simulator.md#stiff, deep gross sliding)
+        AF = (max(min(A, 1.0), max(abs(zi) for zi in z)) if tracks and z else min(A, 1.0)) * eps
         Av = A * eps
         P[0], P[1], P[2], P[3] = Ax, Av, AF, s
         if iEb is not None:

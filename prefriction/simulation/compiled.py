@@ -8,8 +8,13 @@ same Function loads it without compiling; :mod:`prefriction.simulation.library_s
 libraries atomically and verifies a checksum before loading one. Processes that need the same
 library at once (e.g. pytest-xdist workers) compile it once: one holds a lock beside the library
 while it compiles and publishes it, the others wait and load it. Without a compiler, with
-``PREFRICTION_NO_JIT=1``, or if compiling fails, the interpreted Function is returned: same
-results, slower calls.
+``PREFRICTION_NO_JIT=1``, or if compiling fails, the interpreted Function is returned: the
+same computation, slower calls (results agree to rounding: the compiler may order floating-point
+operations differently). With no C compiler at all, one warning per process says what that costs.
+
+Only the user's own files are loaded: the cache directory must be this user's and writable by
+no one else (else this process compiles into a private temporary directory and says so once);
+see :mod:`prefriction.simulation.library_store` and :mod:`prefriction._safe_files`.
 """
 
 from __future__ import annotations
@@ -23,15 +28,18 @@ import subprocess
 import sys
 import tempfile
 import time
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Optional
 
 import casadi as ca
 
+from prefriction import _safe_files as safe
 from prefriction.simulation import library_store as store
 
-__all__ = ["CompileInfo", "cache_dir", "compile_timeout", "compiled", "compiled_seconds", "jit_available", "library"]
+__all__ = ["CompileInfo", "cache_dir", "compile_timeout", "compiled", "compiled_seconds", "jit_available", "library",
+           "no_jit"]
 
 _SPENT = [0.0]  # wall time spent generating and compiling code in this process [s]
 
@@ -62,9 +70,30 @@ class CompileInfo:
 
 
 def cache_dir() -> Path:
-    """Directory of the compiled-code cache: ``$PREFRICTION_CACHE`` or ``~/.cache/prefriction``."""
-    env = os.environ.get("PREFRICTION_CACHE")
-    return Path(env) if env else Path.home() / ".cache" / "prefriction"
+    """Directory of the compiled-code cache: ``$PREFRICTION_CACHE`` (``~`` expanded, made
+    absolute) or ``~/.cache/prefriction``."""
+    env = os.environ.get("PREFRICTION_CACHE", "")
+    return Path(os.path.abspath(os.path.expanduser(env))) if env else Path.home() / ".cache" / "prefriction"
+
+
+_FALSE = ("", "0", "false", "no", "off")
+_TRUE = ("1", "true", "yes", "on")
+_WARNED: list[bool] = []
+NO_TIMEOUT = 1e6
+"""A ``PREFRICTION_COMPILE_TIMEOUT`` at or above this [s] (about 11.6 days), ``inf`` included, means no limit."""
+
+
+def no_jit() -> bool:
+    """True if ``$PREFRICTION_NO_JIT`` turns compiled code off (``1``, ``true``, ``yes``, ``on``;
+    ``0``, ``false``, ``no``, ``off`` or unset leave it on; any case). ``ValueError`` for other values."""
+    value = os.environ.get("PREFRICTION_NO_JIT", "")
+    word = value.strip().lower()
+    if word in _FALSE:
+        return False
+    if word in _TRUE:
+        return True
+    raise ValueError(f"the environment variable PREFRICTION_NO_JIT must be one of 1, true, yes, on (compiled code "
+                     f"off) or 0, false, no, off, empty (on), got {value!r}")
 
 
 def _compiler() -> str | None:
@@ -79,17 +108,42 @@ def _which(name: str) -> str | None:
 
 
 def jit_available() -> bool:
-    """True if compiled code can be used: a C compiler exists and ``PREFRICTION_NO_JIT`` is unset."""
-    return os.environ.get("PREFRICTION_NO_JIT", "") in ("", "0") and _compiler() is not None
+    """True if compiled code can be used: a C compiler exists and ``PREFRICTION_NO_JIT`` is off.
+
+    The first time in a process that no compiler is found, a ``RuntimeWarning`` says what that
+    costs and how to install one.
+    """
+    if no_jit():
+        return False
+    if _compiler() is not None:
+        return True
+    if not _WARNED:
+        _WARNED.append(True)
+        warnings.warn(
+            f"prefriction found no C compiler ({os.environ.get('CC', 'gcc')!r}, from $CC or gcc, is not on the PATH): "
+            "simulations run interpreted, about 100 times slower. Install one (Debian/Ubuntu: apt install gcc; "
+            "Fedora: dnf install gcc; macOS: xcode-select --install; conda: conda install c-compiler) or set "
+            "PREFRICTION_NO_JIT=1 to choose interpreted code without this warning.", RuntimeWarning, stacklevel=2)
+    return False
 
 
 def compile_timeout() -> float:
-    """Longest wait for the C compiler [s]: ``$PREFRICTION_COMPILE_TIMEOUT``, else 120."""
-    try:
-        value = float(os.environ.get("PREFRICTION_COMPILE_TIMEOUT", "120"))
-    except ValueError:
+    """Longest wait for the C compiler [s]: ``$PREFRICTION_COMPILE_TIMEOUT``, else 120.
+
+    ``inf`` or any value at or above :data:`NO_TIMEOUT` means no limit (returned as ``inf``);
+    ``ValueError`` naming the variable for a value that is no number > 0.
+    """
+    text = os.environ.get("PREFRICTION_COMPILE_TIMEOUT", "").strip()
+    if not text:
         return 120.0
-    return value if value > 0 else 120.0
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not value > 0:
+        raise ValueError(f"the environment variable PREFRICTION_COMPILE_TIMEOUT must be a number of seconds > 0 "
+                         f"(inf or >= {NO_TIMEOUT:g} for no limit), got {text!r}")
+    return float("inf") if value >= NO_TIMEOUT else value
 
 
 def _say(line: str) -> None:
@@ -122,7 +176,7 @@ def compiled(fun: ca.Function, what: str = "") -> tuple[ca.Function, CompileInfo
         The external Function with the same inputs and outputs as ``fun``, or ``fun`` itself
         when no compiler is available or compiling fails (``CompileInfo.reason`` says why).
     """
-    if os.environ.get("PREFRICTION_NO_JIT", "") not in ("", "0"):
+    if no_jit():
         return fun, CompileInfo("interpreted", 0.0, reason="PREFRICTION_NO_JIT is set")
     name = fun.name()
     with tempfile.TemporaryDirectory(prefix="prefriction-") as tmp:
@@ -138,7 +192,8 @@ def compiled(fun: ca.Function, what: str = "") -> tuple[ca.Function, CompileInfo
 
 
 def library(name: str, source: str, what: str, load: Callable[[Path, str], tuple[Optional[Any], str]],
-            fallback: str = "the interpreted Function") -> tuple[Optional[Any], CompileInfo]:
+            fallback: str = "the interpreted Function",
+            cflags: tuple[str, ...] = CFLAGS) -> tuple[Optional[Any], CompileInfo]:
     """The shared library of the C ``source`` from the cache, or compiled into it, loaded by ``load``.
 
     ``load(path, key)`` returns the loaded object or ``None`` and what is wrong with the file
@@ -146,31 +201,37 @@ def library(name: str, source: str, what: str, load: Callable[[Path, str], tuple
     it waits on the lock beside it (:func:`~prefriction.simulation.library_store.build_lock`)
     and loads what the first published. Returns ``(None, info)`` when no compiler is available
     or compiling fails (``info.reason`` says why): the caller then uses ``fallback``, which the
-    line printed to stderr names.
+    line printed to stderr names. ``cflags`` are the compiler flags (they enter the key).
     """
-    if os.environ.get("PREFRICTION_NO_JIT", "") not in ("", "0"):
+    if no_jit():
         return None, CompileInfo("interpreted", 0.0, reason="PREFRICTION_NO_JIT is set")
     cc = _compiler()
     if cc is None:
+        jit_available()  # the one warning of the process
         return None, CompileInfo("interpreted", 0.0, reason="no C compiler found (gcc or $CC)")
     start = time.perf_counter()
-    key = hashlib.sha256(source.encode() + " ".join((cc, *CFLAGS)).encode()
+    key = hashlib.sha256(source.encode() + " ".join((cc, *cflags)).encode()
                          + ca.__version__.encode()).hexdigest()[:24]
-    directory = cache_dir()
+    cache = cache_dir()
+    directory, refused = store.trusted_dir(cache)
+    if refused:
+        _say(f"the compile cache {cache} is refused ({refused}): a library there could have been written by "
+             f"someone else. Compiled code is kept for this process only, in {directory}; make the cache yours and "
+             f"private (chown, chmod 700) or set PREFRICTION_CACHE to a directory of yours")
     lib = directory / f"{name}_{key}.so"
     found, problem = _from_cache(name, lib, key, load, fallback)
     if found is not None:
         return found
-    blocked = store.unwritable(directory, lib)
+    blocked = store.unwritable(directory, lib) or (f"the cache {cache} is not trusted" if directory != cache else "")
     if blocked:
-        return _build(name, source, what, cc, lib, key, problem, blocked, start, load, fallback)
+        return _build(name, source, what, (cc, *cflags), lib, key, problem, blocked, start, load, fallback)
     patience = compile_timeout() + 10.0  # the holder's compiler is stopped after compile_timeout()
     with store.build_lock(lib, patience, lambda path: _say(
             f"{name}: waiting for another process that is compiling it (lock {path})")):
         found, problem = _from_cache(name, lib, key, load, fallback)  # published while this process waited
         if found is not None:
             return found
-        return _build(name, source, what, cc, lib, key, problem, "", start, load, fallback)
+        return _build(name, source, what, (cc, *cflags), lib, key, problem, "", start, load, fallback)
 
 
 def _from_cache(name: str, lib: Path, key: str, load: Callable[[Path, str], tuple[Optional[Any], str]],
@@ -180,19 +241,20 @@ def _from_cache(name: str, lib: Path, key: str, load: Callable[[Path, str], tupl
     ext, problem = load(lib, key)
     if ext is not None:
         return (ext, CompileInfo("cached", 0.0, str(lib))), ""
-    earlier = store.failure_note(lib)
+    earlier = store.failure_note(lib, compile_timeout())
     if earlier:
-        _say(f"{name}: {earlier}; using {fallback} (same results, slower)")
+        _say(f"{name}: {earlier}; using {fallback} (the same computation, slower)")
         return (None, CompileInfo("interpreted", 0.0, reason=earlier)), ""
     return None, problem
 
 
-def _build(name: str, source: str, what: str, cc: str, lib: Path, key: str, problem: str, blocked: str,
+def _build(name: str, source: str, what: str, command: tuple[str, ...], lib: Path, key: str, problem: str, blocked: str,
            start: float, load: Callable[[Path, str], tuple[Optional[Any], str]],
            fallback: str) -> tuple[Optional[Any], CompileInfo]:
     """Compile ``source`` into ``lib`` (or a directory of this process if ``blocked`` says why the
     cache cannot hold it), publish it and load it; ``problem`` is what was wrong with the library
-    found there, ``start`` when :func:`library` began [s]."""
+    found there, ``command`` the compiler and its flags, ``start`` when :func:`library` began [s]."""
+    cc = command[0]
     dest = store.private_dir() / lib.name if blocked else lib
     where = (f"{blocked}: compiled code kept for this process only, in {dest.parent}" if blocked
              else f"cached in {lib.parent}")
@@ -203,10 +265,10 @@ def _build(name: str, source: str, what: str, cc: str, lib: Path, key: str, prob
         src.write_text(source)
         part = src.with_name(lib.name)
         try:
-            _run_compiler([cc, *CFLAGS, str(src), "-o", str(part), "-lm"])
+            _run_compiler([*command, str(src), "-o", str(part), "-lm"])
         except subprocess.TimeoutExpired:
             why = f"compiling {name} with {cc} took longer than {compile_timeout():g} s (PREFRICTION_COMPILE_TIMEOUT)"
-            return _interpreted(lib, why, fallback)
+            return _interpreted(lib, why, fallback, timeout=compile_timeout())
         except subprocess.CalledProcessError as exc:
             detail = exc.stderr.decode(errors="replace").strip().splitlines()[-1:] or [f"exit status {exc.returncode}"]
             return _interpreted(lib, f"compiling {name} with {cc} failed: {detail[0]}", fallback)
@@ -230,7 +292,8 @@ def _run_compiler(cmd: list[str]) -> None:
     """Run the compiler; on timeout stop it and everything it started (``TimeoutExpired``)."""
     with subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True) as proc:
         try:
-            out, err = proc.communicate(timeout=compile_timeout())
+            limit = compile_timeout()
+            out, err = proc.communicate(timeout=None if limit == float("inf") else limit)
         except subprocess.TimeoutExpired:
             os.killpg(proc.pid, signal.SIGKILL)
             proc.communicate()
@@ -239,10 +302,11 @@ def _run_compiler(cmd: list[str]) -> None:
         raise subprocess.CalledProcessError(proc.returncode, cmd, out, err)
 
 
-def _interpreted(lib: Path, why: str, fallback: str, record: bool = True) -> tuple[None, CompileInfo]:
+def _interpreted(lib: Path, why: str, fallback: str, record: bool = True,
+                 timeout: Optional[float] = None) -> tuple[None, CompileInfo]:
     """No library: one line on stderr (the caller falls back to interpreted code); note a
-    compiler failure beside ``lib``."""
+    compiler failure beside ``lib`` (``timeout`` [s]: the limit it was stopped at)."""
     if record:
-        store.record_failure(lib, why)
-    _say(f"{why}; using {fallback} (same results, slower)")
+        store.record_failure(lib, why, timeout)
+    _say(f"{safe.printable(why, 500)}; using {fallback} (the same computation, slower)")
     return None, CompileInfo("interpreted", 0.0, reason=why)

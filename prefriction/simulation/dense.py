@@ -127,6 +127,7 @@ def dense(run: "Run", times: np.ndarray, t_end: float, n_target: float, buf: Sam
     b = run.breaks
     grid = np.union1d(times, b[(b > run.st["t"]) & (b < last)]) if b.size else np.asarray(times, dtype=float)
     is_sample = np.isin(grid, times) if b.size else np.ones(grid.size, dtype=bool)
+    is_break = np.isin(grid, b) if b.size else np.zeros(grid.size, dtype=bool)
     i = 0
     if grid.size and grid[0] <= run.st["t"]:
         buf.append(run.sample())
@@ -140,6 +141,8 @@ def dense(run: "Run", times: np.ndarray, t_end: float, n_target: float, buf: Sam
         m = len(pts)
         n0 = len(run.rev)
         xf, a = run._call(run.f1, run.L, pts.tolist(), nstop)
+        m = _rest_ends_at_break(run, xf, pts, is_break[i:i + m], a, nstop)
+        pts = pts[:m]
         cols = xf[:, :m]
         n_col = np.floor(cols[n_key] + 0.5)
         total = n_col[-1] - n0
@@ -155,6 +158,23 @@ def dense(run: "Run", times: np.ndarray, t_end: float, n_target: float, buf: Sam
             used = m
         i += used
     return False
+
+
+def _rest_ends_at_break(run: "Run", xf: np.ndarray, pts: np.ndarray, is_break: np.ndarray, a: dict,
+                        nstop: float) -> int:
+    """Number of the call's outputs to keep: all of them, or those up to the first sample time of
+    the input or reference (``is_break``) at which a resting mass feels a net force above the
+    rest threshold. The input's jump there falls between two output intervals, where the plant
+    sees no sign change of its rest-exit indicator; the next call starts at that time and
+    leaves the rest (``Run._leave_rest``)."""
+    if "rest" not in run.L.state:
+        return len(pts)
+    rest = xf[run.L.state["rest"], :len(pts) - 1]
+    for j in np.flatnonzero(is_break[:-1] & (rest > 0.5)):
+        out = run._unpack(run.L, xf[:, j], a, len(run.rev), nstop)
+        if not out["frozen"] and run._leaves_rest_at(out, float(pts[j]), a["Av"]):
+            return int(j) + 1
+    return len(pts)
 
 
 def _columns_together(run: "Run", cols: np.ndarray, pts: np.ndarray, is_sample: np.ndarray, a: dict,

@@ -36,9 +36,10 @@ from prefriction._validation import check_positive, check_real_array
 Reference = Union[float, Callable[[Any], Any], tuple]
 
 MAX_SAMPLES = 10_000_000
-"""Largest number of sample instants of a sampled loop: each keeps about ten numbers of output
-(about 1 GB at the limit) and costs microseconds (a minute at the limit); more would exhaust the
-memory or appear to hang. Split a longer run, or sample less often."""
+"""Largest number of sample instants of a sampled loop: each costs microseconds (a minute at the
+limit); more would appear to hang. Each also keeps its inputs and records (about 60 numbers for
+a PID loop of a Dahl stage), so the memory limit (:data:`prefriction._memory.MAX_BYTES`) may
+refuse a run below this count. Split a longer run, or sample less often."""
 
 
 def sample_count(t_end: float, Ts: float, periods: float) -> int:

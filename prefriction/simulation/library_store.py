@@ -14,6 +14,12 @@ needs the same library waits for it (:func:`build_lock`) and then loads the publ
 instead of compiling it again. The kernel releases the lock when its holder exits, so a killed
 process leaves no stale lock; without ``fcntl`` (Windows) there is no lock and two processes may
 both compile (each publishes the same bytes atomically).
+
+Every file is read and written through :mod:`prefriction._safe_files`: the cache directory is
+created 0700 and used only if it and its parents are this user's own and not writable by
+others (:func:`trusted_dir`; else this process compiles into a private temporary directory);
+libraries, checksums, notes and locks are opened without following links and must be this
+user's files; a note is printed as data (printable ASCII, one line), never raw.
 """
 
 from __future__ import annotations
@@ -24,6 +30,7 @@ import hashlib
 import os
 import shutil
 import tempfile
+import threading
 import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -31,14 +38,23 @@ from typing import Optional
 
 import casadi as ca
 
+from prefriction import _safe_files as safe
+
 try:
     import fcntl
 except ImportError:  # Windows: no advisory file locks; concurrent builds stay correct, only duplicated
     fcntl = None  # type: ignore[assignment]
 
-__all__ = ["build_lock", "failure_note", "load", "private_dir", "publish", "record_failure", "unwritable", "verify"]
+__all__ = ["build_lock", "failure_note", "load", "private_dir", "publish", "record_failure", "trusted_dir",
+           "unwritable", "verify"]
 
 _PRIVATE: list[Path] = []
+_PRIVATE_LOCK = threading.Lock()
+_REFUSED: dict[str, str] = {}  # cache directories refused in this process -> why
+MAX_LIBRARY = 1 << 30
+"""Largest library [bytes] the cache reads (a generated plant is a few MiB)."""
+MAX_NOTE = 4096
+"""Largest checksum or failure note [bytes] the cache reads."""
 
 
 def _sidecar(lib: Path) -> Path:
@@ -47,10 +63,6 @@ def _sidecar(lib: Path) -> Path:
 
 def _marker(lib: Path) -> Path:
     return lib.with_name(lib.name[: -len(".so")] + ".failed")
-
-
-def _digest(path: Path) -> str:
-    return hashlib.sha256(path.read_bytes()).hexdigest()
 
 
 def _same_signature(a: ca.Function, b: ca.Function) -> bool:
@@ -66,16 +78,20 @@ def verify(lib: Path, key: str) -> str:
     ``"missing"`` if there is none yet)."""
     if not os.path.lexists(lib):
         return "missing"
-    if lib.is_dir():
+    if lib.is_dir() and not lib.is_symlink():
         return f"{lib} is a directory, not a library"
     try:
-        stored = _sidecar(lib).read_text().split()
-    except OSError:
-        return f"{lib} has no readable checksum beside it (written by an older version or damaged)"
-    try:
-        actual = _digest(lib)
+        actual = hashlib.sha256(safe.read_owned(lib, MAX_LIBRARY)).hexdigest()
+    except safe.UnsafeFile as exc:
+        return f"{exc}: not loaded"
     except OSError as exc:
         return f"{lib} cannot be read ({exc.strerror or exc})"
+    try:
+        stored = safe.read_owned(_sidecar(lib), MAX_NOTE).decode("ascii", "replace").split()
+    except safe.UnsafeFile as exc:
+        return f"{exc}: {lib} not loaded"
+    except OSError:
+        return f"{lib} has no readable checksum beside it (written by an older version or damaged)"
     if stored[1:2] != [key]:
         return f"{lib} belongs to another structure (its checksum file names another key)"
     if stored[:1] != [actual]:
@@ -100,68 +116,91 @@ def load(fun: ca.Function, lib: Path, key: str) -> tuple[Optional[ca.Function], 
     return ext, ""
 
 
-def _atomic_write(data: bytes, dest: Path) -> None:
-    """Write ``data`` to ``dest`` through a temporary file in its directory and a rename."""
-    fd, tmp = tempfile.mkstemp(prefix=f".{dest.name}.", dir=dest.parent)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.chmod(tmp, 0o644)  # mkstemp makes 0600: let other users of a shared cache read it
-        os.replace(tmp, dest)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
 def publish(built: Path, lib: Path, key: str) -> None:
     """Store the freshly built library ``built`` as ``lib`` with its checksum (``OSError`` if it cannot)."""
     data = built.read_bytes()
-    _atomic_write(data, lib)
-    _atomic_write(f"{hashlib.sha256(data).hexdigest()} {key}\n".encode(), _sidecar(lib))
+    safe.write_atomic(lib, data)
+    safe.write_atomic(_sidecar(lib), f"{hashlib.sha256(data).hexdigest()} {key}\n".encode())
     _marker(lib).unlink(missing_ok=True)
 
 
 def unwritable(directory: Path, lib: Path) -> str:
     """Why ``lib`` cannot be stored in ``directory`` (``""`` if it can)."""
     try:
-        directory.mkdir(parents=True, exist_ok=True)
+        safe.make_private_dir(directory)
         fd, probe = tempfile.mkstemp(prefix=".probe.", dir=directory)
         os.close(fd)
         os.unlink(probe)
     except OSError as exc:
         return f"the cache {directory} is not writable ({exc.strerror or exc})"
-    if lib.is_dir():
+    if lib.is_dir() and not lib.is_symlink():
         return f"{lib} is a directory, not a library (remove it to use the cache again)"
     return ""
 
 
-def private_dir() -> Path:
-    """A directory of this process for libraries the cache cannot hold (removed at exit)."""
-    if not _PRIVATE:
-        path = Path(tempfile.mkdtemp(prefix="prefriction-jit-"))
-        atexit.register(shutil.rmtree, path, True)
-        _PRIVATE.append(path)
-    return _PRIVATE[0]
+def trusted_dir(directory: Path) -> tuple[Path, str]:
+    """The directory to load libraries from and store them in, and why ``directory`` was refused.
 
-
-def record_failure(lib: Path, why: str) -> None:
-    """Note beside ``lib`` that building it failed with ``why`` (best effort)."""
+    ``directory`` (created with its missing parents, mode 0700) is used if it and its parents
+    are this user's own and not writable by others (:func:`prefriction._safe_files.dir_problem`);
+    otherwise this process's :func:`private_dir` is, and the second item says why (non-empty
+    only the first time a directory is refused in this process: one message each).
+    """
     try:
-        _atomic_write(why.encode(), _marker(lib))
+        safe.make_private_dir(directory)
+    except OSError:
+        return directory, ""  # nothing there to load; unwritable() says why it cannot be stored
+    key = str(directory)
+    if key in _REFUSED:
+        return private_dir(), ""
+    problem = safe.dir_problem(directory)
+    if not problem:
+        return directory, ""
+    _REFUSED[key] = problem
+    return private_dir(), problem
+
+
+def private_dir() -> Path:
+    """A directory of this process (mode 0700) for libraries the cache cannot hold (removed at exit)."""
+    with _PRIVATE_LOCK:
+        if not _PRIVATE:
+            path = Path(tempfile.mkdtemp(prefix="prefriction-jit-"))
+            atexit.register(shutil.rmtree, path, True)
+            _PRIVATE.append(path)
+        return _PRIVATE[0]
+
+
+def record_failure(lib: Path, why: str, timeout: Optional[float] = None) -> None:
+    """Note beside ``lib`` that building it failed with ``why`` (best effort); ``timeout`` [s] is
+    the compiler's time limit if it was stopped (a later process with a longer one tries again)."""
+    try:
+        safe.write_atomic(_marker(lib), f"timeout={'' if timeout is None else repr(float(timeout))}\n{why}".encode())
     except OSError:
         pass
 
 
-def failure_note(lib: Path) -> str:
-    """The failure recorded beside ``lib`` by an earlier process, with how to retry (``""`` if none)."""
+def failure_note(lib: Path, timeout: float) -> str:
+    """The failure recorded beside ``lib`` by an earlier process, with how to retry (``""`` if none).
+
+    A note is data: it is read only if it is this user's own file (no link followed) and returned
+    as one line of printable ASCII. A note of a compiler stopped after a shorter time limit than
+    ``timeout`` [s] is ignored (this process tries again, with its longer limit).
+    """
     marker = _marker(lib)
     try:
-        why = marker.read_text().strip()
+        text = safe.read_owned(marker, MAX_NOTE).decode("utf-8", "replace")
     except OSError:
         return ""
-    return f"{why} in an earlier process; delete {marker} to try again"
+    first, _, why = text.partition("\n")
+    if not first.startswith("timeout="):
+        return ""  # not a note this version wrote
+    try:
+        limit = float(first[len("timeout="):]) if first != "timeout=" else None
+    except ValueError:
+        return ""
+    if limit is not None and not timeout <= limit:
+        return ""
+    return f"{safe.printable(why)} in an earlier process; delete {marker} to try again"
 
 
 @contextlib.contextmanager
@@ -178,8 +217,8 @@ def build_lock(lib: Path, patience: float, waiting: Callable[[Path], None]) -> I
         return
     path = lib.with_name(lib.name + ".lock")
     try:
-        fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
-    except OSError:
+        fd = safe.open_lock(path)
+    except OSError:  # a link or another user's file (not followed), or no lock possible here
         yield False
         return
     try:

@@ -65,17 +65,31 @@ class Rest:
     rev_events: list
     _scales: Callable[[], dict]
 
-    def _net_force(self) -> float:
-        """Normalised net force ``u~ - F~`` on the mass in the current state."""
-        st, sc, fb = self.st, self.sc, self.fb
-        t_si = st["t"] * sc.t
+    def _net_force(self, state: Optional[dict] = None, t: Optional[float] = None) -> float:
+        """Normalised net force ``u~ - F~`` on the mass in the current state (or in ``state``,
+        an unpacked output column, at the normalised time ``t``)."""
+        sc, fb = self.sc, self.fb
+        st = self.st if state is None else state
+        t_si = (self.st["t"] if t is None else t) * sc.t
         u = float(self.system.u(t_si)) if self.system.forced else 0.0
         if self.spec.fb == "continuous":
             e = float(self.fb.reference(t_si)) - st["x"] * sc.x
             u += float(self.fb.force(st["xc"], e))
         elif fb is not None and fb.sampled:
-            u += st["uhold"]
+            u += self.st["uhold"]
         return u / sc.F - st["F"]
+
+    def _leaves_rest_at(self, state: dict, t: float, Av: float) -> bool:
+        """True if the mass of the unpacked output column ``state``, at rest at the normalised
+        time ``t`` (a sample time of the input or reference, where it may jump), feels a net
+        force above the rest threshold ``EPS_REST Av`` (``Av`` the call's velocity scale times
+        ``eps``).
+
+        Inside a call the end of a rest is an event (``eps_rest - |a~|`` turning negative),
+        but an input that jumps at an output time makes the indicator jump between two output
+        intervals, where no sign change is seen: such a call must end there
+        (``docs/simulator.md#events``)."""
+        return state["rest"] > 0.5 and abs(self._net_force(state, t)) > EPS_REST * Av
 
     def _leave_rest(self) -> None:
         """End a rest at the start of a call if the net force no longer vanishes (the input or the

@@ -70,6 +70,7 @@ class Run(StateIO, Rest):
         self.breaks = np.zeros(0)  # sample times of sampled signals (normalised)
         self.S = np.ones(spec.n_c)  # controller state scales (times eps)
         self.P0 = np.zeros(self.L.np)  # parameters fixed during the run
+        self.note = ""  # a change of method during the run, for the result's message
 
     # --- one call -----------------------------------------------------------------------
     def _call(self, call: BufferedIntegrator, L: Layout, times: list[float], nstop: float) -> tuple[np.ndarray, dict]:
@@ -142,7 +143,7 @@ class Run(StateIO, Rest):
             f"simulate failed after t = {st['t'] * sc.t:.9g} s (state there: x = {st['x'] * sc.x:.6g} m, "
             f"v = {st['v'] * sc.v:.6g} m/s, F = {st['F'] * sc.F:.6g} N, direction {int(st['s']):+d}, "
             f"{len(self.rev)} reversals so far): {why}. Try a looser rtol, a shorter t_end or fewer "
-            f"reversals, or a smoother input force (samples closer together)."
+            f"reversals" + (", or a smoother input force (samples closer together)." if self.spec.forced else ".")
         )
 
     def _record(self, out: dict) -> None:

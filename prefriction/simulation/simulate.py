@@ -257,6 +257,8 @@ def simulate(
         status, message = 1, f"reached {int(n_target)} reversals at t = {run.rev.t[int(n_target) - 1] * sc.t:.9g} s"
     else:
         status, message = 0, f"reached t_end = {t_end_si:.9g} s"
+    if run.note:
+        message += f"; {run.note}"
     wall = time.perf_counter() - start
 
     n_rev = int(min(len(run.rev), n_target))

@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, Optional
 
 import casadi as ca
+import numpy as np
 
 from prefriction._validation import check_bool
+from prefriction.errors import SolverError
 from prefriction.models import FrictionModel, Oscillator
 from prefriction.signals import Constant
 from prefriction.simulation.compiled import compiled
@@ -17,6 +19,74 @@ from prefriction.simulation.plant import EPS_TOUCH, Layout, PlantSpec, build_int
 __all__ = ["plant_step"]
 
 _NSTOP = 1e9  # no reversal limit within a step
+RTOL_RANGE = (1e-13, 1e-2)
+"""The tolerances a numeric call of :func:`plant_step` accepts (as :func:`prefriction.simulate`)."""
+
+
+class PlantStep(ca.Function):
+    """The Function of :func:`plant_step`; a call with numbers has its arguments checked first.
+
+    With numeric arguments (floats, lists, numpy arrays, ``DM``) a state of the wrong size or
+    with a non-finite entry, non-finite numbers ``q`` or force ``u``, a step ``h`` that is
+    negative or not finite, or ``rtol`` outside :data:`RTOL_RANGE` is a ``ValueError`` naming
+    the argument, and an integrator failure inside the step (e.g. more events than one step
+    can hold) a :class:`prefriction.SolverError` saying what helps. Symbolic calls (``SX``,
+    ``MX``, inside an NLP) go to CasADi unchanged.
+    """
+
+    def __call__(self, *args: Any, **kwargs: Any) -> Any:
+        values = _numbers(self, args, kwargs)
+        if values is None:
+            return super().__call__(*args, **kwargs)
+        _check_call(values, self.size1_in(0), self.size1_in(1))
+        try:
+            return super().__call__(*args, **kwargs)
+        except RuntimeError as exc:
+            last = str(exc).strip().splitlines()[-1]
+            raise SolverError(
+                f"plant_step failed inside the step of h = {values['h']!r} (normalised time) from y0 = "
+                f"{np.asarray(values['y0']).ravel().tolist()!r}: {last}. Take shorter steps (a step holds at most a "
+                f"few reversals and model events; a half-period of the free motion is about pi) or a looser rtol"
+            ) from exc
+
+
+def _numbers(fun: ca.Function, args: tuple, kwargs: dict) -> Optional[dict]:
+    """The arguments of a call by name as float arrays, or None if any is symbolic or not a number."""
+    names = fun.name_in()
+    if kwargs and (args or set(kwargs) - set(names)):
+        return None
+    given = dict(zip(names, args)) if args else kwargs
+    if len(given) != len(names):
+        return None
+    out = {}
+    for name, value in given.items():
+        if isinstance(value, (ca.SX, ca.MX)) or (isinstance(value, (list, tuple))
+                                                 and any(isinstance(v, (ca.SX, ca.MX)) for v in value)):
+            return None
+        try:
+            out[name] = np.asarray(value.full() if isinstance(value, ca.DM) else value, dtype=float)
+        except (TypeError, ValueError):
+            return None
+    return out
+
+
+def _check_call(values: dict, n_y: int, n_q: int) -> None:
+    """``ValueError`` naming the first argument of a numeric :class:`PlantStep` call out of its range."""
+    y0, q = values["y0"].ravel(), values["q"].ravel()
+    if y0.size != n_y or not np.all(np.isfinite(y0)):
+        raise ValueError(f"y0 must be {n_y} finite numbers [x~, v~, z..., s, m...], got {y0.tolist()!r}")
+    if q.size != n_q or not np.all(np.isfinite(q)):
+        raise ValueError(f"q must be the model's {n_q} finite run-time numbers, got {q.tolist()!r}")
+    for name in ("u", "h", "rtol"):
+        if values[name].size != 1:
+            raise ValueError(f"{name} must be one number, got {values[name].ravel().tolist()!r}")
+    u, h, rtol = (float(values[k].ravel()[0]) for k in ("u", "h", "rtol"))
+    if not math.isfinite(u):
+        raise ValueError(f"u must be a finite normalised force (u [N] / Fc), got {u!r}")
+    if not (math.isfinite(h) and h >= 0.0):
+        raise ValueError(f"h must be a finite step >= 0 (normalised time), got {h!r}")
+    if not RTOL_RANGE[0] <= rtol <= RTOL_RANGE[1]:
+        raise ValueError(f"rtol must lie in [{RTOL_RANGE[0]:g}, {RTOL_RANGE[1]:g}], got {rtol!r}")
 
 
 def plant_step(model: Any, *, jit: bool = False) -> ca.Function:
@@ -58,7 +128,8 @@ def plant_step(model: Any, *, jit: bool = False) -> ca.Function:
     Returns
     -------
     casadi.Function
-        ``plant_step(y0, q, u, h, rtol) -> (y1, reversals, ok)``.
+        ``plant_step(y0, q, u, h, rtol) -> (y1, reversals, ok)`` (a :class:`PlantStep`: numeric
+        calls are checked, ``ValueError`` naming an argument out of range).
 
     Examples
     --------
@@ -110,5 +181,5 @@ def plant_step(model: Any, *, jit: bool = False) -> ca.Function:
     fun = ca.Function("plant_step", [y0, q, u, h, rtol], [y1, out["n"], ok],
                       ["y0", "q", "u", "h", "rtol"], ["y1", "reversals", "ok"])
     if not check_bool("jit", jit):
-        return fun
-    return compiled(fun, f"{type(model).__name__} plant over a step")[0]
+        return PlantStep(fun)
+    return PlantStep(compiled(fun, f"{type(model).__name__} plant over a step")[0])

@@ -18,6 +18,7 @@ from typing import Optional
 import casadi as ca
 import numpy as np
 
+from prefriction._memory import check_memory
 from prefriction.models import Oscillator
 from prefriction.signals import Constant
 from prefriction.simulation.compiled import compiled, jit_available
@@ -217,6 +218,9 @@ def run_sampled(
     eps = rtol * _CAL * math.sqrt(L.n_active / L.nx)
     Ts_n, t_end_n = fb.Ts / sc.t, t_end / sc.t
     n_s = sample_count(t_end_n, Ts_n, t_end / fb.Ts)
+    lay = LoopLayout(spec)  # before any compile: the inputs and records of every sample
+    check_memory(f"the sampled loop of {type(model).__name__}", n_s, lay.nw + lay.nrec + 12 + n_user,
+                 "sample instants", "increase Ts or split the run")
     tk = np.minimum(np.arange(n_s) * Ts_n, t_end_n)
     blk, setup, mode = _block(spec, jit)
     LL = blk.LL

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from prefriction.simulation.native.library import HEAD
+from prefriction.simulation.stiff import advance_stiff
 
 if TYPE_CHECKING:
     from prefriction.simulation.run import Run
@@ -21,11 +22,14 @@ if TYPE_CHECKING:
 __all__ = ["BLOCK", "advance_native"]
 
 BLOCK = 1 << 16  # reversals per C call (4 x 512 kB of output buffers)
+STIFF = 6  # the driver's code of a stiff branch (PF_STIFF)
 _WHY = {
     2: "its amplitude fell below 1e-250 normalised units, or its velocity crosses zero only at the level of "
        "the integration error",
     3: "the right-hand side became non-finite",
-    4: "more than 1e6 steps without a reversal",
+    4: "more than 1e6 steps without a reversal (the driver's limit per half-cycle; these steps were held by the "
+       "accuracy asked for, not by stiffness, which switches to the implicit method after 20,000 steps): the "
+       "half-cycle is very long against its own time scale",
     5: "the step size fell below round-off of the time",
 }
 
@@ -61,6 +65,11 @@ def advance_native(run: "Run", t_target: float, n_target: float) -> bool:
     z, m = state[HEAD:HEAD + drv.nz].tolist(), state[HEAD + drv.nz:].tolist()
     st.update(t=float(t), x=float(x), v=float(v), s=float(s), z=z, m=m, ne=int(ne),
               F=float(model.force(z, m, float(v), float(s), run.q.tolist())))
+    if code == STIFF:  # the rest of the run on the implicit method (docs/simulator.md#stiff)
+        run.note = (f"switched to the implicit Radau method at t = {st['t'] * run.sc.t:.9g} s after "
+                    f"{len(run.rev)} reversal{'' if len(run.rev) == 1 else 's'}: the explicit Runge-Kutta step was held by stability "
+                    f"(h |lambda| > 3.25 on 15 steps of a branch longer than 20,000 steps), the problem is stiff")
+        return advance_stiff(run, t_target, n_target)
     if code > 1:
         raise run._failure(_WHY[code])
     return n >= n_target

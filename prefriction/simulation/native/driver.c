@@ -25,9 +25,10 @@
 #define PF_NMA (PF_NM > 0 ? PF_NM : 1)
 #define PF_NEA (PF_NE > 0 ? PF_NE : 1)
 #define PF_BRANCH_STEPS 1000000L /* steps without a reversal before a run is stopped */
+#define PF_STIFF_STEPS 20000L    /* steps on a branch before a stiff one is handed to the implicit method */
 
 enum { PF_REVERSALS = 0, PF_T_END = 1, PF_DIED_OUT = 2, PF_NONFINITE = 3, PF_TOO_MANY_STEPS = 4,
-       PF_STEP_UNDERFLOW = 5 };
+       PF_STEP_UNDERFLOW = 5, PF_STIFF = 6 };
 
 static const double pf_A[7][6] = {
   {0., 0., 0., 0., 0., 0.},
@@ -168,7 +169,11 @@ static void pf_scale(pf_scales* S, const double* y, double F, double eps) {
   int i;
   S->sc[0] = fmax(fmax(A, 0.5 * A * A), fmin(fabs(y[0]), 1.0)) * eps;
   S->sc[1] = A * eps;
-  for (i = 2; i < PF_NY; ++i) S->sc[i] = fmin(A, 1.0) * eps;
+  /* a state that carries the travel (models that track the position: Dahl's log-gap L, gamma >= 1,
+   * grows like v^2/2 in deep gross sliding while F = 1 - exp(-L) has long saturated) is held to
+   * its own size, as the position would be: against eps alone, the round-off of v in its
+   * increments stopped the run at |v| ~ 1.5e7 */
+  for (i = 2; i < PF_NY; ++i) S->sc[i] = (PF_NORM_X ? fmin(A, 1.0) : fmax(fmin(A, 1.0), fabs(y[i]))) * eps;
 }
 
 /* the scales and the branch energy at the state y */
@@ -194,6 +199,33 @@ static double pf_first_step(pf_ctx* c, const pf_scales* S, const double* y, cons
   return fmin(fmin(100.0 * h0, h1), dur);
 }
 
+#if PF_VSCALE
+/* A step near a narrow curve of the force in the speed (Stribeck velocity vs): within PF_CURVE_K vs
+ * of v = 0 the speed changes by at most PF_CURVE_C vs per step (at the rate a = v'), and a step
+ * from outside ends at most PF_CURVE_C vs inside that band, so that stages sample the curve and
+ * the error estimate sees it (docs/simulator.md#narrow-stribeck). */
+#define PF_CURVE_K 3.0
+#define PF_CURVE_C 0.5
+static double pf_curve_bound(double vs, double v, double a) {
+  return (fmax(fabs(v) - PF_CURVE_K * vs, 0.0) + PF_CURVE_C * vs) / fmax(fabs(a), 1e-300);
+}
+#endif
+
+/* Stiffness test of Hairer & Wanner (dopri5, II.IV.2): the stages 6 and 7 are both at the step's
+ * end, so h |lambda| ~ |h f7 - h f6| / |y7 - y6| (scaled norms); above 3.25 the step size is held
+ * by the explicit method's stability, not by its accuracy. */
+static int pf_stiff_step(const pf_scales* S, const double U[7][PF_NY], const double* y7, const double* y6) {
+  double num = 0.0, den = 0.0, a, b;
+  int i;
+  for (i = 0; i < PF_NY; ++i) {
+    a = (U[6][i] - U[5][i]) / S->sc[i];
+    b = (y7[i] - y6[i]) / S->sc[i];
+    num += a * a;
+    den += b * b;
+  }
+  return den > 0.0 && num > 3.25 * 3.25 * den;
+}
+
 /* One run from the state st[] until n_max reversals, the time t_end or a failure (the codes
  * above). Each reversal writes its time, position, force (after the model's reset) and the model
  * events of the half-cycle it ends. eps: the run's tolerance; snap: the coincidence tolerance of
@@ -202,9 +234,9 @@ int pf_run(const double* q, double eps, double snap, double* st, double t_end, l
            double* t_out, double* x_out, double* F_out, double* ev_out, long* n_done, long* steps) {
   pf_ctx c;
   pf_scales S;
-  double y[PF_NY], y0[PF_NY], ys[PF_NY], f0[PF_NY], e[PF_NY], U[7][PF_NY], g0[PF_NEA], g1[PF_NEA];
-  double t = st[0], ne = st[4], t_last = st[5], t_prev = st[6], h, err, err_prev = 1.0, fac, dur;
-  long n = 0, branch_steps = 0;
+  double y[PF_NY], y0[PF_NY], ys[PF_NY], y6[PF_NY], f0[PF_NY], e[PF_NY], U[7][PF_NY], g0[PF_NEA], g1[PF_NEA];
+  double t = st[0], ne = st[4], t_last = st[5], t_prev = st[6], h, err, err_prev = 1.0, fac, dur, vs = 0.0;
+  long n = 0, branch_steps = 0, stiff = 0, nonstiff = 0;
   int i, j, rejected = 0, fsal = 0, nonfinite = 0, code = PF_T_END;
   memset(&c, 0, sizeof c);
   c.q = q;
@@ -215,6 +247,13 @@ int pf_run(const double* q, double eps, double snap, double* st, double t_end, l
   y[1] = st[2];
   for (i = 0; i < PF_NZ; ++i) y[2 + i] = st[PF_HEAD + i];
   for (i = 0; i < PF_NM; ++i) c.m[i] = st[PF_HEAD + PF_NZ + i];
+#if PF_VSCALE
+  pf_args(&c, y); /* the model's velocity scale from its numbers q */
+  c.res[0] = &vs;
+  pf_vscale(c.arg, c.res, c.iw, c.w, 0);
+#else
+  (void)vs;
+#endif
 #define PF_DURATION() ((isfinite(t_prev) ? 2.0 * (t_last - t_prev) : 2.0 * M_PI / fmax(1.0, fabs(y[1]))) * S.grow)
 #define PF_BRANCH()                                \
   do {                                             \
@@ -241,6 +280,10 @@ int pf_run(const double* q, double eps, double snap, double* st, double t_end, l
       break;
     }
     if (++branch_steps > PF_BRANCH_STEPS) { code = PF_TOO_MANY_STEPS; break; }
+#if PF_VSCALE
+    if (!fsal) { pf_f(&c, y, f0); fsal = 1; }
+    h = fmin(h, pf_curve_bound(vs, y[1], f0[1]));
+#endif
     if (t + h >= t_end) { h = t_end - t; last = 1; }
     if (!(h > 1e-15 * fmax(fabs(t), 1e-300))) { code = nonfinite ? PF_NONFINITE : PF_STEP_UNDERFLOW; break; }
     if (!fsal) { pf_f(&c, y, f0); fsal = 1; }
@@ -252,6 +295,7 @@ int pf_run(const double* q, double eps, double snap, double* st, double t_end, l
         for (l = 0; l < j; ++l) acc += pf_A[j][l] * U[l][i];
         ys[i] = acc;
       }
+      if (j == 5) memcpy(y6, ys, sizeof ys);
       pf_f(&c, ys, U[j]);
       for (i = 0; i < PF_NY; ++i) U[j][i] *= h;
     }
@@ -270,6 +314,10 @@ int pf_run(const double* q, double eps, double snap, double* st, double t_end, l
     }
     ++*steps;
     nonfinite = 0;
+    if (pf_stiff_step(&S, U, ys, y6)) { /* 15 stiff steps (no 6 non-stiff ones between) on a long branch */
+      nonstiff = 0;
+      if (++stiff >= 15 && branch_steps > PF_STIFF_STEPS) { code = PF_STIFF; break; }
+    } else if (++nonstiff >= 6) stiff = 0;
     /* events of the step: the reversal (s v < 0 at its end) and the model's indicators */
     sv = c.s * ys[1];
     if (sv < 0.0) { k_ev = -1; th_ev = pf_locate(&c, U, y0, -1, c.s * y0[1], sv); }

@@ -1,7 +1,7 @@
 """The C code of a friction model for the native driver: CasADi Functions of the unforced oscillator.
 
 The normalised unforced oscillator ``x~' = v~``, ``v~' = -F~``, ``z' = rate(z, m, v~, s, q)``
-(``docs/mathematics.md#normalised-units``) is written as six small CasADi Functions of the
+(``docs/mathematics.md#normalised-units``) is written as seven small CasADi Functions of the
 state ``y = (x~, v~, z...)``, the flags ``m``, the branch direction ``s`` and the model's
 run-time numbers ``q``. :func:`model_source` generates their C code (``Function.generate``,
 one file) with the sizes the driver (``driver.c``) needs as ``#define`` lines:
@@ -17,7 +17,10 @@ one file) with the sizes the driver (``driver.c``) needs as ``#define`` lines:
     (:meth:`~prefriction.FrictionModel.reverse`);
 ``pf_force(y, m, s, q) -> F~`` and ``pf_pot(z, m, s, q) -> potential``
     the force and the branch potential (:meth:`~prefriction.FrictionModel.branch_potential`;
-    0 for a model without one).
+    0 for a model without one);
+``pf_vscale(y, m, s, q) -> vs~``
+    the model's velocity scale (:meth:`~prefriction.FrictionModel.velocity_scale`; 0 for none),
+    near which the driver bounds its steps.
 
 The model's methods build the expressions, as for the CasADi plant
 (:mod:`prefriction.simulation.plant`): one source per :meth:`~prefriction.FrictionModel.structure_key`,
@@ -40,7 +43,7 @@ __all__ = ["model_functions", "model_source"]
 
 
 def model_functions(model: FrictionModel) -> list[ca.Function]:
-    """The six Functions of the module notes for ``model`` (its structure, numbers symbolic)."""
+    """The seven Functions of the module notes for ``model`` (its structure, numbers symbolic)."""
     nz, nm, nq = model.n_states, model.n_flags, len(model.runtime_params())
     y, m, s, q = ca.SX.sym("y", 2 + nz), ca.SX.sym("m", nm), ca.SX.sym("s"), ca.SX.sym("q", nq)
     v = y[1]
@@ -61,6 +64,7 @@ def model_functions(model: FrictionModel) -> list[ca.Function]:
         zr, mr = model.reverse(z, mm, -s, q, snap)
         F_rev = model.force(zr, mr, 0.0, -s, q)
         pot = model.branch_potential(z, mm, s, q) if has_potential(model) else 0.0
+        vscale = model.velocity_scale(q)
     funs = [
         ca.Function("pf_rhs", args, [rhs], names, ["dy"]),
         ca.Function("pf_ind", args, [ind], names, ["g"]),
@@ -69,6 +73,7 @@ def model_functions(model: FrictionModel) -> list[ca.Function]:
                     names + ["snap"], ["z_next", "m_next", "F"]),
         ca.Function("pf_force", args, [F], names, ["F"]),
         ca.Function("pf_pot", args, [ca.SX(pot)], names, ["pot"]),
+        ca.Function("pf_vscale", args, [ca.SX(0.0 if vscale is None else vscale)], names, ["vs"]),
     ]
     return funs
 
@@ -88,6 +93,7 @@ def model_source(model: FrictionModel) -> str:
         "PF_NQ": len(model.runtime_params()),
         "PF_NE": model.n_events,
         "PF_POT": int(has_potential(model)),
+        "PF_VSCALE": int(model.velocity_scale(model.runtime_params()) is not None),
         "PF_RATE_INDEPENDENT": int(model.rate_independent),
         "PF_NORM_X": int(not model.tracks_position),
         "PF_NOISE": repr(EPS_DIED),

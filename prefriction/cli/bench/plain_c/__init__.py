@@ -15,18 +15,16 @@ from __future__ import annotations
 
 import ctypes
 import functools
-import hashlib
 import os
 import shutil
-import subprocess
-import tempfile
 from pathlib import Path
 from typing import Optional
 
 import numpy as np
 
 from prefriction.models import Oscillator
-from prefriction.simulation.compiled import cache_dir
+from prefriction.simulation import library_store as store
+from prefriction.simulation.compiled import library
 from prefriction.units import Scales
 
 __all__ = ["SOURCE", "c_available", "c_reversals"]
@@ -45,26 +43,28 @@ def c_available() -> bool:
     return _compiler() is not None
 
 
+def _load(lib: Path, key: str) -> tuple[Optional[ctypes.CDLL], str]:
+    """The verified library loaded with ctypes (the cache's checks), or None and what is wrong."""
+    problem = store.verify(lib, key)
+    if problem:
+        return None, "" if problem == "missing" else problem
+    try:
+        dll = ctypes.CDLL(str(lib))
+        dll.dahl_reversals
+    except (OSError, AttributeError) as exc:
+        return None, f"{lib} could not be loaded ({exc})"
+    return dll, ""
+
+
 @functools.lru_cache(maxsize=1)
 def _library() -> ctypes.CDLL:
-    """The compiled reference, built once per machine into the compiled-code cache."""
-    cc = _compiler()
-    if cc is None:
+    """The compiled reference, built once per machine into the compiled-code cache (its checks apply)."""
+    if _compiler() is None:
         raise RuntimeError("the plain-C reference needs a C compiler ($CC or gcc) on the PATH")
-    code = SOURCE.read_bytes()
-    key = hashlib.sha256(code + cc.encode()).hexdigest()[:24]
-    directory = cache_dir()
-    lib = directory / f"plain_c_dahl_rk54_{key}.so"
-    if not lib.exists():
-        directory.mkdir(parents=True, exist_ok=True)
-        with tempfile.TemporaryDirectory(prefix="prefriction-c-") as tmp:
-            part = Path(tmp) / lib.name
-            subprocess.run([cc, "-O2", "-shared", "-fPIC", str(SOURCE), "-o", str(part), "-lm"],
-                           check=True, capture_output=True, timeout=120)
-            staged = directory / f".{lib.name}.{os.getpid()}"
-            shutil.copyfile(part, staged)
-            os.replace(staged, lib)
-    dll = ctypes.CDLL(str(lib))
+    dll, info = library("plain_c_dahl_rk54", SOURCE.read_text(), "the plain-C reference", _load,
+                        "no plain-C row", cflags=("-O2", "-shared", "-fPIC"))
+    if dll is None:
+        raise RuntimeError(f"the plain-C reference could not be compiled: {info.reason}")
     dll.dahl_reversals.restype = ctypes.c_long
     dll.dahl_reversals.argtypes = [ctypes.c_double] * 4 + [ctypes.c_int] + [_DOUBLE_P] * 3
     return dll
