@@ -3,7 +3,7 @@
 Public API, re-exported from private modules:
 
 - models (:mod:`prefriction.models`): :class:`FrictionModel` (the protocol), :class:`Dahl`,
-  :class:`MaxwellSlip`, :class:`GMS`, :class:`LuGre`, :class:`Viscous`, :class:`Parallel` (``a + b``),
+  :class:`MaxwellSlip`, :class:`GMS`, :class:`LuGre`, :class:`ElastoPlastic`, :class:`Viscous`, :class:`Parallel` (``a + b``),
   :class:`Oscillator`, :class:`Parameter`
 - input signals: :mod:`prefriction.signals` (``Constant``, ``Step``, ``Ramp``, ``Sine``,
   ``Chirp``, ``Samples``, ``ZeroOrderHold`` and sums; compiled once per kind)
@@ -37,8 +37,8 @@ _check_casadi(_casadi.__version__)
 if TYPE_CHECKING:  # the names below, imported on first use (module __getattr__)
     from prefriction.errors import PrefrictionError, SolverError
     from prefriction.along import AlongResult, FrictionStream, friction_along
-    from prefriction.models import (GMS, Dahl, DirectionalViscous, FrictionModel, LuGre, MaxwellSlip, Oscillator,
-                                    Parallel, Parameter, Viscous)
+    from prefriction.models import (GMS, Dahl, DirectionalViscous, ElastoPlastic, FrictionModel, LuGre, MaxwellSlip,
+                                    Oscillator, Parallel, Parameter, Viscous)
     from prefriction.reversals import ReversalTable
     from prefriction.units import Scales
     from prefriction.simulation.simulate import SimulationResult, simulate
@@ -59,8 +59,8 @@ del annotations, TYPE_CHECKING  # bound by the imports above; not part of the AP
 _WHERE = {
     **dict.fromkeys(["PrefrictionError", "SolverError"], "prefriction.errors"),
     **dict.fromkeys(["AlongResult", "FrictionStream", "friction_along"], "prefriction.along"),
-    **dict.fromkeys(["GMS", "Dahl", "DirectionalViscous", "FrictionModel", "LuGre", "MaxwellSlip", "Oscillator",
-                     "Parallel", "Parameter", "Viscous"], "prefriction.models"),
+    **dict.fromkeys(["GMS", "Dahl", "DirectionalViscous", "ElastoPlastic", "FrictionModel", "LuGre", "MaxwellSlip",
+                     "Oscillator", "Parallel", "Parameter", "Viscous"], "prefriction.models"),
     "ReversalTable": "prefriction.reversals",
     "Scales": "prefriction.units",
     **dict.fromkeys(["SimulationResult", "simulate"], "prefriction.simulation.simulate"),

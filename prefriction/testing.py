@@ -121,7 +121,11 @@ def _contract(model: FrictionModel, rng: np.random.Generator) -> None:
     f = ca.Function("contract", [z, m, v, s, q], [ca.vertcat(*outputs(model, zl, ml, v, s, q))])
     for _ in range(20):
         s_ = float(rng.choice([-1.0, 1.0]))
-        z0, m0 = other.initial_state(float(rng.uniform(-0.9, 0.9)), s_)
+        f0 = float(rng.uniform(-0.9, 0.9))
+        try:
+            z0, m0 = other.initial_state(f0, s_)
+        except NotImplementedError:  # no initial_state of a given force (several states): any state
+            z0, m0 = [f0 / nz] * nz, [0.0] * nm
         v_ = float(rng.uniform(0.0, 2.0)) * s_
         sym = np.array(f(z0, m0, v_, s_, q_num)).ravel()
         num = np.array(outputs(other, list(z0), list(m0), v_, s_, q_num.tolist()), dtype=float)

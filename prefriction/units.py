@@ -9,12 +9,12 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 from dataclasses import dataclass
 
 import numpy as np
 
 from prefriction._validation import check_positive
-from prefriction.models import Oscillator
 
 _TINY = 2.2250738585072014e-308  # smallest normal double
 _LABELS = {"x": "Fc/sigma", "F": "Fc", "t": "sqrt(m/sigma)", "v": "Fc/sqrt(m sigma)", "E": "Fc^2/sigma"}
@@ -49,7 +49,7 @@ class Scales:
             object.__setattr__(self, name, check_positive(name, getattr(self, name)))
 
     @classmethod
-    def of(cls, system: Oscillator) -> "Scales":
+    def of(cls, system: Any) -> "Scales":
         """Scales of ``system`` (its friction model's ``sigma``, ``Fc`` and its mass).
 
         Raises
@@ -61,7 +61,8 @@ class Scales:
             e.g. ``sigma = 1e308`` N/m with ``Fc = 1e-308`` N): the simulator and the exact
             references divide by them.
         """
-        if not isinstance(system, Oscillator):
+        # an Oscillator (read, not imported: the models import these units)
+        if not all(hasattr(system, name) for name in ("friction", "mass", "u")):
             raise TypeError(f"system must be a prefriction.Oscillator, got {system!r} of type {type(system).__name__}")
         sigma, Fc, m = system.friction.sigma, system.friction.Fc, system.mass
         for name, value in (("sigma", sigma), ("Fc", Fc)):  # a user model's numbers are unchecked

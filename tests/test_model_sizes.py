@@ -19,6 +19,8 @@ class RateTooLong(ElasticPlastic):
 
 @dataclass(frozen=True)
 class EventsMissing(ElasticPlastic):
+    n_events = 1  # declared (the default would count the events() entries)
+
     def events(self, z, m, v, s, q):
         return []
 
@@ -42,14 +44,31 @@ class NoBranchEnergy(ElasticPlastic):
     branch_energy_of_force = pf.FrictionModel.branch_energy_of_force
 
 
+@dataclass(frozen=True)
+class TwoStatesNoBranchEnergy(NoBranchEnergy):
+    n_states = 2
+
+    def rate(self, z, m, v, s, q):
+        return [v * (1.0 - m[0]), 0.0 * v]
+
+
 def test_rate_independent_model_without_branch_energy_is_refused_before_a_run() -> None:
     from prefriction.testing import check_model
 
-    match = r"NoBranchEnergy is rate-independent .* does not implement branch_energy_of_force"
+    match = r"TwoStatesNoBranchEnergy is rate-independent .* does not implement branch_energy_of_force"
     with pytest.raises(TypeError, match=match):
-        pf.simulate(pf.Oscillator(NoBranchEnergy(1e4, 1.0)), 1.0, reversals=3)
+        pf.simulate(pf.Oscillator(TwoStatesNoBranchEnergy(1e4, 1.0)), 1.0, reversals=3)
     with pytest.raises(TypeError, match=match):
-        check_model(NoBranchEnergy(1e4, 1.0))
+        check_model(TwoStatesNoBranchEnergy(1e4, 1.0))
+
+
+def test_one_state_model_gets_its_branch_energy_by_quadrature() -> None:
+    """The elastic unloading branch stores the triangle ``F~^2 / 2`` (closed form)."""
+    import numpy as np
+
+    F = np.array([-0.9, -0.3, 0.0, 0.5])
+    np.testing.assert_allclose(NoBranchEnergy(1e4, 1.0).branch_energy_of_force(F, 1.0), 0.5 * F ** 2, rtol=1e-12,
+                               atol=1e-16)
 
 
 @dataclass(frozen=True)

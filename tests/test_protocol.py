@@ -32,18 +32,8 @@ class ElasticPlastic(FrictionModel):
 
     parameters = (Parameter("k", "N/m", 0.0, math.inf, low_open=True),
                   Parameter("Fy", "N", 0.0, math.inf, low_open=True))
-
-    def __post_init__(self) -> None:
-        self._validate()
-
-    sigma = property(lambda self: self.k)
-    Fc = property(lambda self: self.Fy)
-    n_states = property(lambda self: 1)
-    n_flags = property(lambda self: 1)
-    n_events = property(lambda self: 1)
-
-    def runtime_params(self) -> np.ndarray:
-        return np.zeros(0)
+    n_states = 1
+    n_flags = 1
 
     def initial_state(self, f0, s):
         return [f0], [1.0 if s * f0 >= 1.0 else 0.0]
@@ -62,9 +52,6 @@ class ElasticPlastic(FrictionModel):
 
     def on_event(self, k, z, m, s, q):
         return [s * 1.0], [1.0]
-
-    def reverse(self, z, m, s_new, q, snap):
-        return [z[0]], [0.0]
 
     def branch_energy_of_force(self, F, s):
         return 0.5 * np.asarray(F, dtype=float) ** 2

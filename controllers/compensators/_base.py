@@ -10,7 +10,7 @@ import casadi as ca
 import numpy as np
 
 from prefriction._validation import check_positive
-from prefriction.models import GMS, Dahl, LuGre, MaxwellSlip
+from prefriction.models import GMS, Dahl, ElastoPlastic, LuGre, MaxwellSlip
 from prefriction.models.base import FrictionModel
 
 __all__ = ["Compensator", "scaled_model"]
@@ -79,10 +79,11 @@ def scaled_model(model: FrictionModel, stiffness: float = 1.0, coulomb: float = 
 
     Parameters
     ----------
-    model : Dahl, LuGre, MaxwellSlip or GMS
+    model : Dahl, LuGre, ElastoPlastic, MaxwellSlip or GMS
         The model.
     stiffness : float, default 1.0
-        Factor of the rest stiffness [-], ``> 0``: Dahl ``sigma``, LuGre ``sigma0``, every element
+        Factor of the rest stiffness [-], ``> 0``: Dahl ``sigma``, LuGre and ElastoPlastic ``sigma0``
+        (ElastoPlastic's ``z_ba`` by ``coulomb / stiffness``: the same breakaway fraction), every element
         stiffness of Maxwell-slip and GMS.
     coulomb : float, default 1.0
         Factor of the friction forces [-], ``> 0``: ``Fc`` (and LuGre's and GMS's ``Fs``, so the
@@ -104,9 +105,12 @@ def scaled_model(model: FrictionModel, stiffness: float = 1.0, coulomb: float = 
         return dataclasses.replace(model, sigma=model.sigma * ks, Fc=model.Fc * kc)
     if isinstance(model, LuGre):
         return dataclasses.replace(model, sigma0=model.sigma0 * ks, Fc=model.Fc * kc, Fs=model.Fs * kc)
+    if isinstance(model, ElastoPlastic):  # the breakaway at the same fraction of Fc / sigma0
+        return dataclasses.replace(model, sigma0=model.sigma0 * ks, Fc=model.Fc * kc, Fs=model.Fs * kc,
+                                   z_ba=model.z_ba * kc / ks)
     if isinstance(model, GMS):
         return dataclasses.replace(model, k=np.asarray(model.k) * ks, Fc=model.Fc * kc, Fs=model.Fs * kc)
     if isinstance(model, MaxwellSlip):
         return dataclasses.replace(model, stiffness=np.asarray(model.stiffness) * ks,
                                    slip_force=np.asarray(model.slip_force) * kc)
-    raise TypeError(f"model must be a Dahl, LuGre, MaxwellSlip or GMS model, got {model!r} of type {type(model).__name__}")
+    raise TypeError(f"model must be a Dahl, LuGre, ElastoPlastic, MaxwellSlip or GMS model, got {model!r} of type {type(model).__name__}")

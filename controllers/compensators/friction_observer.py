@@ -9,7 +9,7 @@ import casadi as ca
 import numpy as np
 
 from prefriction._validation import check_positive
-from prefriction.models import Dahl, LuGre
+from prefriction.models import Dahl, ElastoPlastic, LuGre
 from prefriction.models.base import FrictionModel
 
 from ._base import Compensator
@@ -48,10 +48,10 @@ def _dahl_numbers(model: FrictionModel) -> tuple[float, float]:
             raise ValueError(f"model must be a Dahl model with gamma = 1 (the observer's friction state-space), "
                              f"got gamma={model.gamma!r}")
         return model.sigma, model.Fc
-    if isinstance(model, LuGre):
+    if isinstance(model, (LuGre, ElastoPlastic)):
         return model.sigma0, model.Fc
-    raise TypeError(f"model must be a prefriction.Dahl (gamma = 1) or LuGre model, got {model!r} of type "
-                    f"{type(model).__name__}")
+    raise TypeError(f"model must be a prefriction.Dahl (gamma = 1), LuGre or ElastoPlastic model, got {model!r} "
+                    f"of type {type(model).__name__}")
 
 
 @dataclass(frozen=True)
@@ -94,9 +94,9 @@ class FrictionObserver(Compensator):
 
     Parameters
     ----------
-    model : prefriction.Dahl or prefriction.LuGre
-        Model of the stage's friction: Dahl with ``gamma = 1`` (``sigma``, ``Fc``) or LuGre
-        (``sigma0``, ``Fc``; its Stribeck and damping terms are not used).
+    model : prefriction.Dahl, prefriction.LuGre or prefriction.ElastoPlastic
+        Model of the stage's friction: Dahl with ``gamma = 1`` (``sigma``, ``Fc``), LuGre or
+        ElastoPlastic (``sigma0``, ``Fc``; the Stribeck, damping and breakaway terms are not used).
     pole : float
         Dominant (slowest) observer pole ``p`` [rad/s], ``0 < p < inf``.
     fast_pole : float, optional

@@ -58,7 +58,7 @@ from typing import Any, Optional
 import numpy as np
 
 from prefriction._validation import check_array_interval, check_count, check_interval, check_nonnegative
-from prefriction.analysis.exact import check_initial_state
+from prefriction.analysis.exact_input import check_initial_state
 from prefriction.models import Oscillator
 from prefriction.models.maxwell_slip import MaxwellSlip
 from prefriction.reversals import ReversalTable

@@ -15,7 +15,7 @@ long stop, for instance).
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import casadi as ca
 import numpy as np
@@ -26,8 +26,6 @@ from prefriction.identify.motion_start import derivatives
 from prefriction.identify.motion_step import step_function
 from prefriction.units import Scales
 
-if TYPE_CHECKING:
-    from prefriction.identify.result import FitResult
 
 __all__ = ["predict_motion"]
 
@@ -36,7 +34,7 @@ _WINDOW = 7
 _SIMS: dict[Any, ca.Function] = {}
 
 
-def predict_motion(result: "FitResult", data: Motion, *, v0: float | None = None, F0: float | None = None,
+def predict_motion(result: Any, data: Motion, *, v0: float | None = None, F0: float | None = None,
                    substeps: int | None = None) -> np.ndarray:
     """Positions [m] of ``result``'s fitted model driven by ``data.u``, from ``data.x[0]``.
 

@@ -143,6 +143,10 @@ def _start_d0(problem: PrescribedProblem, space: ParameterSpace, series: _Series
         return float(problem.force(w, *args)[0]) - float(data.F[0])
 
     lo, hi = -30.0, 30.0
+    while not np.isfinite(f0(lo)) and lo < -1e-6:  # a model that diverges running far backwards
+        lo *= 0.5
+    while not np.isfinite(f0(hi)) and hi > 1e-6:
+        hi *= 0.5
     if f0(lo) > 0.0:
         return lo
     if f0(hi) < 0.0:

@@ -1,27 +1,25 @@
-"""Text report and figure of a :class:`prefriction.identify.FitResult`."""
+"""Text report and figure of a :class:`prefriction.identify.FitResult` (which imports this module:
+``res`` is annotated ``Any`` here, so no import runs back up to it)."""
 
 from __future__ import annotations
 
 import textwrap
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import Any
 
 import numpy as np
 
 from prefriction.identify.data import ForceDisplacement, ForceVelocity, Motion
 from prefriction.identify.validation import check_directory, model_name
 
-if TYPE_CHECKING:
-    from prefriction.identify.result import FitResult
-
 __all__ = ["plot_fit", "report_text"]
 
 
-def _flag(res: "FitResult", i: int) -> str:
+def _flag(res: Any, i: int) -> str:
     return f"  ({res.flags[i]})" if i < len(res.flags) and res.flags[i] else ""
 
 
-def report_text(res: "FitResult") -> str:
+def report_text(res: Any) -> str:
     """The text of :meth:`FitResult.report`.
 
     Parameters
@@ -66,7 +64,7 @@ def report_text(res: "FitResult") -> str:
     return "\n".join(rows)
 
 
-def plot_fit(res: "FitResult", path: str | Path, show: bool) -> Path:
+def plot_fit(res: Any, path: str | Path, show: bool) -> Path:
     """The figure of :meth:`FitResult.plot`.
 
     Parameters

@@ -278,8 +278,8 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
     """
     if model.n_events or model.n_flags:
         raise ValueError(f"Motion fits support models without in-branch events or flags (Dahl with gamma >= 1, "
-                         f"LuGre); {type(model).__name__} has {model.n_events} events: fit it to "
-                         f"ForceDisplacement data")
+                         f"LuGre, ElastoPlastic(..., crossings=False)); {type(model).__name__} has {model.n_events} events: "
+                         f"fit it to ForceDisplacement data{_without_events(model)}")
     mass_free = "mass" in space.start and "mass" in space.free
     mass = space.start["mass"] if "mass" in space.start else float(data.mass)
     xsm, v, a = derivatives(data.t, data.x, _NODE_WINDOW)
@@ -367,3 +367,9 @@ def _nuisance(model: FrictionModel, space: ParameterSpace, w: np.ndarray, prob: 
     k = np.flatnonzero(np.sign(vel[1:]) * np.sign(vel[:-1]) < 0)
     tau = t[k] + (t[k + 1] - t[k]) * vel[k] / (vel[k] - vel[k + 1])
     return {"initial velocity v0 [m/s]": v0, "initial force F0 [N]": F0, "reversal times [s]": tau}
+
+
+def _without_events(model: FrictionModel) -> str:
+    """The hint for a model that has a form without events (ElastoPlastic's ``crossings=False``)."""
+    return ", or give it with crossings=False (the crossings inside the right-hand side)" \
+        if hasattr(model, "crossings") else ""

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
@@ -30,8 +30,6 @@ from scipy.optimize import brentq, minimize_scalar
 from prefriction._validation import check_finite
 from prefriction.identify.data import ForceDisplacement, ForceVelocity, Motion
 
-if TYPE_CHECKING:
-    from prefriction.identify.result import FitResult
 
 __all__ = ["Validation", "check_directory", "model_name", "predict", "predict_force", "validate"]
 
@@ -126,7 +124,7 @@ def _best_start(force: Any, data: ForceDisplacement, offset: float, warmup: floa
     return float(minimize_scalar(cost, bounds=(lo, hi), method="bounded", options={"xatol": 1e-9}).x)
 
 
-def predict(result: "FitResult", data: ForceDisplacement | Motion, **kwargs: Any) -> np.ndarray:
+def predict(result: Any, data: ForceDisplacement | Motion, **kwargs: Any) -> np.ndarray:
     """The output of ``result``'s fitted model on ``data``: force [N] or position [m].
 
     Parameters
@@ -259,7 +257,7 @@ class Validation:
         return out
 
 
-def validate(result: "FitResult", data: ForceDisplacement | Motion, *, skip: float = 0.0,
+def validate(result: Any, data: ForceDisplacement | Motion, *, skip: float = 0.0,
              **kwargs: Any) -> Validation:
     """Score ``result``'s prediction on ``data``: rms, NRMSE, fit %.
 

@@ -1,18 +1,29 @@
-"""The friction-model protocol: what a model tells the simulator and the energy analysis.
+"""The friction-model contract: a model's mathematics, and the bookkeeping the base derives from it.
 
-See ``docs/models.md`` for how to add a model in one file and the reusable test that holds it
-to the generic invariants.
+A model declares its parameters (:class:`Parameter`), ``n_states``, ``rate`` and ``force`` on a
+branch of fixed direction, and, only if it has them, in-branch ``events`` with ``on_event``.
+Everything else has a default here (template-method style): the reversal keeps the state, the
+structure key is the class and its sizes, the run-time numbers are the declared parameters in
+normalised units, the units come from the parameters named or measured in ``N/m`` and ``N``,
+rate independence is read off ``rate`` and ``force``, and the branch energy of a one-state model
+is a quadrature (:mod:`prefriction.models.defaults`). Closed forms (``advance``,
+``free_branch``, ``branch_energy_of_force``, ...) are optional overrides that make a model
+faster. See ``docs/models.md#add-a-model``.
 """
 
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
+from functools import cached_property
 from typing import TYPE_CHECKING, Any, ClassVar, Hashable, Optional, Sequence
 
+import casadi as ca
 import numpy as np
 
 from prefriction._validation import check_nonnegative, check_positive, check_real
+from prefriction.models.defaults import (branch_energy_by_quadrature, detect_rate_independent, normalised_parameters,
+                                         state_of_force)
 
 if TYPE_CHECKING:  # prefriction.units imports the models
     from prefriction.units import Scales
@@ -52,8 +63,22 @@ class Parameter:
         return v
 
 
+_UNITS = {"sigma": "N/m", "Fc": "N"}
+"""The units of the reference stiffness and force, by which the base finds them among the parameters."""
+
+
+def unit_of(par: Parameter) -> str:
+    """The unit of ``par`` with single spaces."""
+    return " ".join(par.unit.split())
+
+
 class FrictionModel(ABC):
     """Contract of a friction model for the simulator, the sweeps and the energy analysis.
+
+    **Required** (the mathematics): :attr:`parameters`, :attr:`n_states`, :meth:`rate`,
+    :meth:`force`; with events also :meth:`events` and :meth:`on_event` (and :attr:`n_flags` if
+    the events set flags). A missing one is refused at construction, naming it. Everything else
+    is a default that a model may override with a closed form (module notes).
 
     Everything is stated in the normalised units of :mod:`prefriction.units`, built on the
     model's reference stiffness ``sigma`` [N/m] and reference force ``Fc`` [N]: force
@@ -75,8 +100,8 @@ class FrictionModel(ABC):
 
     **Compile once per structure.** The simulator builds one CasADi function per
     :meth:`structure_key`. Everything that may change without changing the generated code is a
-    run-time number returned by :meth:`runtime_params_for` (``q``; by default
-    :meth:`runtime_params`, numbers independent of the mass); :meth:`rate`, :meth:`force`,
+    run-time number returned by :meth:`runtime_params_for` (``q``; by default the declared
+    parameters in normalised units, in their order); :meth:`rate`, :meth:`force`,
     :meth:`events`, :meth:`on_event` and :meth:`reverse` must build their expressions from
     ``q`` and never from the instance's own numbers, and must work on Python floats, numpy
     arrays and CasADi ``SX`` symbols alike (the test helper
@@ -91,15 +116,51 @@ class FrictionModel(ABC):
 
     parameters: ClassVar[tuple[Parameter, ...]] = ()
     """The physical parameters, validated on construction (each an attribute of that name)."""
-    rate_independent: ClassVar[bool] = True
     tracks_position: ClassVar[bool] = False
     """True if :meth:`travel` gives the displacement along a branch from the state alone (the
     simulator then integrates no position state in unforced runs)."""
 
+    def __new__(cls, *args: Any, **kwargs: Any) -> "FrictionModel":
+        missing = sorted(getattr(cls, "__abstractmethods__", ()))
+        if missing:
+            raise TypeError(f"{cls.__name__} does not define {', '.join(missing)}: a friction model needs its state "
+                            f"size n_states, its rate(z, m, v, s, q) and its force(z, m, v, s, q), which the "
+                            f"simulator integrates and records (docs/models.md#add-a-model)")
+        return super().__new__(cls)
+
+    def __post_init__(self) -> None:
+        self._validate()
+
     def _validate(self) -> None:
-        """Check every declared parameter (call from ``__post_init__``)."""
+        """Check every declared parameter, refuse a model without the units ``sigma`` and ``Fc``
+        (defined, or a parameter in ``N/m`` and in ``N``) and events without ``on_event``
+        (called by ``__post_init__``)."""
         for par in self.parameters:
             object.__setattr__(self, par.name, par.check(getattr(self, par.name)))
+        for role, unit in _UNITS.items():
+            if not hasattr(self, role):
+                raise TypeError(f"{type(self).__name__} has no {role}, the reference "
+                                f"{'stiffness' if role == 'sigma' else 'force'} [{unit}] of the normalised units: "
+                                f"declare a parameter in {unit} or define {role}")
+        cls = type(self)
+        if cls.events is not FrictionModel.events and cls.on_event is FrictionModel.on_event:
+            raise TypeError(f"{cls.__name__} defines events() but not on_event(k, z, m, s, q), the state just "
+                            f"after event k, which the simulator applies at every event")
+
+    def __getattr__(self, name: str) -> Any:
+        """``sigma`` and ``Fc`` of a class that does not define them: the first declared parameter
+        in ``N/m`` and in ``N`` (read each time, so a copy with other numbers has its own)."""
+        declared = [p.name for p in type(self).parameters if name in _UNITS and unit_of(p) == _UNITS[name]]
+        if not declared:
+            raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+        return getattr(self, declared[0])
+
+    @cached_property
+    def rate_independent(self) -> bool:  # type: ignore[override]
+        """True if the force ignores ``v`` and the rate is ``v`` times a function of the state: the
+        energy analysis (2.3)-(2.12) applies. Default: read off :meth:`force` and :meth:`rate` on
+        CasADi symbols (a class may declare it)."""
+        return detect_rate_independent(self)
 
     # --- normalisation: attributes (or properties) of every model -----------------------
     sigma: float
@@ -129,34 +190,51 @@ class FrictionModel(ABC):
         """Number of discrete flags ``m`` (0.0 or 1.0 each)."""
         return 0
 
-    @property
-    def n_events(self) -> int:
-        """Number of in-branch event indicators returned by :meth:`events`."""
-        return 0
+    @cached_property
+    def n_events(self) -> int:  # type: ignore[override]
+        """Number of in-branch event indicators returned by :meth:`events` (default: counted on symbols)."""
+        if type(self).events is FrictionModel.events:
+            return 0
+        z = [ca.SX.sym(f"z{i}") for i in range(self.n_states)]
+        m = [ca.SX.sym(f"m{i}") for i in range(self.n_flags)]
+        q = ca.SX.sym("q", len(self.runtime_params()))
+        return len(self.events(z, m, ca.SX.sym("v"), ca.SX.sym("s"), [q[i] for i in range(q.numel())]))
 
     def structure_key(self) -> Hashable:
         """What changes the generated code; models with equal keys share one compiled plant."""
         return (type(self).__module__, type(self).__qualname__, self.n_states, self.n_flags, self.n_events)
 
-    @abstractmethod
     def runtime_params(self) -> np.ndarray:
-        """Normalised numbers ``q`` that enter the compiled plant as run-time inputs (for a unit
-        mass if they depend on the mass, see :meth:`runtime_params_for`)."""
+        """Normalised numbers ``q`` that enter the compiled plant as run-time inputs, for a unit
+        mass (:meth:`runtime_params_for` with ``m = 1 kg``)."""
+        return normalised_parameters(self, self.Fc / self.sigma, self.Fc, 1.0 / np.sqrt(self.sigma))
 
     def runtime_params_for(self, scales: "Scales") -> np.ndarray:
         """Normalised numbers ``q`` for a system with the units ``scales`` (:class:`prefriction.Scales`).
 
-        The simulator calls this. Numbers that involve the time or velocity unit depend on the
-        mass, which the model does not know (e.g. LuGre's damping ``sigma1 scales.v / Fc`` and
-        Stribeck velocity ``vs / scales.v``): such models override this method. The default is
-        :meth:`runtime_params` (numbers independent of the mass, e.g. Dahl's ``gamma``).
+        The simulator calls this. Default: every declared parameter in the order of
+        :attr:`parameters`, divided by its unit in ``scales`` (``N/m`` by ``sigma``, ``N`` by
+        ``scales.F``, ``m`` by ``scales.x``, ``N s/m`` by ``scales.F / scales.v``, ...), so
+        ``q[i]`` is the ``i``-th parameter in normalised units. A class that overrides only
+        :meth:`runtime_params` (numbers independent of the mass, e.g. Dahl's ``gamma``) gets those.
         """
-        return self.runtime_params()
+        if type(self).runtime_params is not FrictionModel.runtime_params:
+            return self.runtime_params()
+        return normalised_parameters(self, scales.x, scales.F, scales.t)
 
     # --- dynamics (floats, numpy and CasADi SX alike) ------------------------------------
-    @abstractmethod
     def initial_state(self, f0: float, s: float) -> tuple[list[float], list[float]]:
-        """State ``(z, m)`` with normalised force ``f0`` at the start of a branch of direction ``s``."""
+        """State ``(z, m)`` with normalised force ``f0`` at the start of a branch of direction ``s``.
+
+        Default: zero state and flags for ``f0 = 0``; for a one-state model the state whose force
+        at rest is ``f0`` (solved); otherwise ``NotImplementedError`` naming this method."""
+        if f0 == 0.0 and float(self.force([0.0] * self.n_states, [0.0] * self.n_flags, 0.0, s,
+                                          self.runtime_params().tolist())) == 0.0:
+            return [0.0] * self.n_states, [0.0] * self.n_flags
+        if self.n_states != 1:
+            raise NotImplementedError(f"{type(self).__name__} does not define initial_state(f0, s), the state of "
+                                      f"a given force at rest, which a start from F0 != 0 needs")
+        return [state_of_force(self, float(f0), float(s), self.runtime_params().tolist())], [0.0] * self.n_flags
 
     @abstractmethod
     def rate(self, z: Sequence[Any], m: Sequence[Any], v: Any, s: Any, q: Any) -> list[Any]:
@@ -190,13 +268,14 @@ class FrictionModel(ABC):
         """State ``(z, m)`` just after in-branch event ``k``."""
         raise NotImplementedError(f"{type(self).__name__} has no in-branch events")
 
-    @abstractmethod
     def reverse(self, z: Sequence[Any], m: Sequence[Any], s_new: Any, q: Any, snap: Any) -> tuple[list[Any], list[Any]]:
         """State ``(z, m)`` just after a velocity reversal into direction ``s_new``.
 
         ``snap`` is the relative tolerance of the run: an event whose indicator is within
-        ``snap`` of zero at the reversal may be taken as coinciding with it.
+        ``snap`` of zero at the reversal may be taken as coinciding with it. Default: the
+        state carries over and the flags clear (the modes end with the motion).
         """
+        return list(z), [0.0 * f for f in m]
 
     def advance(self, z: Sequence[Any], m: Sequence[Any], v: Any, dt: Any, s: Any,
                 q: Any) -> Optional[tuple[list[Any], list[Any]]]:
@@ -211,14 +290,15 @@ class FrictionModel(ABC):
         """
         return None
 
+    _sum: ClassVar[Any] = None
+    """``Parallel.of``, set by :mod:`prefriction.models.parallel` (which subclasses this class)."""
+
     def __add__(self, other: "FrictionModel") -> "FrictionModel":
         """``a + b``: the models in parallel (forces summed, each with its own state),
         :class:`prefriction.Parallel`."""
-        from prefriction.models.parallel import Parallel
-
         if not isinstance(other, FrictionModel):
             return NotImplemented
-        return Parallel.of(self, other)
+        return FrictionModel._sum(self, other)
 
     @property
     def has_free_branch(self) -> bool:
@@ -279,7 +359,12 @@ class FrictionModel(ABC):
     def branch_energy_of_force(self, F: np.ndarray, s: Any) -> np.ndarray:
         """Normalised stored energy on a branch of direction ``s`` at forces ``F~`` (numpy),
         for models whose branch energy depends on the force alone (Dahl); the sample-based
-        energy analysis needs it. Other models raise ``NotImplementedError``."""
-        raise NotImplementedError(
-            f"{type(self).__name__} gives no branch energy as a function of the force alone"
-        )
+        energy analysis needs it. Default for a one-state model: ``-int F dx`` from the state of
+        force ``F~`` to the force's zero crossing, by quadrature (:mod:`prefriction.models.defaults`);
+        other models raise ``NotImplementedError``."""
+        if self.n_states != 1:
+            raise NotImplementedError(
+                f"{type(self).__name__} gives no branch energy as a function of the force alone "
+                f"(define branch_energy_of_force(F, s); the quadrature default serves one-state models)"
+            )
+        return branch_energy_by_quadrature(self, F, s)

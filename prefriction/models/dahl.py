@@ -1,4 +1,6 @@
-"""Dahl friction model (3.2) through the friction-model protocol.
+"""Dahl friction model (3.2) through the friction-model protocol::
+
+    dF/dx = sigma (1 - s F / Fc)^gamma,   s = sign(x');   normalised: f' = s v (1 - f)^gamma, f = s F~
 
 gamma is a run-time number of the compiled plant; the structure only distinguishes the
 saturating case (gamma < 1: branch-distance state, a saturation event and flag) from
@@ -14,7 +16,7 @@ from typing import Any, Hashable, Optional, Sequence
 import casadi as ca
 import numpy as np
 
-from prefriction.analysis.branch import branch_potential
+from prefriction.models.dahl_branch import branch_potential
 from prefriction.models.base import FrictionModel, Parameter
 from prefriction.models.closed_form import exp, log1p_ratio, pick
 
@@ -109,9 +111,8 @@ class Dahl(FrictionModel):
         Parameter("Fc", "N", 0.0, math.inf, low_open=True),
         Parameter("gamma", "-", 0.0, math.inf),
     )
-
-    def __post_init__(self) -> None:
-        self._validate()
+    rate_independent = True
+    n_states = 1
 
     @property
     def saturates(self) -> bool:
@@ -122,10 +123,6 @@ class Dahl(FrictionModel):
     def tracks_position(self) -> bool:  # type: ignore[override]
         """Without saturation ``x - x_start = s (p - p_start)`` on a branch."""
         return not self.saturates
-
-    @property
-    def n_states(self) -> int:
-        return 1
 
     @property
     def n_flags(self) -> int:
@@ -256,5 +253,5 @@ class Dahl(FrictionModel):
         return s * (distance_of_log_gap(z1[0], g) - distance_of_log_gap(z0[0], g))
 
     def branch_energy_of_force(self, F: np.ndarray, s: Any) -> np.ndarray:
-        """``H_gamma(s F~)`` (:func:`prefriction.analysis.branch.branch_potential`), (3.9) for gamma = 1."""
+        """``H_gamma(s F~)`` (:func:`prefriction.models.dahl_branch.branch_potential`), (3.9) for gamma = 1."""
         return np.asarray(branch_potential(np.clip(s * np.asarray(F, dtype=float), -1.0, 1.0), self.gamma), dtype=float)

@@ -1,4 +1,4 @@
-"""Force-displacement curves of N elasto-plastic elements in parallel, and their energies.
+"""Force-displacement curves of N elastic-plastic (Jenkin) elements in parallel, and their energies.
 
 Elements ``i`` with normalised stiffnesses ``kappa_i`` and slip forces ``w_i`` (normalised
 units, ``docs/mathematics.md``; :class:`prefriction.MaxwellSlip`, and the elements of

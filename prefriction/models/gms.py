@@ -1,4 +1,7 @@
-"""Generalised Maxwell-slip (GMS) friction: N elements with a Stribeck curve, through the protocol.
+"""Generalised Maxwell-slip (GMS) friction: N elements with a Stribeck curve, through the protocol::
+
+    F = sum_i (F_i + damping_i F_i' / k_i) + sigma2 v,   F_i' = k_i v (sticking),
+    F_i' = s C (1 - s F_i / (alpha_i S(v))) (slipping),   S(v) = Fc + (Fs - Fc) exp(-|v / vs|^delta)
 
 F. Al-Bender, V. Lampaert and J. Swevers, "The generalized Maxwell-slip model: a novel model
 for friction simulation and compensation", IEEE Transactions on Automatic Control 50(11),

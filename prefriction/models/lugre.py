@@ -1,4 +1,6 @@
-"""LuGre friction model (Canudas de Wit, Olsson, Astrom, Lischinsky 1995) through the protocol.
+"""LuGre friction model (Canudas de Wit, Olsson, Astrom, Lischinsky 1995) through the protocol::
+
+    zeta' = v (1 - s zeta / g(v)),   g = 1 + (Fs/Fc - 1) exp(-(v / vs~)^2),   F~ = zeta + sigma1~ zeta' + sigma2~ v
 
 One bristle state, no flags, no events; rate-dependent. Its numbers in normalised units depend
 on the mass (the velocity unit ``Fc / sqrt(m sigma0)``), so the model gives them through
@@ -72,7 +74,7 @@ class LuGre(FrictionModel):
     -----
     Protocol (``docs/models.md``): one state, the normalised bristle force
     ``zeta = sigma0 z / Fc``. On a branch of direction ``s`` (``|v| = s v``) the right-hand side
-    is smooth, so the kink of ``|v|`` at ``v = 0`` is a reversal; :meth:`reverse` keeps ``zeta``
+    is smooth, so the kink of ``|v|`` at ``v = 0`` is a reversal; the default reverse keeps ``zeta``
     (the deflection is continuous). In normalised units (:mod:`prefriction.units`)::
 
         zeta' = v (1 - s zeta / g),   g = 1 + (Fs / Fc - 1) exp(-(v / vs~)^2),
@@ -106,6 +108,7 @@ class LuGre(FrictionModel):
         Parameter("vs", "m/s", 0.0, math.inf, low_open=True),
     )
     rate_independent = False
+    n_states = 1
 
     def __post_init__(self) -> None:
         self._validate()
@@ -119,10 +122,6 @@ class LuGre(FrictionModel):
     def sigma(self) -> float:  # type: ignore[override]
         """Reference stiffness of the normalised units: ``sigma0`` [N/m]."""
         return self.sigma0
-
-    @property
-    def n_states(self) -> int:
-        return 1
 
     @property
     def max_hysteretic_force(self) -> float:  # type: ignore[override]
@@ -162,10 +161,6 @@ class LuGre(FrictionModel):
     def force(self, z: Sequence[Any], m: Sequence[Any], v: Any, s: Any, q: Any) -> Any:
         dz = self.rate(z, m, v, s, q)[0]
         return z[0] + q[0] * dz + q[1] * v
-
-    def reverse(self, z: Sequence[Any], m: Sequence[Any], s_new: Any, q: Any, snap: Any) -> tuple[list[Any], list[Any]]:
-        """The bristle deflection is continuous: ``zeta`` unchanged."""
-        return [z[0]], []
 
     def advance(self, z: Sequence[Any], m: Sequence[Any], v: Any, dt: Any, s: Any,
                 q: Any) -> tuple[list[Any], list[Any]]:

@@ -1,6 +1,8 @@
-"""Maxwell-slip friction: N elasto-plastic (Jenkin) elements in parallel, through the protocol.
+"""Maxwell-slip friction: N elastic-plastic (Jenkin) elements in parallel, through the protocol::
 
-Iwan's parallel model of elasto-plastic elements (W. D. Iwan, "A distributed-element model for
+    F = sum_i F_i,   F_i' = k_i x' while |F_i| < W_i (sticking),   F_i = s W_i while slipping
+
+Iwan's parallel model of elastic-plastic elements (W. D. Iwan, "A distributed-element model for
 hysteresis and its steady-state dynamic response", J. Appl. Mech. 33 (1966) 893-900) in the
 form of V. Lampaert, F. Al-Bender, J. Swevers, "A generalized Maxwell-slip friction model
 appropriate for control purposes", Proc. 2003 IEEE Int. Conf. Physics and Control (PhysCon),
@@ -50,7 +52,7 @@ __all__ = ["MaxwellSlip", "MAX_ELEMENTS"]
 
 @dataclass(frozen=True, eq=False)
 class MaxwellSlip(ParallelElements):
-    """Maxwell-slip friction: N elasto-plastic elements in parallel (Iwan 1966; Lampaert,
+    """Maxwell-slip friction: N elastic-plastic (Jenkin) elements in parallel (Iwan 1966; Lampaert,
     Al-Bender and Swevers 2003, "A generalized Maxwell-slip friction model appropriate for
     control purposes", with constant slip forces).
 
@@ -135,6 +137,7 @@ class MaxwellSlip(ParallelElements):
     )
 
     _stiffness_field: ClassVar[str] = "stiffness"
+    rate_independent = True
 
     def _validate(self) -> None:
         """Check both arrays elementwise (each entry in the declared range) and their lengths."""

@@ -315,3 +315,6 @@ class Parallel(FrictionModel):
 def _len(q: Any) -> int:
     """Length of a run-time vector (numpy array, list or CasADi column)."""
     return int(q.shape[0]) if hasattr(q, "shape") and len(q.shape) > 0 else len(q)
+
+
+FrictionModel._sum = Parallel.of  # ``a + b`` of any two models (FrictionModel.__add__)

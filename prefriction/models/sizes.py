@@ -29,11 +29,13 @@ def check_sizes(model: Any) -> None:
     name = type(model).__name__
     from prefriction.models.base import FrictionModel
 
-    if model.rate_independent and type(model).branch_energy_of_force is FrictionModel.branch_energy_of_force:
+    if (model.rate_independent and model.n_states != 1
+            and type(model).branch_energy_of_force is FrictionModel.branch_energy_of_force):
         raise TypeError(
-            f"{name} is rate-independent (rate_independent = True) but does not implement "
-            f"branch_energy_of_force(F, s), which gives the potential energy E_p at every reversal: implement it "
-            f"(docs/models.md#energy), or declare rate_independent = False if the model is not")
+            f"{name} is rate-independent (rate_independent = True) with {model.n_states} states but does not "
+            f"implement branch_energy_of_force(F, s), which gives the potential energy E_p at every reversal (the "
+            f"quadrature default serves one-state models): implement it (docs/models.md#energy), or declare "
+            f"rate_independent = False if the model is not")
     nz, nm, ne = int(model.n_states), int(model.n_flags), int(model.n_events)
     nq = len(model.runtime_params())
     z, m = ca.SX.sym("z", nz), ca.SX.sym("m", nm)

@@ -1,4 +1,4 @@
-"""Viscous friction ``F = b v`` through the friction-model protocol (no state).
+"""Viscous friction ``F = b v`` through the friction-model protocol (no state): ``F~ = b~ v~``.
 
 Meant as a term of a sum of models (:class:`prefriction.Parallel`, ``pf.Dahl(...) +
 pf.Viscous(b)``); alone it is a linear damper. See :class:`Viscous`.
@@ -8,14 +8,9 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Hashable, Sequence
-
-import numpy as np
+from typing import Any, Sequence
 
 from prefriction.models.base import FrictionModel, Parameter
-
-if TYPE_CHECKING:  # units imports the models
-    from prefriction.units import Scales
 
 __all__ = ["Viscous"]
 
@@ -42,7 +37,8 @@ class Viscous(FrictionModel):
     no stiffness and no force level of its own, so its normalised units are nominal:
     ``sigma = 1`` N/m and ``Fc = 1`` N; in a sum (:class:`prefriction.Parallel`) the units
     are those of the other models. Run-time number ``q = [b V / Fc]`` with the velocity unit
-    ``V`` (it holds the mass). ``max_hysteretic_force`` and ``k_min`` are 0.
+    ``V`` (it holds the mass: the base's default for a parameter in N s/m), ``max_hysteretic_force``
+    (so ``F0 = 0``, the default initial state) and ``k_min`` are 0.
 
     Examples
     --------
@@ -57,10 +53,7 @@ class Viscous(FrictionModel):
     b: float
 
     parameters = (Parameter("b", "N s/m", 0.0, math.inf),)
-    rate_independent = False
-
-    def __post_init__(self) -> None:
-        self._validate()
+    n_states = 0
 
     @property
     def sigma(self) -> float:  # type: ignore[override]
@@ -82,34 +75,11 @@ class Viscous(FrictionModel):
         """0 N/m: a damper has no stiffness."""
         return 0.0
 
-    @property
-    def n_states(self) -> int:
-        return 0
-
-    def structure_key(self) -> Hashable:
-        return ("Viscous",)
-
-    def runtime_params_for(self, scales: "Scales") -> np.ndarray:
-        """``q = [b V / Fc]`` with the velocity unit ``V = scales.v`` (``Fc = 1`` N)."""
-        return np.array([self.b * scales.v / self.Fc])
-
-    def runtime_params(self) -> np.ndarray:
-        """``q`` for a unit mass (``V = 1`` m/s with the nominal units)."""
-        return np.array([self.b])
-
-    def initial_state(self, f0: float, s: float) -> tuple[list[float], list[float]]:
-        """No state (``f0`` unused): a damper at rest carries no force, and ``simulate`` and
-        ``friction_along`` refuse ``F0 != 0`` through ``max_hysteretic_force = 0``."""
-        return [], []
-
     def rate(self, z: Sequence[Any], m: Sequence[Any], v: Any, s: Any, q: Any) -> list[Any]:
         return []
 
     def force(self, z: Sequence[Any], m: Sequence[Any], v: Any, s: Any, q: Any) -> Any:
         return q[0] * v
-
-    def reverse(self, z: Sequence[Any], m: Sequence[Any], s_new: Any, q: Any, snap: Any) -> tuple[list[Any], list[Any]]:
-        return [], []
 
     def advance(self, z: Sequence[Any], m: Sequence[Any], v: Any, dt: Any, s: Any,
                 q: Any) -> tuple[list[Any], list[Any]]:

@@ -221,24 +221,23 @@ class Signal(ABC):
 
     # --- algebra -----------------------------------------------------------------------------
 
-    def __add__(self, other: Any) -> "Signal":
-        from prefriction.signals.algebra import Sum  # the kinds derive from Signal
-        from prefriction.signals.piecewise import Constant
+    _sum: Any = None
+    """:class:`Sum`, set by :mod:`prefriction.signals.algebra` (the kinds derive from Signal)."""
+    _constant: Any = None
+    """:class:`Constant`, set by :mod:`prefriction.signals.piecewise`."""
 
+    def __add__(self, other: Any) -> "Signal":
         if isinstance(other, Signal):
-            return Sum(self, other)
+            return Signal._sum(self, other)
         if is_real(other):
-            return Sum(self, Constant(other))
+            return Signal._sum(self, Signal._constant(other))
         return NotImplemented
 
     def __radd__(self, other: Any) -> "Signal":
         if type(other) is int and other == 0:  # start value of sum([...])
             return self
-        from prefriction.signals.algebra import Sum  # the kinds derive from Signal
-        from prefriction.signals.piecewise import Constant
-
         if is_real(other):
-            return Sum(Constant(other), self)
+            return Signal._sum(Signal._constant(other), self)
         return NotImplemented
 
     def _fields(self) -> dict:

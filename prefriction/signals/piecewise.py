@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 
 from prefriction.signals._checks import UNIT, number, time_end
-from prefriction.signals.base import Analytic
+from prefriction.signals.base import Analytic, Signal
 
 __all__ = ["Constant", "Ramp", "Step"]
 
@@ -128,3 +128,6 @@ class Ramp(Analytic):
         value is monotonic): ``max(|offset|, |offset + slope max(t_end - time, 0)|)``."""
         end = self.offset + self.slope * max(time_end(t_end) - self.time, 0.0)
         return max(abs(self.offset), abs(end))
+
+
+Signal._constant = Constant  # Signal.__add__ builds it (the kinds import Signal, not the reverse)

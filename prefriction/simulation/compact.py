@@ -10,19 +10,17 @@ it is the hot path of every unforced run (about 2 us of Python per reversal).
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import Any
 
 from prefriction.simulation.integrator import INTEGRATOR_FAILED
 from prefriction.simulation.plant import EPS_DIED
 
-if TYPE_CHECKING:
-    from prefriction.simulation.run import Run
-
 __all__ = ["advance_compact"]
 
 
-def advance_compact(self: "Run", t_target: float, n_target: float) -> bool:
-    """:meth:`Run.advance` for the compact unforced model (``spec.stops_at_reversal``): each call
+def advance_compact(self: Any, t_target: float, n_target: float) -> bool:
+    """:meth:`Run.advance` (``self``: the :class:`~prefriction.simulation.run.Run`, which imports this
+    module) for the compact unforced model (``spec.stops_at_reversal``): each call
     runs to the next reversal (or ``t_target``); the new branch starts here, in Python.
     Local variables only (``self.st`` is written at the end or before an error); True if
     ``n_target`` reversals were reached."""

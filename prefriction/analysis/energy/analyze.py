@@ -14,7 +14,7 @@ from prefriction.analysis.energy.report import EnergyReport, _rel_residual
 from prefriction.analysis.energy.sampled_energy import kinetic_energy
 from prefriction.analysis.energy.sampled_reversals import SampledReversals, find_reversals
 from prefriction.analysis.energy.work import input_work, split_integrals
-from prefriction.models import LuGre, Oscillator
+from prefriction.models import ElastoPlastic, LuGre, Oscillator
 from prefriction.simulation.result import SimulationResult
 
 Report = Union[EnergyReport, LuGreEnergyReport]
@@ -108,6 +108,11 @@ def analyze_samples(
         with ``Fs > Fc`` or damping), or ``zoh`` is not a bool.
     """
     friction, mass = check_system(system, lugre=True)
+    if isinstance(friction, ElastoPlastic):
+        raise TypeError("the sampled energy analysis of an ElastoPlastic model needs its bristle deflection, which "
+                        "the samples do not give in closed form (alpha depends on it): analyse its reversal table "
+                        "with prefriction.energy.analyze_table(result.reversals, system=system) (the stored energy "
+                        "F_i^2 / (2 sigma0) at each reversal, exact)")
     method = check_method(method)
     zoh = check_flag("zoh", zoh)
     if u is None:

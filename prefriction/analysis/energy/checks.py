@@ -7,7 +7,7 @@ from typing import Any, Optional
 
 import numpy as np
 
-from prefriction.models import GMS, FrictionModel, LuGre, MaxwellSlip, check_oscillator
+from prefriction.models import GMS, ElastoPlastic, FrictionModel, LuGre, MaxwellSlip, check_oscillator
 
 QUADRATURES = ("trapezoid", "simpson")
 """Quadrature rules of the power integrals: cumulative trapezoid or Simpson (scipy)."""
@@ -126,10 +126,11 @@ def check_system(system: Any, *, lugre: bool = False) -> tuple[FrictionModel, fl
 
     The model is :func:`check_model`'s (a rate-independent model, a GMS in its rate-independent
     configuration as the equal Maxwell-slip model); with ``lugre`` a :class:`prefriction.LuGre`
-    model is returned as it is. ``TypeError`` otherwise.
+    model is returned as it is, and so is a :class:`prefriction.ElastoPlastic` model (the same
+    bristle, the same stored energy ``sigma0 z^2 / 2``). ``TypeError`` otherwise.
     """
     friction = check_oscillator(system, "the energy analysis")
-    if lugre and isinstance(friction, LuGre):
+    if lugre and isinstance(friction, (LuGre, ElastoPlastic)):
         return friction, system.mass
     return check_model(friction), system.mass
 
@@ -165,7 +166,7 @@ def check_model(friction: Any) -> FrictionModel:
         extra = " (LuGre: pass the Oscillator to analyze_samples, which splits viscous and hysteretic dissipation)" \
             if isinstance(friction, LuGre) else ""
         raise TypeError(f"the energy analysis needs a rate-independent friction model, got {type(friction).__name__}{extra}")
-    if type(friction).branch_energy_of_force is FrictionModel.branch_energy_of_force:
+    if friction.n_states != 1 and type(friction).branch_energy_of_force is FrictionModel.branch_energy_of_force:
         raise TypeError(f"the energy analysis needs the branch energy as a function of the force; "
                         f"{type(friction).__name__} does not define branch_energy_of_force")
     return friction

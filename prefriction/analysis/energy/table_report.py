@@ -12,7 +12,7 @@ from prefriction.analysis.energy.checks import value_array, check_system
 from prefriction.analysis.energy.lugre import lugre_bound
 from prefriction.analysis.energy.lugre_report import lugre_table_energy
 from prefriction.analysis.energy.report import EnergyReport, _rel_residual
-from prefriction.models import FrictionModel, LuGre, Oscillator
+from prefriction.models import ElastoPlastic, FrictionModel, LuGre, Oscillator
 from prefriction.reversals import ReversalTable
 
 
@@ -111,7 +111,7 @@ def analyze_table(
         check, label = None, "none: E_p is computed from the tabulated forces"
     top = float(np.max(E_p))
     S, R = series(E_p, E_d[1:])
-    bound = lugre_bound(E_p, friction, E_0) if isinstance(friction, LuGre) else bound_check(E_p, friction=friction, E_0=E_0)
+    bound = lugre_bound(E_p, friction, E_0) if isinstance(friction, (LuGre, ElastoPlastic)) else bound_check(E_p, friction=friction, E_0=E_0)
     return EnergyReport(
         source="reversal table",
         t=t,
@@ -142,7 +142,7 @@ def _undefined_table_energy(
     W = _work_per_reversal(work_input, len(table), required=system.forced, system=system)
     F = np.asarray(table.F, dtype=float)
     s0 = -int(direction[0])
-    if isinstance(friction, LuGre):
+    if isinstance(friction, (LuGre, ElastoPlastic)):  # stored bristle energy sigma0 z^2 / 2, z' = 0 at v = 0
         return lugre_table_energy(F, friction), float(table.E_0) + float(lugre_table_energy(F0, friction)), W
     return branch_energy(F, direction, friction=friction), float(table.E_0) + float(branch_energy(F0, s0, friction=friction)), W
 

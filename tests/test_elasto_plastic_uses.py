@@ -1,0 +1,101 @@
+"""ElastoPlastic everywhere a model works: identify.fit (force-displacement data), the positioning
+loop with its compensators, the exported C step and the energy analysis of a reversal table."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import prefriction as pf
+from prefriction import controllers, export, identify
+
+from _elasto_plastic_reference import along, oscillator
+
+TRUE = pf.ElastoPlastic(sigma0=1e5, sigma1=100.0, sigma2=0.4, Fc=1.0, Fs=1.5, vs=1e-3, z_ba=0.5e-5)
+
+
+def test_fit_recovers_the_parameters_from_force_displacement_data():
+    """Data from the independent scipy integration plus 1 mN noise; the fit starts 20-30 % off."""
+    t = np.linspace(0.0, 0.4, 2001)
+    x = 3e-5 * np.sin(2 * np.pi * 5 * t) + 0.5e-5 * np.sin(2 * np.pi * 13 * t)
+    F = along(TRUE, t, x) + 1e-3 * np.random.default_rng(1).standard_normal(t.size)
+    start = pf.ElastoPlastic(sigma0=0.7e5, sigma1=100.0, sigma2=0.4, Fc=1.2, Fs=1.2, vs=1e-3, z_ba=0.4e-5)
+    res = identify.fit(start, identify.ForceDisplacement(t, x, F), fixed=["sigma1", "sigma2", "vs"])
+    for name in ("sigma0", "Fc", "Fs", "z_ba"):
+        lo, hi = res.interval(name)  # 95 %: four of them miss together 19 % of the time; 2x wide: 1e-8
+        assert abs(getattr(res.model, name) - getattr(TRUE, name)) <= hi - lo, name
+        assert getattr(res.model, name) == pytest.approx(getattr(TRUE, name), rel=2e-3), name
+    assert res.rms == pytest.approx(1e-3, rel=0.1)
+
+
+@pytest.mark.slow  # about 30 s: the reference under a sampled force, then multiple shooting
+def test_motion_fit_with_the_crossings_in_the_right_hand_side():
+    """Positions from the reference under a known force; the motion fit needs the form without
+    events (``crossings=False``), and names it for the form with them."""
+    t = np.linspace(0.0, 0.25, 501)
+    u = 0.2 + 0.9 * np.sin(2 * np.pi * 8 * t)
+    ref = oscillator(TRUE, 0.5, 1e-300, u=lambda tt: float(np.interp(tt, t, u)), t_end=0.25, times=t)
+    assert ref["breakaways"] >= 3
+    x = ref["dense"][:, 0] + 1e-9 * np.random.default_rng(0).standard_normal(t.size)
+    data = identify.Motion(t, x, u=u, mass=0.5, hold="linear")
+    with pytest.raises(ValueError, match="ElastoPlastic has 2 events: fit it to ForceDisplacement data, or give it "
+                                         "with crossings=False"):
+        identify.fit(TRUE, data)
+    start = pf.ElastoPlastic(0.7e5, 100.0, 0.4, 1.2, 1.3, 1e-3, 0.4e-5, crossings=False)
+    res = identify.fit(start, data, fixed=["sigma1", "sigma2", "vs"])
+    for name in ("sigma0", "Fc", "Fs", "z_ba"):
+        assert getattr(res.model, name) == pytest.approx(getattr(TRUE, name), rel=2e-3), name
+
+
+def test_crossings_in_the_right_hand_side_match_the_2002_equations():
+    ep = pf.ElastoPlastic(1e5, 100.0, 0.4, 1.0, 1.5, 1e-3, 0.5e-5, crossings=False)
+    assert (ep.n_flags, ep.n_events) == (0, 0)
+    res = pf.simulate(pf.Oscillator(ep, mass=0.5), 0.05, reversals=8, rtol=1e-10)
+    ref = oscillator(TRUE, 0.5, 0.05, t_end=res.reversals.t[-1] * (1 + 1e-7))["reversals"]
+    assert np.max(np.abs(res.reversals.t - ref[:, 0]) / ref[:, 0]) < 1e-9
+    assert np.max(np.abs(res.reversals.F - ref[:, 2])) < 1e-9 * np.max(np.abs(ref[:, 2]))
+
+
+def test_loop_with_feedforward_and_observers():
+    ep = pf.ElastoPlastic(sigma0=1e6, sigma1=2000.0, sigma2=0.4, Fc=1.0, Fs=1.2, vs=1e-3, z_ba=0.5e-6)
+    stage = pf.Oscillator(ep, mass=1.0)
+    pid = controllers.design_pid(pf.Oscillator(pf.Dahl(sigma=1e6, Fc=1.0), mass=1.0), wn=2 * math.pi * 150.0)
+    sine = pf.signals.Sine(5e-6, 1.0, phase=-math.pi / 2, offset=5e-6)
+
+    def spike(res):
+        return np.max(np.abs(res.error[res.t >= 1.0]))
+
+    alone = spike(controllers.simulate_loop(stage, pid, sine, Ts=1e-4, t_end=1.1))
+    for comp in (controllers.Feedforward(ep), controllers.FrictionObserver(ep, pole=2 * math.pi * 300)):
+        res = controllers.simulate_loop(stage, pid, sine, Ts=1e-4, t_end=1.1, compensator=comp, mismatch=(1.2, 0.8))
+        assert spike(res) < 0.5 * alone, type(comp).__name__
+        if isinstance(comp, controllers.Feedforward):
+            m = res.compensator.model  # the mismatch keeps the breakaway at the same fraction
+            assert (m.sigma0, m.Fc, m.z_ba) == pytest.approx((1.2e6, 0.8, 0.5e-6 * 0.8 / 1.2), rel=1e-14)
+
+
+@pytest.mark.skipif(export.gcc() is None, reason="gcc is not on the PATH")
+def test_exported_c_matches_the_2002_equations(tmp_path):
+    Ts = 2.0 ** -14
+    t = np.arange(4000) * Ts
+    x = 2e-5 * np.sin(2 * np.pi * 20 * t) + 0.6e-5 * np.sin(2 * np.pi * 47 * t)
+    src = export.c_source(TRUE, "ep", tmp_path, Ts=Ts)
+    run = export.run_c(src, x)
+    ref = along(TRUE, t, x)
+    assert np.max(np.abs(run.F[1:] - ref[1:])) <= 1e-9 * np.max(np.abs(ref))
+
+
+def test_energy_of_the_reversal_table():
+    """Stored bristle energy ``F_i^2 / (2 sigma0)`` at the reversals of the independent reference,
+    ``E_0 = m v0^2 / 2``, and the balance (2.10)."""
+    system = pf.Oscillator(TRUE, mass=0.5)
+    res = pf.simulate(system, 0.05, reversals=6, rtol=1e-10)
+    rep = pf.energy.analyze_table(res.reversals, system=system)
+    ref = oscillator(TRUE, 0.5, 0.05, t_end=res.reversals.t[-1] * (1 + 1e-7))["reversals"]
+    np.testing.assert_allclose(rep.E_p, ref[:, 2] ** 2 / (2 * TRUE.sigma0), rtol=1e-8)
+    assert rep.E_0 == pytest.approx(0.5 * 0.5 * 0.05 ** 2, rel=1e-14)
+    assert np.all(rep.E_d > 0) and rep.bound.holds
+    with pytest.raises(TypeError, match="analyze_table"):
+        pf.energy.analyze_samples(res.reversals.t, res.reversals.x, np.zeros(6), res.reversals.F, system=system)
