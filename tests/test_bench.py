@@ -97,7 +97,7 @@ def test_peers_against_the_exact_table_and_their_rows() -> None:
 def test_simulate_rows_and_stability_in_process(headline_ref: ReversalTable) -> None:
     row = simulate_point(HEADLINE, 1e-6, "erk", headline_ref, 2, min_seconds=0.0)
     assert row.solver == "simulate[erk]" and row.error <= 10 * row.tol and row.seconds > 0
-    assert [r.solver for r in headline([1e-6], 1, peers=False, budget=0.0)] == ["simulate[erk]"]
+    assert [r.solver for r in headline([1e-6], 1, peers=False, budget=0.0)] == ["simulate[native]", "simulate[erk]"]
     stab, points = stability([1e-6], 100, 1e-8, cases=[HEADLINE])
     assert len(points) == 1 and stab[0].n_long == 100 and stab[0].passed and stab[0].energy_drift < 1e-6
     names = [c.name for c in stability_cases()]
@@ -132,7 +132,7 @@ def test_stability_rows_against_their_references() -> None:
 
 
 def _rows(err: float) -> list[Row]:
-    return [Row("h", "simulate[erk]", 1e-8, err, 1e-3), Row("h", "scipy DOP853 +events", 1e-9, 5e-9, 0.05)]
+    return [Row("h", "simulate[native]", 1e-8, err, 1e-3), Row("h", "scipy DOP853 +events", 1e-9, 5e-9, 0.05)]
 
 
 def test_targets_decide_from_the_measured_rows() -> None:
@@ -145,7 +145,7 @@ def test_targets_decide_from_the_measured_rows() -> None:
     lines = targets(_rows(5e-7), stab, 1e-5, 1.6e-5, 500, [1e-8], [ok])
     assert "FAIL" in lines[0] and lines[1].startswith("target 2: not measured") and "FAIL" in lines[2]
     assert "FAIL" in targets(_rows(5e-9), stab, 1e-5, 1e-5, 500, [1e-8], [bad])[0]
-    slow = [Row("h", "simulate[erk]", 1e-8, 5e-9, 1e-2), Row("h", "scipy DOP853 +events", 1e-9, 5e-9, 0.05)]
+    slow = [Row("h", "simulate[native]", 1e-8, 5e-9, 1e-2), Row("h", "scipy DOP853 +events", 1e-9, 5e-9, 0.05)]
     assert "FAIL  ratio 5.0x" in targets(slow, stab, 1e-5, 1e-5, 500, [1e-8], [ok])[1]
 
 
@@ -237,5 +237,5 @@ def test_models_bench_quick_end_to_end(tmp_path, capsys) -> None:
     assert (code == 0) == all("PASS" in line for line in targets_)
     with (tmp_path / "models.csv").open() as fh:
         rows = list(csv.DictReader(fh))
-    sim = [r for r in rows if r["solver"] == "simulate[erk]"]
+    sim = [r for r in rows if r["solver"] == "simulate[native]"]
     assert len(sim) == 2 and all(float(r["max_rel_error"]) <= 10 * float(r["tol"]) for r in sim)

@@ -35,16 +35,20 @@ def python_loop(system, Cd, r, t_end, Ts, rtol=1e-8):
     return prefriction.simulate(system, 0.0, t_end=t_end, rtol=rtol, feedback=fb)
 
 
-def test_agrees_with_the_python_loop_over_several_blocks():
+def test_agrees_with_the_python_loop_over_several_blocks(monkeypatch):
+    from prefriction.simulation.loops import runner
+
+    monkeypatch.setattr(runner, "NATIVE_BLOCK", 128)  # the native loop's blocks: several here too
     res = controllers.simulate_loop(stage(), pid(), STEP, 0.03)
     assert len(res.t) > BLOCK and res.loop_stats.blocks >= 2
     old = python_loop(stage(), pid(), STEP, 0.03, TS)
     np.testing.assert_allclose(res.t, old.t, rtol=0, atol=1e-15)
-    assert np.max(np.abs(res.x - old.x)) <= 1e-9 * STEP
-    assert np.max(np.abs(res.u - old.u)) <= 1e-9 * np.max(np.abs(old.u))
+    # two integrations at rtol 1e-8 (the native loop carries its step size over the periods)
+    assert np.max(np.abs(res.x - old.x)) <= 1e-8 * STEP
+    assert np.max(np.abs(res.u - old.u)) <= 1e-8 * np.max(np.abs(old.u))
     assert len(res.reversals) == len(old.reversals) >= 2
-    np.testing.assert_allclose(res.reversals.t, old.reversals.t, rtol=1e-9)
-    np.testing.assert_allclose(res.reversals.F, old.reversals.F, rtol=1e-9)
+    np.testing.assert_allclose(res.reversals.t, old.reversals.t, rtol=1e-8)
+    np.testing.assert_allclose(res.reversals.F, old.reversals.F, rtol=1e-8)
 
 
 def test_tight_tolerance_against_independent_zoh_reference():
@@ -62,7 +66,7 @@ def test_resting_periods_are_skipped():
     assert st.integrated <= st.samples - 1 - 100
     assert np.all(res.x[:101] == 0.0) and res.x[-1] > 0.5 * STEP
     old = python_loop(stage(), pid(), r, 0.02, TS)
-    assert np.max(np.abs(res.x - old.x)) <= 1e-9 * STEP
+    assert np.max(np.abs(res.x - old.x)) <= 1e-8 * STEP  # two integrations at rtol 1e-8
 
 
 def test_periods_with_many_reversals_are_finished_in_python():
@@ -73,7 +77,10 @@ def test_periods_with_many_reversals_are_finished_in_python():
     Cd = controllers.PID(kp=1e4).c2d(1e-3)
     with pytest.warns(controllers.UnstableLoopWarning):
         res = controllers.simulate_loop(light, Cd, STEP, 0.01)
-    assert res.loop_stats.finished_in_python >= 5
+    if res.loop_stats.jit != "interpreted" and res.simulation.stats.steps is not None:
+        assert res.loop_stats.finished_in_python == 0  # the native loop holds any number per period
+    else:
+        assert res.loop_stats.finished_in_python >= 5
     old = python_loop(light, Cd, STEP, 0.01, 1e-3)
     assert np.max(np.abs(res.x - old.x)) <= 1e-9 * STEP
     assert len(res.reversals) == len(old.reversals) > 100

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import prefriction as pf
-import prefriction.simulation.simulate as simulate_module
+import prefriction.simulation.lazy_table as lazy_table
 from prefriction.simulation.reversal_log import ReversalLog
 
 
@@ -29,7 +29,7 @@ def test_log_behaves_as_the_list_of_tuples() -> None:
 def test_blocked_energies_match_the_exact_reversals(monkeypatch: pytest.MonkeyPatch) -> None:
     # energies computed in blocks of 7 reversals (the start in the first): E_p and E_d of the
     # exact reversal map, with the start's energy E_0 (F0 != 0: the start's branch energy counts)
-    monkeypatch.setattr(simulate_module, "_ENERGY_BLOCK", 7)
+    monkeypatch.setattr(lazy_table, "_ENERGY_BLOCK", 7)
     system = pf.Oscillator(pf.Dahl(sigma=1e4, Fc=2.0, gamma=1.5), mass=0.5)
     res = pf.simulate(system, 0.4, F0=0.5, reversals=30)
     ref = pf.exact_reversals(system, 0.4, 30, F0=0.5)
@@ -38,3 +38,21 @@ def test_blocked_energies_match_the_exact_reversals(monkeypatch: pytest.MonkeyPa
     assert np.max(np.abs(tab.E_p / ref.E_p - 1.0)) < 1e-7
     assert np.max(np.abs(tab.E_d - ref.E_d) / ref.E_d) < 1e-6
     assert np.max(np.abs(tab.t / ref.t - 1.0)) < 1e-8
+    assert isinstance(tab, lazy_table.LazyReversalTable) and isinstance(tab.eager(), pf.ReversalTable)
+    np.testing.assert_array_equal(tab.eager().E_d, tab.E_d)
+
+
+def test_lazy_table_pickles_and_computes_its_energies_once_read() -> None:
+    """The table of a run pickles before its energies were read; both copies give the energies of
+    the exact reversal map (Ruderman 2023, (3.9), (2.10))."""
+    import pickle
+
+    system = pf.Oscillator(pf.Dahl(sigma=1e4, Fc=2.0), mass=0.5)
+    tab = pf.simulate(system, 0.4, reversals=12).reversals
+    assert "_done" not in tab.__dict__  # not computed yet
+    copy = pickle.loads(pickle.dumps(tab))
+    ref = pf.exact_reversals(system, 0.4, 12)
+    for t in (tab, copy):
+        assert np.max(np.abs(t.E_p / ref.E_p - 1.0)) < 1e-7
+        assert np.max(np.abs(t.E_d - ref.E_d) / ref.E_d) < 1e-6
+        assert t.E_0 == pytest.approx(ref.E_0, rel=1e-14)

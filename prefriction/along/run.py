@@ -11,6 +11,7 @@ from prefriction._validation import check_count, check_finite
 from prefriction.along.engine import Units, stepper
 from prefriction._memory import check_memory
 from prefriction.along.motion import Motion
+from prefriction.along.native import along_driver, run_native
 from prefriction.along.result import AlongResult
 from prefriction.models.base import FrictionModel
 
@@ -105,15 +106,19 @@ def friction_along(model: FrictionModel, t: Any, x: Any, *, F0: float = 0.0, v: 
     start = time.perf_counter()
     U = Units.of(model)
     q = np.asarray(model.runtime_params(), dtype=float)
-    rows = np.vstack([motion.v / U.v, motion.dt / U.t, motion.s_prev, motion.s, motion.v_at[1:] / U.v])
     _X, F_first, _e = run.step(X0, 0.0, 0.0, motion.s0, motion.s0, motion.v_at[0] / U.v, q)
-    X, F, ev = run.run(X0, rows, q)
-    F = U.F * np.concatenate(([float(F_first)], F))
+    lib = along_driver(model, run.substeps)
+    if lib is not None:  # one C pass writing into the result's arrays (prefriction.along.native)
+        X, F, ev = run_native(lib, X0, float(F_first), motion, q, U)
+    else:
+        rows = np.vstack([motion.v / U.v, motion.dt / U.t, motion.s_prev, motion.s, motion.v_at[1:] / U.v])
+        Xb, Fb, evb = run.run(X0, rows, q)
+        F = U.F * np.concatenate(([float(F_first)], Fb))
+        X = np.hstack((X0[:, None], Xb)).T
+        ev = np.concatenate(([0], evb.astype(int)))
     _check_finite(F, motion.t)
-    X = np.hstack((X0[:, None], X)).T
     nz = model.n_states
-    return AlongResult(model, motion.t, motion.x, F, motion.v_at, X[:, :nz], X[:, nz:],
-                       np.concatenate(([0], ev.astype(int))), motion.reversals, F0,
+    return AlongResult(model, motion.t, motion.x, F, motion.v_at, X[:, :nz], X[:, nz:], ev, motion.reversals, F0,
                        "exact" if run.exact else f"rk4 x {substeps}", time.perf_counter() - start)
 
 

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from prefriction.reversals import ReversalTable
+from prefriction.simulation.lazy_table import LazyReversalTable
 from prefriction.simulation.result import RunStats, SimulationResult
 
 __all__ = ["Packed", "pack"]
@@ -95,6 +96,8 @@ def pack(outcomes: list) -> Packed:
     """
     positions, results, others = [], [], []
     for k, outcome in enumerate(outcomes):
+        if type(outcome) is SimulationResult and isinstance(outcome.reversals, LazyReversalTable):
+            outcome = dataclasses.replace(outcome, reversals=outcome.reversals.eager())  # energies computed here
         if _plain(outcome):
             positions.append(k)
             results.append(outcome)

@@ -9,7 +9,7 @@ in :class:`array.array` (8 bytes per number) and hands them to numpy without a c
 from __future__ import annotations
 
 from array import array
-from typing import Iterable, Union
+from typing import Iterable, Optional, Union
 
 import numpy as np
 
@@ -42,9 +42,10 @@ class ReversalLog:
         for row in rows:
             self.append(row)
 
-    def extend_columns(self, t: np.ndarray, x: np.ndarray, F: np.ndarray) -> None:
-        """Add reversals from columns of times, positions and forces (``W~ = 0``: unforced runs)."""
-        for col, values in ((self.t, t), (self.x, x), (self.F, F), (self.W, np.zeros(len(t)))):
+    def extend_columns(self, t: np.ndarray, x: np.ndarray, F: np.ndarray, W: Optional[np.ndarray] = None) -> None:
+        """Add reversals from columns of times, positions, forces and input works (None: ``W~ = 0``,
+        unforced runs)."""
+        for col, values in ((self.t, t), (self.x, x), (self.F, F), (self.W, np.zeros(len(t)) if W is None else W)):
             col.frombytes(memoryview(np.ascontiguousarray(values, dtype=float)).cast("B"))  # no bytes copy
 
     def __len__(self) -> int:

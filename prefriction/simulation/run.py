@@ -16,6 +16,7 @@ from prefriction.simulation.compact import advance_compact
 from prefriction.simulation.integrator import INTEGRATOR_FAILED, BufferedIntegrator, integrator
 from prefriction.simulation.feedback import LinearFeedback
 from prefriction.simulation.native.advance import advance_native
+from prefriction.simulation.native.forced import forced_driver
 from prefriction.simulation.native.library import native_driver
 from prefriction.simulation.plant import Layout, PlantSpec
 from prefriction.simulation.rest import Rest
@@ -41,19 +42,28 @@ class Run(StateIO, Rest):
     """
 
     def __init__(self, system: Oscillator, spec: PlantSpec, fb: Optional[LinearFeedback],
-                 eps: float, jit: bool) -> None:
+                 eps: float, jit: bool, native: bool = True, sc: Optional[Scales] = None,
+                 L: Optional[Layout] = None) -> None:
         self.system, self.spec, self.fb = system, spec, fb
-        self.sc = Scales.of(system)
+        self.sc = Scales.of(system) if sc is None else sc  # (simulate has them already)
         self.model = system.friction
         self.q = self.model.runtime_params_for(self.sc)  # may depend on the mass (units)
         self.eps = eps  # run-time tolerance: states are scaled by amplitude * eps
-        self.L = Layout(spec)  # the same for any number of outputs per call
+        self.eps_native = eps  # the same for the native drivers' norm over the active states (simulate sets it)
+        self.L = Layout(spec) if L is None else L  # the same for any number of outputs per call
         # a sampled controller on a plant without a hold control: its force joins the input piece
         self.hold_in_piece = fb is not None and fb.sampled and spec.fb == "none"
         # one plant: a dense run makes its single-output calls on the dense plant, padded
         # the compact unforced model runs on the native driver where it exists (docs/simulator.md#native)
-        self.native, setup = native_driver(self.model) if spec.stops_at_reversal and jit else (None, 0.0)
-        if self.native is not None:
+        # forced and dense open-loop runs on the forced native driver (native/forced.py)
+        self.native, setup = native_driver(self.model) if spec.stops_at_reversal and jit and native else (None, 0.0)
+        self.native_forced = None
+        if native and jit and fb is None and not spec.stops_at_reversal:
+            self.native_forced, setup = forced_driver(self.model, spec.u_sig)
+        if self.native_forced is not None:
+            self.f1, self.setup_time = None, setup
+            self.mode = self.native_forced.info.mode if setup else "cached"
+        elif self.native is not None:
             self.f1, self.setup_time = None, setup
             self.mode = self.native.info.mode if setup else "cached"
         else:

@@ -41,6 +41,7 @@ from prefriction.signals import Constant, compiled_form
 from prefriction.simulation.feedback import LinearFeedback
 from prefriction.simulation.dense import SampleBuffer, dense_loop, samples_si
 from prefriction.simulation.rest import initial_direction
+from prefriction.simulation.native.forced import linear_pieces, run_forced
 from prefriction.simulation.run import N_DENSE, Run
 from prefriction.simulation.plant import Layout, PlantSpec
 from prefriction.simulation.force_scale import applied_force_scale
@@ -48,14 +49,16 @@ from prefriction.simulation.budget import check_input_budget
 from prefriction._validation import check_count, check_finite, check_positive
 from prefriction.models import Oscillator, check_oscillator
 from prefriction.reversals import ReversalTable
+from prefriction.simulation.lazy_table import LazyReversalTable
 from prefriction.simulation.result import RunStats, SimulationResult
 from prefriction.units import Scales
 
 __all__ = ["MAX_AMPLITUDE", "MAX_PERIODS", "MAX_REVERSALS", "METHODS", "MIN_AMPLITUDE", "RAMP_ROUNDOFF", "RunStats",
            "SimulationResult", "simulate"]
 
-METHODS = ("erk",)
-"""Integrator plugins exposed by :func:`simulate` (each tested on the whole case set)."""
+METHODS = ("native", "erk")
+"""Integrators of :func:`simulate`: ``"native"`` (the C driver, ``docs/simulator.md#native``)
+and ``"erk"`` (CasADi's integrator, the reference the native driver is tested against)."""
 
 _K = 2  # reversals recorded per integrator call (register length; forced or dense runs)
 _MIN_ORDER = 2  # continuous controllers are padded to this order (one plant for P, PD, PID)
@@ -89,7 +92,7 @@ def simulate(
     t_end: Optional[float] = None,
     rtol: float = 1e-8,
     atol: Optional[float] = None,
-    method: str = "erk",
+    method: str = "native",
     dense: Union[bool, np.ndarray, list] = False,
     feedback: Optional[LinearFeedback] = None,
     jit: bool = True,
@@ -124,11 +127,14 @@ def simulate(
         Tolerance relative to the current amplitude of the motion (dimensionless); defaults to
         ``rtol``. The error control is absolute on states scaled by that amplitude, so the two
         act alike and the smaller one is used (``docs/simulator.md``).
-    method : str, default "erk"
-        CasADi integrator plugin; one of :data:`METHODS`. Only ``"erk"`` is exposed: it passes
-        every case of ``prefriction bench``. (``"rosenbrock"`` works with the same events but is
-        5-10 times slower on these non-stiff problems; ``cvodes``/``idas`` events and
-        ``collocation`` fail: docs/simulator.md, why only erk.)
+    method : str, default "native"
+        One of :data:`METHODS`. ``"native"``: the C driver (the model's and the input's
+        generated code driven by a Runge-Kutta 5(4) in C, one C call per run or block;
+        ``docs/simulator.md#native``) where it applies (no sampled or continuous controller,
+        a C compiler), else CasADi's integrator. ``"erk"``: CasADi's integrator (adaptive
+        explicit Runge-Kutta 5(4) with events; ``"rosenbrock"`` works with the same events but
+        is 5-10 times slower on these non-stiff problems; ``cvodes``/``idas`` events and
+        ``collocation`` fail: docs/simulator.md, why only erk). Both agree to the tolerance.
     dense : bool or array_like, default False
         ``False``: reversal table only (no dense output is computed). ``True``: samples every
         ``2 pi / 64`` normalised time units (64 per small oscillation). An array: samples at
@@ -216,14 +222,15 @@ def simulate(
     spec = PlantSpec.of(
         model, u_plant, feedback.reference if fb_kind == "continuous" else None,
         fb=fb_plant, n_c=n_c, energy=want_dense, K=_K, n_out=N_DENSE if want_dense else 1,
-        method=method, compact=True,
+        method="erk", compact=True,
     )
     force_scale = applied_force_scale(system, feedback, x0, t_end_si) / Fc if forced else 0.0
     _check_amplitude(v0, F0, force_scale, sc)
     L = Layout(spec)
     # error control on states scaled by amplitude * eps (the plant's run-time tolerance)
     eps = min(rtol, atol) * _CAL * math.sqrt(L.n_active / L.nx)
-    run = Run(system, spec, feedback, eps, jit)
+    run = Run(system, spec, feedback, eps, jit, native=method == "native", sc=sc, L=L)
+    run.eps_native = min(rtol, atol) * _CAL  # the native drivers' RMS norm runs over the active states only
     run.snap = rtol
     run.P0 = run._constant_params(run.L)
     run.force_scale = force_scale
@@ -241,7 +248,11 @@ def simulate(
 
     start = time.perf_counter()
     u_hist: list = []
-    if fb_kind == "sampled":
+    if run.native_forced is not None:
+        samples = SampleBuffer(0, len(times_si) if times_si is not None else 1024) if want_dense else []
+        run_forced(run, t_end_n, n_target, None if times_si is None else times_si / sc.t,
+                   samples if want_dense else None)
+    elif fb_kind == "sampled":
         samples, u_hist = _sampled_loop(run, xc0, t_end_n, n_target)
     elif want_dense:
         samples = dense_loop(run, None if times_si is None else times_si / sc.t, t_end_n, n_target)
@@ -318,9 +329,11 @@ def _check_ramps(run: Run, t_end: float, rtol: float) -> None:
         return
     level = run.eps * max(run.force_scale, 1e-300)  # error level of the net force (normalised)
     t = np.concatenate(([0.0], run.breaks[run.breaks < t_end], [t_end]))
-    for ta, tb in zip(t[:-1], t[1:]):
-        slope = float(sig.piece(ta * sc.t, tb * sc.t)[2]) * sc.t / sc.F  # normalised
-        err = abs(slope) * tb * 2.0 ** -53
+    _, slopes = linear_pieces(sig, t[:-1] * sc.t, t[1:] * sc.t)  # vectorised: one pass over the pieces
+    slopes = np.abs(slopes) * (sc.t / sc.F)  # normalised
+    errs = slopes * t[1:] * 2.0 ** -53
+    for k in np.flatnonzero(errs > RAMP_ROUNDOFF * level)[:1]:
+        ta, tb, slope, err = float(t[k]), float(t[k + 1]), float(slopes[k]), float(errs[k])
         if err > RAMP_ROUNDOFF * level:
             rise = abs(slope) * (tb - ta) * sc.F
             shortest = rise / sc.F * tb * 2.0 ** -53 / (RAMP_ROUNDOFF * level) * sc.t
@@ -402,44 +415,23 @@ def _sampled_loop(run: Run, xc0: np.ndarray, t_end: float, n_target: float) -> t
     return samples, u_hist
 
 
-_ENERGY_BLOCK = 4096  # reversals per branch_energy_of_force call: temporaries of ~2 MB (Dahl: 57 doubles each)
-
-
 def _reversal_table(rev: Union[list, tuple], system: Oscillator, s0: float, v0: float, F0: float,
                     sc: Optional[Scales] = None) -> tuple[ReversalTable, np.ndarray]:
-    """The reversals as a :class:`ReversalTable` in SI, and the input's work over each
-    half-cycle [J]; ``E_p`` is the branch potential (3.9), ``E_d`` the balance (2.10).
+    """The reversals as a :class:`ReversalTable` in SI (its energies ``E_p`` (3.9), ``E_d``
+    (2.10), ``E_0`` computed on first use: :class:`~prefriction.simulation.lazy_table.LazyReversalTable`),
+    and the input's work over each half-cycle [J].
 
     ``rev``: a list of ``(t~, x~, F~, W~)`` tuples, or the four columns
     (:meth:`~prefriction.simulation.reversal_log.ReversalLog.columns`; writable columns are
     converted to SI in place, so that a long run holds them once); ``sc``: the system's scales,
     if known."""
     sc = Scales.of(system) if sc is None else sc
-    model = system.friction
     if isinstance(rev, list):
         R = np.array(rev, dtype=float).reshape(-1, 4)
         rev = (R[:, 0], R[:, 1], R[:, 2], R[:, 3])
-    n = len(rev[0])
-    if not model.rate_independent:  # no stored branch energy: E_p is not defined (NaN), E_0 kinetic
-        E_p = np.full(n, np.nan)
-        E0 = 0.5 * system.mass * v0 * v0
-    else:  # the start and every reversal, in blocks (each call costs ~50 us whatever its size)
-        E = np.empty(n + 1)  # the start (F0, s0), then reversal k on the branch s0 (-1)^k
-        for a in range(0, n + 1, _ENERGY_BLOCK):
-            b = min(n + 1, a + _ENERGY_BLOCK)
-            F = rev[2][max(a - 1, 0):b - 1]
-            if a == 0:
-                F = np.concatenate(([F0 / sc.F], F))
-            E[a:b] = model.branch_energy_of_force(F, np.where(np.arange(a, b) % 2 == 0, s0, -s0)) * sc.E
-        E0, E_p = 0.5 * system.mass * v0 * v0 + float(E[0]), E[1:]
     t_r, x_r, F_r, W_r = (np.multiply(col, unit, out=col if col.flags.writeable else None)
                           for col, unit in zip(rev, (sc.t, sc.x, sc.F, sc.E)))
-    E_d = np.empty(n)
-    if n:
-        E_d[0] = E0 - E_p[0] + W_r[0]
-        np.add(E_p[:-1], W_r[1:], out=E_d[1:])
-        E_d[1:] -= E_p[1:]
-    return ReversalTable(t=t_r, x=x_r, F=F_r, E_p=E_p, E_d=E_d, E_0=E0), W_r
+    return LazyReversalTable(t_r, x_r, F_r, W_r, system, s0, v0, F0), W_r
 
 
 def _padded(fb: LinearFeedback, order: int) -> LinearFeedback:

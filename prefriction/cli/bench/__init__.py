@@ -93,6 +93,10 @@ def main(argv: Optional[list[str]] = None) -> int:
         from prefriction.cli.bench import emps
 
         return emps.main(args.emps)
+    if args.native:
+        from prefriction.cli.bench import native_rows
+
+        return native_rows.main(args.quick)
     if args.identify:
         from prefriction.cli.bench import identify
 

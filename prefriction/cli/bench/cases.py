@@ -19,7 +19,7 @@ from prefriction.reversals import ReversalTable
 N_REV = 50
 LADDER = [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11]
 QUICK_LADDER = [1e-6, 1e-9]
-DEFAULT_METHOD = "erk"
+DEFAULT_METHOD = "native"
 
 
 @dataclass(frozen=True)

@@ -124,7 +124,7 @@ def run(cases: list[ModelCase], ladder: tuple[float, ...] = LADDER, peers: tuple
                 return np.column_stack([tab.t / sc.t, tab.x / sc.x, tab.F / sc.F])
 
             got, sec = min_time(sim, most=math.inf, fill=budget, stop_best=0.05)
-            rows.append(ModelRow(case.name, "simulate[erk]", tol, _error(got, ref), sec))
+            rows.append(ModelRow(case.name, "simulate[native]", tol, _error(got, ref), sec))
         for method in peers:
             for tol in ladder:
                 def peer(tol: float = tol, method: str = method) -> np.ndarray:

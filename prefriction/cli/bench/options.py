@@ -150,12 +150,16 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
     what.add_argument("--export", action="store_true",
                       help="instead: ns per step of the exported C code (prefriction.export) against friction_along "
                            "and FrictionStream, and the exported plant and loop; --repeats sets its passes (default 5)")
+    what.add_argument("--native", action="store_true",
+                      help="instead: every run kind of the native driver (unforced, forced, Samples, dense) against "
+                           "the plain-C and numba references written from the equations, at matched error, in the "
+                           "same run (docs/bench.md#native)")
     what.add_argument("--identify", action="store_true",
                       help="instead: time and peak memory of a closed-loop Motion fit against the number of "
                            "samples (1e3, 5e3, 2.5e4; --quick: 500, 1000, 2000), each in a fresh process")
     what.add_argument("--emps", default=None, metavar="DIR",
                       help="instead: the identification routes on the EMPS benchmark files in DIR (DATA_EMPS.mat, "
-                           "DATA_EMPS_PULSES.mat; not shipped), docs/identify.md#emps")
+                           "DATA_EMPS_PULSES.mat; not shipped), docs/identify_closed_loop.md#emps")
     args = ap.parse_args(argv)
     if args.compensation and (args.quick or args.repeats is not None):
         ap.error("--quick and --repeats do not apply to --compensation")

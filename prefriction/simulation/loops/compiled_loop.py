@@ -33,7 +33,7 @@ import casadi as ca
 
 from prefriction.simulation.plant import EPS_REST, Layout, PlantSpec, build_integrator
 
-__all__ = ["MAX_DELAY", "LoopLayout", "LoopSpec", "NoCompensation", "loop_function"]
+__all__ = ["MAX_DELAY", "LoopLayout", "LoopSpec", "NoCompensation", "control_law", "loop_function"]
 
 MAX_DELAY = 8
 """Most samples of measurement delay (a run-time number up to this structural limit)."""
@@ -107,6 +107,47 @@ class LoopLayout:
         self.nrec = self.reg + 4 * K
 
 
+def control_law(spec: LoopSpec, LL: LoopLayout, S: ca.SX, w: ca.SX, par: ca.SX) -> dict:
+    """The sample instant ``t_k`` of the loop (module notes, step 1 and 2) on the symbols of the
+    loop state ``S``, the sample's inputs ``w`` and the parameters ``par``: the friction force
+    ``F``, the measurement (``y_now``, ``past``, ``y_meas``), the compensator (``cs``, ``cs_next``,
+    ``comp``), the applied force ``u`` (and ``u_total`` with the oscillator's own input) and the
+    controller's next state ``xc_next`` (the native loop compiles the same law, loops/native_loop.py)."""
+    L, model, n = LL.plant, spec.plant.model, spec.n_c
+    st = {k: S[i] for k, i in LL.state.items()}
+    wi = {k: w[i] for k, i in LL.inp.items()}
+    pp = {k: par[i] for k, i in LL.param.items()}
+    P0 = par[LL.p_plant]
+    pl = {k: P0[i] for k, i in L.param.items()}
+    z = [st[f"z{i}"] for i in range(L.nz)]
+    m = [st[f"m{i}"] for i in range(L.nm)]
+    xc = ca.vertcat(*[st[f"xc{i}"] for i in range(n)]) if n else ca.SX(0, 1)
+    F = model.force(z, m, st["v"], st["s"], P0[L.q])
+    active = wi["active"] > 0.5
+    # measurement (SI): noise, encoder rounding, delay of whole samples
+    y_now = st["x"] * pl["xunit"] + wi["noise"]
+    qs = pp["quant"]
+    y_now = ca.if_else(qs > 0.0, qs * ca.floor(y_now / ca.fmax(qs, 1e-300) + 0.5), y_now)
+    past = [st[f"y{i}"] for i in range(MAX_DELAY)]
+    y_meas = ca.dot(par[LL.p_delay], ca.vertcat(y_now, *past))
+    # compensator and controller (SI): error, raw output, clipped force, update with back-calculation
+    cs = ca.vertcat(*[st[f"c{i}"] for i in range(LL.n_comp)]) if LL.n_comp else ca.SX(0, 1)
+    cs_next, comp = spec.comp.function()(cs, ca.vertcat(y_meas, st["uprev"]),
+                                         ca.vertcat(wi["r"], wi["rn"], wi["vr"], wi["vrn"]), par[LL.p_comp])
+    e = wi["r"] - y_meas
+    raw = (ca.dot(par[LL.p_C], xc) if n else 0.0) + pp["D"] * e + comp
+    u = ca.fmin(ca.fmax(raw, -pp["umax"]), pp["umax"])
+    t_si = wi["t0"] * pl["tunit"]
+    u_total = u + wi["da"] + wi["db"] * (t_si - wi["tl"])  # with the oscillator's own input
+    xc_next = xc
+    if n:
+        A = ca.reshape(par[LL.p_A], n, n)
+        xc_next = ca.mtimes(A, xc) + par[LL.p_B] * e + pp["Ts"] * par[LL.p_kaw] * (u - raw)
+        xc_next = ca.if_else(active, xc_next, xc)
+    return {"F": F, "y_now": y_now, "past": past, "y_meas": y_meas, "cs": cs, "cs_next": cs_next, "comp": comp,
+            "u": u, "u_total": u_total, "xc_next": xc_next, "active": active}
+
+
 def _step(spec: LoopSpec, LL: LoopLayout) -> ca.Function:
     """One sample period: ``(S, w, par) -> (S_next, record)`` (record: the state at ``t_k``, the
     friction force, the applied force, a reversal at ``t_k`` and the plant's register)."""
@@ -121,28 +162,10 @@ def _step(spec: LoopSpec, LL: LoopLayout) -> ca.Function:
     x, v, s, W = st["x"], st["v"], st["s"], st["W"]
     z = [st[f"z{i}"] for i in range(L.nz)]
     m = [st[f"m{i}"] for i in range(L.nm)]
-    xc = ca.vertcat(*[st[f"xc{i}"] for i in range(n)]) if n else ca.SX(0, 1)
-    F = model.force(z, m, v, s, q)
-    active = wi["active"] > 0.5
-    # measurement (SI): noise, encoder rounding, delay of whole samples
-    y_now = x * pl["xunit"] + wi["noise"]
-    qs = pp["quant"]
-    y_now = ca.if_else(qs > 0.0, qs * ca.floor(y_now / ca.fmax(qs, 1e-300) + 0.5), y_now)
-    past = [st[f"y{i}"] for i in range(MAX_DELAY)]
-    y_meas = ca.dot(par[LL.p_delay], ca.vertcat(y_now, *past))
-    # compensator and controller (SI): error, raw output, clipped force, update with back-calculation
-    cs = ca.vertcat(*[st[f"c{i}"] for i in range(LL.n_comp)]) if LL.n_comp else ca.SX(0, 1)
-    cs_next, comp = spec.comp.function()(cs, ca.vertcat(y_meas, st["uprev"]),
-                                         ca.vertcat(wi["r"], wi["rn"], wi["vr"], wi["vrn"]), par[LL.p_comp])
-    e = wi["r"] - y_meas
-    raw = (ca.dot(par[LL.p_C], xc) if n else 0.0) + pp["D"] * e + comp
-    u = ca.fmin(ca.fmax(raw, -pp["umax"]), pp["umax"])
-    t_si = wi["t0"] * pl["tunit"]
-    u_total = u + wi["da"] + wi["db"] * (t_si - wi["tl"])  # with the oscillator's own input
-    if n:
-        A = ca.reshape(par[LL.p_A], n, n)
-        xc_next = ca.mtimes(A, xc) + par[LL.p_B] * e + pp["Ts"] * par[LL.p_kaw] * (u - raw)
-        xc_next = ca.if_else(active, xc_next, xc)
+    law = control_law(spec, LL, S, w, par)
+    F, y_now, past, y_meas = law["F"], law["y_now"], law["past"], law["y_meas"]
+    cs, cs_next, comp, u, u_total = law["cs"], law["cs_next"], law["comp"], law["u"], law["u_total"]
+    xc_next, active = law["xc_next"], law["active"]
     # amplitude scales of the period (Run._scales, forced), first with the state at t_k
     A0 = ca.hypot(v, F)
     Amax = ca.fmax(st["Amax"], A0)

@@ -31,12 +31,15 @@ from prefriction.simulation.simulate import _CAL, _reversal_table
 from prefriction.units import Scales
 
 from .compiled_loop import MAX_DELAY, NSTOP, LoopLayout, LoopSpec, NoCompensation, loop_function
+from .native_loop import loop_driver, run_blocks
 from .records import collect, failure, finish_in_python, initial_state
 
-__all__ = ["BLOCK", "LoopStats", "Measurement", "Compensation", "run_sampled"]
+__all__ = ["BLOCK", "NATIVE_BLOCK", "LoopStats", "Measurement", "Compensation", "run_sampled"]
 
 BLOCK = 256
 """Sample periods per compiled call (a structure; the last block of a run is padded)."""
+NATIVE_BLOCK = 4096
+"""Sample periods per call of the native loop (bounds its records' buffers, not a structure)."""
 _MIN_ORDER = 2  # controllers are padded to this order: P, PD and PID loops share one Function
 _K = 2  # the plant's register length, as in prefriction.simulate
 _CACHE = PerThread()  # one Function per structure and process, its buffers per thread
@@ -170,6 +173,7 @@ def run_sampled(
     system: Oscillator, fb: LinearFeedback, t_end: float, *, x0: float, v0: float, F0: float,
     rtol: float, jit: bool, u_max: Optional[float] = None, k_aw: Optional[np.ndarray] = None,
     block: int = BLOCK, measurement: Measurement = Measurement(), compensation: Optional[Compensation] = None,
+    native: bool = True,
 ) -> tuple[SimulationResult, LoopStats]:
     """Run the sampled loop ``fb`` (``fb.Ts`` set) on ``system`` (no input force) up to ``t_end`` [s].
 
@@ -197,6 +201,10 @@ def run_sampled(
         Encoder step, delay and noise of the measured position (default: the exact position).
     compensation : Compensation, optional
         A compensator whose force is added to the controller's (default: none).
+    native : bool, default True
+        Run the periods on the native loop (:mod:`prefriction.simulation.loops.native_loop`: blocks of
+        :data:`NATIVE_BLOCK` periods per C call) where it can be built; False: the CasADi block
+        Function (the reference it is tested against).
 
     Returns
     -------
@@ -222,10 +230,15 @@ def run_sampled(
     check_memory(f"the sampled loop of {type(model).__name__}", n_s, lay.nw + lay.nrec + 12 + n_user,
                  "sample instants", "increase Ts or split the run")
     tk = np.minimum(np.arange(n_s) * Ts_n, t_end_n)
-    blk, setup, mode = _block(spec, jit)
-    LL = blk.LL
+    drv, setup = loop_driver(spec) if native and jit else (None, 0.0)
+    if drv is None:
+        blk, setup, mode = _block(spec, jit)
+        LL, par, comp_fun = blk.LL, blk.par, blk.comp_fun
+    else:
+        mode = drv.info.mode if setup else "cached"
+        LL, comp_fun = LoopLayout(spec), comp.function()
+        par = np.zeros(LL.npar)
     # run-time parameters: the plant's constants, the controller (SI, padded), limit, scales
-    par = blk.par
     par[:] = 0.0
     P0 = par[LL.p_plant]
     pl = L.param
@@ -267,15 +280,22 @@ def run_sampled(
         Wall[:n_s, ii["noise"]] = measurement.noise
     xc0 = _padded(fb.xc0.reshape(1, -1), n, (1, n))[0]
     comp0 = compensation.state0 if compensation is not None else np.zeros(0)
-    u0 = _first_force(blk, Wall[0], par, xc0, comp0, x0, measurement, u_max)
+    u0 = _first_force(LL, comp_fun, Wall[0], par, xc0, comp0, x0, measurement, u_max)
     y0 = x0 if measurement.quantization == 0.0 else measurement.quantization * math.floor(x0 / measurement.quantization + 0.5)
     S, s0 = initial_state(system, LL, x0, v0, F0, xc0, u0, comp0, y0)
-    recs = np.empty((n_s, LL.nrec))
-    rev: list = []
+    rev: "list | tuple" = []
     blocks = finished = 0
     inside = 0.0
+    steps: Optional[int] = None
     start = time.perf_counter()
-    k = 0
+    k = n_s if drv is not None else 0
+    if drv is not None:  # every period in C, NATIVE_BLOCK per call
+        cfg = np.array([rtol * _CAL, eps, rtol, sc.t, 1.0 / sc.F, par[LL.param["force_scale"]], 0.0, 1.0, 0.0])
+        recs, rev, blocks, steps = run_blocks(drv, LL, S, Wall, n_s, par, np.ascontiguousarray(P0[L.q]), cfg,
+                                              NATIVE_BLOCK)
+        inside = time.perf_counter() - start
+    else:
+        recs = np.empty((n_s, LL.nrec))
     while k < n_s:
         blk.S0[:] = S
         blk.W[:] = Wall[k: k + block]
@@ -313,7 +333,7 @@ def run_sampled(
     t = tk * sc.t
     x, v = recs[:, ix["x"]] * sc.x, recs[:, ix["v"]] * sc.v
     xc = recs[:, ix["xc0"]: ix["xc0"] + n_user] if n_user else np.zeros((n_s, 0))
-    stats = RunStats(wall_time=wall, setup_time=setup, calls=blocks, steps=None, jit=mode)
+    stats = RunStats(wall_time=wall, setup_time=setup, calls=blocks, steps=steps, jit=mode)
     sim = SimulationResult(
         reversals=table, status=0, message=f"reached t_end = {t_end:.9g} s", stats=stats, work_input=W_r,
         t=t, x=x, v=v, F=recs[:, LL.rec["F"]] * sc.F, E_k=0.5 * system.mass * v * v, u=recs[:, LL.rec["u"]],
@@ -323,16 +343,15 @@ def run_sampled(
     return sim, LoopStats(n_s, blocks, integrated, finished, wall, setup, inside, mode), extra
 
 
-def _first_force(blk: "_Block", w: np.ndarray, par: np.ndarray, xc0: np.ndarray, comp0: np.ndarray, x0: float,
-                 m: Measurement, u_max: Optional[float]) -> float:
+def _first_force(LL: LoopLayout, comp_fun: ca.Function, w: np.ndarray, par: np.ndarray, xc0: np.ndarray,
+                 comp0: np.ndarray, x0: float, m: Measurement, u_max: Optional[float]) -> float:
     """The force [N] the loop applies at ``t = 0`` (controller and compensator, clipped), for the
     initial direction of motion: the compiled step's law, evaluated once in Python."""
-    LL = blk.LL
     y0 = x0 + (w[LL.inp["noise"]] if m.delay == 0 else 0.0)
     if m.quantization > 0.0:
         y0 = m.quantization * math.floor(y0 / m.quantization + 0.5)
     raw = float(par[LL.p_C] @ xc0) + par[LL.param["D"]] * (w[LL.inp["r"]] - y0)
     if LL.n_comp or LL.p_comp.stop > LL.p_comp.start:
         ref = [w[LL.inp["r"]], w[LL.inp["rn"]], w[LL.inp["vr"]], w[LL.inp["vrn"]]]
-        raw += float(blk.comp_fun(comp0, [y0, 0.0], ref, par[LL.p_comp])[1])
+        raw += float(comp_fun(comp0, [y0, 0.0], ref, par[LL.p_comp])[1])
     return raw if u_max is None else min(max(raw, -u_max), u_max)

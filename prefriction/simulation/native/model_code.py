@@ -78,9 +78,10 @@ def model_functions(model: FrictionModel) -> list[ca.Function]:
     return funs
 
 
-def model_source(model: FrictionModel) -> str:
-    """C source of :func:`model_functions` with the driver's size definitions (``PF_NZ``, ...)."""
-    funs = model_functions(model)
+def model_source(model: FrictionModel, extra: tuple[ca.Function, ...] = ()) -> str:
+    """C source of :func:`model_functions` and the ``extra`` Functions (e.g. the input force of
+    :mod:`~prefriction.simulation.native.forced`) with the driver's size definitions (``PF_NZ``, ...)."""
+    funs = model_functions(model) + list(extra)
     with tempfile.TemporaryDirectory(prefix="prefriction-") as tmp:
         cg = ca.CodeGenerator("pf_model.c", {"with_header": False})
         for f in funs:
