@@ -75,7 +75,7 @@ def main(outdir: str | Path = ".", *, quick: bool = False) -> dict:
     ax.legend(loc="upper left", fontsize=8)
     ax = axes[0, 1]
     ax.set_yscale("log")
-    ax.set_xlabel("cycle")
+    ax.set_xlabel("cycle number [-]")
     ax.set_ylabel(f"|drift| per cycle [nm] (below {FLOOR:g}: at {FLOOR:g})")
     ax.set_title("change of the cycle-mean position", fontsize=10)
     ax.grid(True, alpha=0.3)

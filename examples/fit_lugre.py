@@ -94,7 +94,9 @@ def _figure(res: identify.FitResult, t: np.ndarray, coverage: dict, seeds: int, 
     lines = [f"{n} = {v:.4g} ± {1.96 * s:.2g}{'' if u == '-' else ' ' + u}" for n, u, v, s in zip(res.names, res.units, res.estimates, res.stderr)]
     ax.set_title("force along the prescribed motion (95 %):\n" + ", ".join(lines[:3]) + "\n"
                  + ", ".join(lines[3:]), fontsize=8)
-    ax.legend(loc="lower right", fontsize=8)
+    lo, hi = ax.get_ylim()
+    ax.set_ylim(lo, hi + 0.12 * (hi - lo))  # a free strip above the loops for the legend
+    ax.legend(loc="upper center", ncol=2, fontsize=8)
     ax.grid(alpha=0.3)
 
     ax = axes["S"]

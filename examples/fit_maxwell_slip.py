@@ -80,7 +80,9 @@ def _figure(res: identify.FitResult, truth: np.ndarray, coverage: dict, seeds: i
     ax.set_ylabel("friction force F [N]")
     ax.set_title(f"growing loops, 4 elements, noise sd {NOISE * 1e3:.0f} mN; residual sd "
                  f"{res.statistics.sigma_hat * 1e3:.2f} mN", fontsize=9)
-    ax.legend(loc="lower right", fontsize=8)
+    lo, hi = ax.get_ylim()
+    ax.set_ylim(lo, hi + 0.12 * (hi - lo))  # a free strip above the loops for the legend
+    ax.legend(loc="upper center", ncol=2, fontsize=8)
     ax.grid(alpha=0.3)
 
     ax = axes["E"]

@@ -41,9 +41,9 @@ def main(outdir: str | Path = ".") -> dict:
         ax[0].plot(i, p * ex["dF"][:, j] / ex["F"], "o", color=f"C{j}", mfc="none", label=f"{name} (exact map)")
         ax[1].semilogy(i, np.abs(res.dF[:, j] / ex["dF"][:, j] - 1) + 1e-17, "-o", ms=3, color=f"C{j}", label=f"dF/d{name}")
         ax[1].semilogy(i, np.abs(res.dx[:, j] / ex["dx"][:, j] - 1) + 1e-17, "--s", ms=3, color=f"C{j}", label=f"dx/d{name}")
-    ax[0].set(xlabel="reversal i", ylabel="(p / F_i) dF_i/dp [-]", title="(a) logarithmic sensitivities of the forces")
+    ax[0].set(xlabel="reversal number i [-]", ylabel="(p / F_i) dF_i/dp [-]", title="(a) logarithmic sensitivities of the forces")
     ax[0].legend(ncol=2, fontsize=8, loc="center right", title="sigma and mass coincide: both enter through c = m sigma v0^2 / (2 Fc^2)", title_fontsize=7)
-    ax[1].set(xlabel="reversal i", ylabel="relative difference [-]", title="(b) CasADi against the exact map", ylim=(1e-13, 1e-6))
+    ax[1].set(xlabel="reversal number i [-]", ylabel="relative difference [-]", title="(b) CasADi against the exact map", ylim=(1e-13, 1e-6))
     ax[1].legend(ncol=2, fontsize=7, loc="upper left")
     fig.tight_layout()
     png = outdir / "sensitivities.png"

@@ -14,6 +14,8 @@ every file an export writes (:mod:`prefriction.export`) goes through these primi
   beside the destination and renames it over it, so a reader never sees half a file and a
   link planted at the destination is replaced, never followed;
 - :func:`open_lock` opens a lock file without following a link, and only if it is this user's;
+- :func:`output_dir` checks and creates the directory a writer was given (an export's
+  ``directory``, a figure's ``outdir``), with errors naming that argument;
 - :func:`printable` turns text read from a file (a note of an earlier process) into data fit to
   print: one line of printable ASCII, escapes and control characters shown as ``?``.
 
@@ -28,8 +30,8 @@ import stat
 import tempfile
 from pathlib import Path
 
-__all__ = ["UnsafeFile", "dir_problem", "make_private_dir", "open_lock", "printable", "read_nofollow",
-           "read_owned", "write_atomic"]
+__all__ = ["UnsafeFile", "dir_problem", "make_private_dir", "open_lock", "output_dir", "printable",
+           "read_nofollow", "read_owned", "write_atomic"]
 
 _NOFOLLOW = getattr(os, "O_NOFOLLOW", 0)
 _CLOEXEC = getattr(os, "O_CLOEXEC", 0)
@@ -136,13 +138,21 @@ def read_owned(path: Path, limit: int) -> bytes:
     return _read(path, limit, owned=True)
 
 
-def _read(path: Path, limit: int, owned: bool) -> bytes:
+def _open_nofollow(path: Path, flags: int) -> int:
+    """``os.open(path, flags)`` (new files 0600) without following a link, non-blocking, not inherited.
+
+    Raises :class:`UnsafeFile` if ``path`` is a symbolic link; the ``OSError`` of the open otherwise.
+    """
     try:
-        fd = os.open(path, os.O_RDONLY | _NOFOLLOW | _CLOEXEC | _NONBLOCK)
+        return os.open(path, flags | _NOFOLLOW | _CLOEXEC | _NONBLOCK, 0o600)
     except OSError as exc:
         if os.path.islink(path):
             raise UnsafeFile(f"{path} is a symbolic link (not followed)") from exc
         raise
+
+
+def _read(path: Path, limit: int, owned: bool) -> bytes:
+    fd = _open_nofollow(path, os.O_RDONLY)
     with os.fdopen(fd, "rb") as fh:
         st = os.fstat(fd)
         if not stat.S_ISREG(st.st_mode):
@@ -185,12 +195,7 @@ def open_lock(path: Path) -> int:
     Raises :class:`UnsafeFile` if it is a link, not a regular file or not this user's own;
     ``OSError`` if it cannot be opened.
     """
-    try:
-        fd = os.open(path, os.O_RDWR | os.O_CREAT | _NOFOLLOW | _CLOEXEC | _NONBLOCK, 0o600)
-    except OSError as exc:
-        if os.path.islink(path):
-            raise UnsafeFile(f"{path} is a symbolic link (not followed)") from exc
-        raise
+    fd = _open_nofollow(path, os.O_RDWR | os.O_CREAT)
     st = os.fstat(fd)
     problem = "" if stat.S_ISREG(st.st_mode) else f"{path} is not a regular file"
     problem = problem or _owner_problem(path, st)
@@ -198,6 +203,38 @@ def open_lock(path: Path) -> int:
         os.close(fd)
         raise UnsafeFile(problem)
     return fd
+
+
+def output_dir(directory: object, argument: str = "directory") -> Path:
+    """``directory`` as a :class:`~pathlib.Path`, created with its missing parents if needed.
+
+    Parameters
+    ----------
+    directory : str or os.PathLike
+        The directory a writer was given (``"."`` for the working directory).
+    argument : str, default "directory"
+        The name of the caller's argument, used in the error messages.
+
+    Raises
+    ------
+    TypeError
+        If ``directory`` is not a str or path.
+    ValueError
+        If it is empty, names an existing file, or cannot be created (the reason from the
+        operating system); each message names ``argument`` and the value.
+    """
+    if not isinstance(directory, (str, os.PathLike)):
+        raise TypeError(f"{argument} must be a str or pathlib.Path, got {type(directory).__name__} {directory!r}")
+    if str(directory) == "":
+        raise ValueError(f"{argument} must name a directory, got '' (use '.' for the working directory)")
+    path = Path(directory)
+    if path.exists() and not path.is_dir():
+        raise ValueError(f"{argument} must be a directory, got the file {str(path)!r}")
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ValueError(f"{argument} {str(path)!r} cannot be created ({exc.strerror or exc})") from exc
+    return path
 
 
 def printable(text: str, limit: int = 300) -> str:

@@ -102,12 +102,9 @@ def add_note(fig: Figure, text: str, *, lines: int = 1) -> None:
 
 def save(fig: Figure, outdir: PathLike, name: str, *, dpi: int = 130) -> Path:
     """Save ``fig`` as ``outdir/name`` (PNG), creating ``outdir`` if needed; return the path."""
-    out = Path(outdir)
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise ValueError(f"outdir {str(out)!r} cannot be created ({exc.strerror or exc})") from exc
-    return write_figure(fig, out / name, dpi=dpi, argument="outdir")
+    from prefriction._safe_files import output_dir
+
+    return write_figure(fig, output_dir(outdir, "outdir") / name, dpi=dpi, argument="outdir")
 
 
 def write_figure(fig: Figure, path: object, *, dpi: int = 120, argument: str = "path") -> Path:

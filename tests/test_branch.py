@@ -105,6 +105,26 @@ def test_force_after_distance_closed_forms(g: float) -> None:
                 assert rel(s, mp.mpf(x) - w1 ** (1 - gm) / (1 - gm)) <= 1e-14
 
 
+@pytest.mark.parametrize("g", [0.0, 0.5, 1.0, 2.0])
+def test_branch_started_in_saturation_stays_there(g: float) -> None:
+    """From f1 = 1 the force stays 1 for any distance, also none: (3.2) has dF/dx = 0 there.
+
+    ``gamma < 1`` reaches f = 1 at a finite distance and slides at Fc beyond it (the whole
+    distance is slide); ``gamma >= 1`` never leaves f = 1 either, without a slide. A distance 0
+    gave NaN (0 * inf) with a RuntimeWarning.
+    """
+    import warnings
+
+    f1 = np.ones(3)
+    xi = np.array([0.0, 1e-300, 0.3])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        f2 = br.force_after_distance(f1, xi, g)
+        L2, slide = br.log_gap_after_distance(f1, xi, g)
+    assert np.all(f2 == 1.0) and np.all(L2 == np.inf)
+    assert np.array_equal(slide, xi if g < 1.0 else np.zeros(3))
+
+
 @pytest.mark.parametrize("g", [0.0, 0.3, 0.5, 1.0, 1 + 1e-9, 2.0, 5.0])
 def test_loading_end_inverts_potential(g: float) -> None:
     E = np.array([1e-40, 1e-20, 1e-8, 0.01, 0.3, 1.0, 10.0, 1e3, 1e6])

@@ -18,4 +18,4 @@ def test_block_prints_what_the_page_shows(i, tmp_path, monkeypatch):
 
 
 def test_page_has_the_blocks():
-    assert len(PYTHON) == 3
+    assert len(PYTHON) == 4

@@ -196,6 +196,22 @@ def test_plot_path_errors_are_clear(along, tmp_path) -> None:
         along.plot(tmp_path)
 
 
+def test_figure_outdir_errors_name_outdir(tmp_path) -> None:
+    """plotting.save checks its ``outdir`` like an export's ``directory`` (one shared check)."""
+    from prefriction.plotting import new_figure, save
+
+    fig, _ = new_figure(1, 1)
+    (tmp_path / "file").write_text("")
+    with pytest.raises(ValueError, match="outdir must be a directory, got the file"):
+        save(fig, tmp_path / "file", "a.png")
+    with pytest.raises(ValueError, match="outdir must name a directory, got ''"):
+        save(fig, "", "a.png")
+    with pytest.raises(TypeError, match="outdir must be a str or pathlib.Path, got int 3"):
+        save(fig, 3, "a.png")
+    out = save(fig, tmp_path / "new" / "deeper", "a.png")
+    assert out == tmp_path / "new" / "deeper" / "a.png" and out.read_bytes()[:4] == b"\x89PNG"
+
+
 def test_plot_does_not_write_through_a_link(along, tmp_path) -> None:
     victim = tmp_path / "victim.txt"
     victim.write_text("precious")

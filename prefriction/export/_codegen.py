@@ -22,7 +22,7 @@ import casadi as ca
 from prefriction import _safe_files as safe
 from prefriction._validation import check_positive
 
-__all__ = ["MIN_TS", "c_text", "check_name", "check_sample_time", "comment_text", "directory_of", "work_sizes",
+__all__ = ["MIN_TS", "c_text", "check_name", "check_sample_time", "comment_text", "work_sizes",
            "write_export"]
 
 MIN_TS = 1e-12
@@ -126,23 +126,6 @@ def write_export(path: Path, name: str, header: str, body: str) -> tuple[Path, P
 def digest(header: bytes, body: bytes) -> str:
     """The SHA-256 (hex) that identifies an export's header and source texts."""
     return hashlib.sha256(hashlib.sha256(header).digest() + hashlib.sha256(body).digest()).hexdigest()
-
-
-def directory_of(directory: Any) -> Path:
-    """``directory`` as a Path, created if missing (TypeError/ValueError naming it if it is no
-    path, empty, a file, or cannot be created)."""
-    if not isinstance(directory, (str, os.PathLike)):
-        raise TypeError(f"directory must be a str or pathlib.Path, got {type(directory).__name__} {directory!r}")
-    if str(directory) == "":
-        raise ValueError("directory must name a directory, got '' (use '.' for the working directory)")
-    path = Path(directory)
-    if path.exists() and not path.is_dir():
-        raise ValueError(f"directory must be a directory, got the file {str(path)!r}")
-    try:
-        path.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise ValueError(f"directory {str(path)!r} cannot be created ({exc.strerror or exc})") from exc
-    return path
 
 
 def c_text(functions: dict[str, ca.Function], prefix: str) -> str:

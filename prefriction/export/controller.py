@@ -22,9 +22,10 @@ from typing import Any, Optional
 import casadi as ca
 import numpy as np
 
+from prefriction._safe_files import output_dir
 from prefriction._validation import check_finite, check_positive, check_real
 
-from ._codegen import c_text, check_name, check_sample_time, comment_text, directory_of, work_sizes, write_export
+from ._codegen import c_text, check_name, check_sample_time, comment_text, work_sizes, write_export
 from .source import CSource
 
 __all__ = ["controller_function", "controller_initial_state", "controller_source"]
@@ -276,7 +277,7 @@ def controller_source(controller: Any, name: str, directory: Any, *, Ts: float, 
     name = check_name(name)
     law = _law(controller, Ts, compensator, mass, x0, discretization)
     fun = law.function()
-    path = directory_of(directory)
+    path = output_dir(directory)
     n = law.n_state
     sz = work_sizes(fun)
     comp = "no compensator" if compensator is None else type(compensator).__name__

@@ -26,11 +26,12 @@ from typing import Any, Optional
 
 import casadi as ca
 
+from prefriction._safe_files import output_dir
 from prefriction._validation import check_count, check_positive
 from prefriction.along.step import has_exact_step, interval_function
 from prefriction.models.base import FrictionModel
 
-from ._codegen import c_text, check_name, check_sample_time, comment_text, directory_of, work_sizes, write_export
+from ._codegen import c_text, check_name, check_sample_time, comment_text, work_sizes, write_export
 from .source import CSource
 
 __all__ = ["c_source", "sample_function"]
@@ -221,7 +222,7 @@ def c_source(model: FrictionModel, name: str, directory: Any, *, Ts: Optional[fl
     """
     name = check_name(name)
     fun = sample_function(model, Ts=Ts, n_sub=n_sub)
-    path = directory_of(directory)
+    path = output_dir(directory)
     n = fun.size1_in(0)
     nz1 = model.n_states + model.n_flags - 1
     sz_arg, sz_res, sz_iw, sz_w = work_sizes(fun)

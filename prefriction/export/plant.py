@@ -18,6 +18,7 @@ from typing import Any, Optional
 import casadi as ca
 import numpy as np
 
+from prefriction._safe_files import output_dir
 from prefriction._validation import check_positive
 from prefriction.models import Oscillator
 from prefriction.signals import Constant
@@ -27,7 +28,7 @@ from prefriction.simulation.loops.records import plant_state
 from prefriction.simulation.simulate import _CAL
 from prefriction.units import Scales
 
-from ._codegen import c_text, check_name, check_sample_time, comment_text, directory_of, work_sizes, write_export
+from ._codegen import c_text, check_name, check_sample_time, comment_text, work_sizes, write_export
 from .source import CSource
 
 __all__ = ["plant_function", "plant_initial_state", "plant_source"]
@@ -307,7 +308,7 @@ def plant_source(system: Oscillator, name: str, directory: Any, *, Ts: float, F0
                          f"at rest), got {F0!r}")
     fun = per.function()
     initial = _initial_function(per, F0)
-    path = directory_of(directory)
+    path = output_dir(directory)
     n = per.LL.nS
     sizes = work_sizes(fun)
     isz = work_sizes(initial)

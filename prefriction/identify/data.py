@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from prefriction._validation import check_positive
+from prefriction._validation import check_nonnegative, check_positive
 
 __all__ = ["ForceDisplacement", "ForceVelocity", "HOLDS", "Motion", "MIN_SAMPLES", "MAX_SAMPLES"]
 
@@ -87,6 +87,21 @@ class ForceDisplacement:
         Displacement [m] at the sample times (the prescribed motion).
     F : array_like
         Measured friction force [N] at the sample times.
+    x_noise : float, default 0.0
+        Standard deviation [m] of the noise on the measured ``x`` (``>= 0``).
+    quantum : float, default 0.0
+        Encoder step [m] of ``x`` (``>= 0``; 0: not quantised).
+
+    Attributes
+    ----------
+    path : numpy.ndarray
+        The displacement [m] the model is driven along: ``x`` itself when ``x_noise`` and
+        ``quantum`` are 0, else the estimated true path
+        (:func:`prefriction.identify.positions.denoise_path`: a local cubic fit with the window
+        of least estimated risk, monotone between the reversals it shows), so that the noise does
+        not add a spurious reversal at every sample (``docs/identify.md#positions``).
+    path_window : int
+        The smoothing window of :attr:`path` [samples] (1: ``path`` is ``x``).
 
     Raises
     ------
@@ -94,13 +109,16 @@ class ForceDisplacement:
         If an argument is not an array of real numbers.
     ValueError
         If an array is not 1-D, holds NaN or inf, the lengths differ, there are too few or too
-        many samples, the times are not strictly increasing (unsorted or repeated), or ``x`` or
-        ``F`` is constant. The message names the argument.
+        many samples, the times are not strictly increasing (unsorted or repeated), ``x`` or
+        ``F`` is constant, or ``x_noise`` or ``quantum`` is negative or not finite. The message
+        names the argument.
     """
 
     t: Any
     x: Any
     F: Any
+    x_noise: Any = 0.0
+    quantum: Any = 0.0
 
     def __post_init__(self) -> None:
         t = _times(self.t)
@@ -110,15 +128,31 @@ class ForceDisplacement:
         _same_length(t, "F", F)
         _moving("x", x, "m")
         _moving("F", F, "N")
-        for name, arr in (("t", t), ("x", x), ("F", F)):
-            object.__setattr__(self, name, arr)
+        x_noise = check_nonnegative("x_noise", self.x_noise)
+        quantum = check_nonnegative("quantum", self.quantum)
+        path, window = x, 1
+        if x_noise > 0.0 or quantum > 0.0:
+            from prefriction.identify.positions import denoise_path  # scipy.signal only when needed
+
+            path, window = denoise_path(x, x_noise, quantum)
+        path.flags.writeable = False
+        for name, val in (("t", t), ("x", x), ("F", F), ("x_noise", x_noise), ("quantum", quantum), ("path", path),
+                          ("path_window", window)):
+            object.__setattr__(self, name, val)
+
+    @property
+    def noisy_positions(self) -> bool:
+        """True if ``x_noise`` or ``quantum`` was declared (the fit follows :attr:`path`)."""
+        return bool(self.x_noise or self.quantum)
 
     def __len__(self) -> int:
         return int(self.t.size)
 
     def __repr__(self) -> str:
+        noise = f", x_noise {self.x_noise:.3g} m, quantum {self.quantum:.3g} m" if self.noisy_positions else ""
         return (f"ForceDisplacement({len(self)} samples, t in [{self.t[0]:.4g}, {self.t[-1]:.4g}] s, "
-                f"x in [{self.x.min():.4g}, {self.x.max():.4g}] m, F in [{self.F.min():.4g}, {self.F.max():.4g}] N)")
+                f"x in [{self.x.min():.4g}, {self.x.max():.4g}] m, F in [{self.F.min():.4g}, {self.F.max():.4g}] N"
+                f"{noise})")
 
 
 @dataclass(frozen=True, eq=False)
@@ -142,6 +176,13 @@ class Motion:
         How ``u`` acts between samples ``t[k]`` and ``t[k+1]``: ``"zoh"`` holds ``u[k]`` (what a
         digital loop applies: its output changes at the samples and is held in between);
         ``"linear"`` interpolates linearly between ``u[k]`` and ``u[k+1]``.
+    x_noise : float, default 0.0
+        Standard deviation [m] of the noise on the measured ``x`` (``>= 0``), if known.
+    quantum : float, default 0.0
+        Encoder step [m] of ``x`` (``>= 0``), if known. A Motion fit is an output-error fit (the
+        residual is the measured position minus the model's), consistent under position noise
+        and rounding without them; declared, they let the residual diagnostics compare the
+        residual level with the measurement's (``docs/identify.md#diagnostics``).
 
     Raises
     ------
@@ -149,7 +190,7 @@ class Motion:
         If an argument is not a real number or an array of them.
     ValueError
         As :class:`ForceDisplacement` for ``t``, ``x`` and sampled ``u``; also if ``mass`` is
-        not finite and positive.
+        not finite and positive, or ``x_noise`` or ``quantum`` negative or not finite.
     """
 
     t: Any
@@ -157,6 +198,8 @@ class Motion:
     u: Any = 0.0
     mass: Any = None
     hold: str = "zoh"
+    x_noise: Any = 0.0
+    quantum: Any = 0.0
 
     def __post_init__(self) -> None:
         if self.hold not in HOLDS:
@@ -179,7 +222,9 @@ class Motion:
             u = _samples("u", self.u, "N")
             _same_length(t, "u", u)
         mass = None if self.mass is None else check_positive("mass", self.mass)
-        for name, val in (("t", t), ("x", x), ("u", u), ("mass", mass)):
+        x_noise = check_nonnegative("x_noise", self.x_noise)
+        quantum = check_nonnegative("quantum", self.quantum)
+        for name, val in (("t", t), ("x", x), ("u", u), ("mass", mass), ("x_noise", x_noise), ("quantum", quantum)):
             object.__setattr__(self, name, val)
 
     def __len__(self) -> int:

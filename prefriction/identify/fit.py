@@ -12,8 +12,8 @@ from prefriction.identify.data import ForceDisplacement, ForceVelocity, Motion
 from prefriction.identify.parameters import ParameterSpace, name_list
 from prefriction.identify.result import FitResult
 from prefriction.identify.validation import model_name
-from prefriction.identify.statistics import (BoundWarning, ConvergenceWarning, IdentifiabilityWarning, at_bounds,
-                                             gauss_newton)
+from prefriction.identify.statistics import (BoundWarning, ConvergenceWarning, IdentifiabilityWarning,
+                                             NoisyPositionsWarning, ResidualWarning, at_bounds, gauss_newton)
 from prefriction.models.base import FrictionModel
 
 __all__ = ["fit"]
@@ -118,6 +118,13 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
         structure boundary such as Dahl's ``gamma = 1``); its interval starts at the bound.
     ConvergenceWarning
         If the solver stops at ``max_iter`` without converging.
+    NoisyPositionsWarning
+        For :class:`ForceDisplacement` data whose positions turn far more often than the motion
+        reverses, with neither ``x_noise`` nor ``quantum`` declared.
+    ResidualWarning
+        If the residuals show structure the model does not explain (runs with a lag-1
+        autocorrelation above 0.3, or spikes after the reversals); it names the estimates to
+        distrust (``FitResult.diagnostics``).
     IdentifiabilityWarning
         Naming every parameter the data cannot identify: a relative standard error above
         ``identifiability_limit`` (e.g. ``Fc`` from loops that never leave pre-sliding), or a
@@ -126,10 +133,12 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
 
     Notes
     -----
-    Standard errors are Gauss-Newton: ``s^2 (J^T J)^-1`` at the optimum with the residual
-    variance ``s^2 = |r|^2 / (n - p)``, nuisance variables (initial state, shooting nodes,
-    reversal times) marginalised; intervals are cut at the allowed range; see
-    ``docs/identify.md``.
+    Standard errors are the HAC (Newey-West) sandwich around the Gauss-Newton covariance
+    ``s^2 (J^T J)^-1`` (correlated residuals), never below it, nuisance variables (initial
+    state, shooting nodes, reversal times) marginalised; for :class:`ForceDisplacement` data with
+    declared ``x_noise`` or ``quantum`` the model follows the estimated true path and that path's
+    error is added (errors in variables); intervals are cut at the allowed range; see
+    ``docs/identify.md#statistics`` and ``#positions``.
 
     Examples
     --------
@@ -186,7 +195,11 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
     if mass0 is not None:
         raise ValueError(f"mass0 = {mass0!r} is for Motion data with a free mass; force-displacement data "
                          f"involve no mass (allowed: mass0=None)")
+    from prefriction.identify.positions import noisy_positions_message
     from prefriction.identify.structures import fit_structures, gamma_entry
+
+    if not data.noisy_positions and (why := noisy_positions_message(data.x)) is not None:
+        warnings.warn(why, NoisyPositionsWarning, stacklevel=2)
 
     scale = float(np.std(data.F)) if offset else None
 
@@ -210,7 +223,8 @@ def _fit_prescribed(model: FrictionModel, data: ForceDisplacement, free: Any, fi
     sol = fit_prescribed(model, data, space, n_sub=substeps, max_iter=max_iter, tol=tol)
     values = space.values(sol.w[:-1])
     est = np.array([values[n] for n in space.free])
-    stats = gauss_newton(sol.jacobian, sol.residuals, space.free, est, space.scale, limit=limit)
+    stats = gauss_newton(sol.jacobian, sol.residuals, space.free, est, space.scale, limit=limit, covariance="hac",
+                         extra=sol.extra_covariance)
     nuisance = {"initial force F0 [N]": float(sol.prediction[0])}
     return _finish(space, values, est, stats, -sol.residuals, sol.prediction, data, None, nuisance, sol.message,
                    sol.success, level=6)
@@ -239,7 +253,7 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
     values = space.values(sol.w[: space.n_free])
     est = np.array([values[n] for n in space.free])
     stats = gauss_newton(sol.jacobian, sol.residuals, space.free, est, space.scale,
-                         constraints=sol.constraints, limit=limit)
+                         constraints=sol.constraints, limit=limit, covariance="hac")
     mass = values["mass"] if data.mass is None else data.mass
     return _finish(space, values, est, stats, -sol.residuals, sol.prediction, data, mass, sol.nuisance, sol.message,
                    getattr(sol, "success", True))
@@ -264,6 +278,23 @@ def _finish(space: ParameterSpace, values: dict, est: np.ndarray, stats: Any, re
         warnings.warn(f"the fit of {model_name(fitted_model)} did not converge: {message}; the estimates are where "
                       f"the solver stopped (raise max_iter, or give better start values)", ConvergenceWarning,
                       stacklevel=level)
-    return FitResult(fitted_model, mass, tuple(space.free), tuple(space.units[n] for n in space.free), est,
-                     stats.stderr, low, high, stats.correlation, residuals, fitted, data, stats,
-                     nuisance, message, success=success, flags=flags)
+    res = FitResult(fitted_model, mass, tuple(space.free), tuple(space.units[n] for n in space.free), est,
+                    stats.stderr, low, high, stats.correlation, residuals, fitted, data, stats,
+                    nuisance, message, success=success, flags=flags)
+    _warn_structure(res, level)
+    return res
+
+
+def _warn_structure(res: FitResult, level: int) -> None:
+    """A :class:`ResidualWarning` if the residuals show structure (``docs/identify.md#diagnostics``)."""
+    diag = res.diagnostics
+    if not diag.structured:
+        return
+    who = "; ".join(f"{n} ({why})" for n, why in diag.distrust) if diag.distrust else \
+        "no single estimate stands out, every one may be biased"
+    noise = ", declare the position noise (x_noise, quantum)" if isinstance(res.data, ForceDisplacement) and \
+        not res.data.noisy_positions else ""
+    warnings.warn(f"the residuals of the {model_name(res.model)} fit show structure the model does not explain: "
+                  f"{'; '.join(diag.findings)}. Distrust: {who}. Try another model or structure, free the "
+                  f"parameters held{noise}, and look at res.plot_residuals() (docs/identify.md#diagnostics)",
+                  ResidualWarning, stacklevel=level + 1)

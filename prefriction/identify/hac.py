@@ -87,5 +87,7 @@ def sandwich(J: np.ndarray, r: np.ndarray, stats: Statistics, estimates: np.ndar
         kept += [(n, f"relative standard error {100.0 * rse[i]:.3g} % > {100.0 * limit:.3g} %")
                  for i, n in enumerate(names) if n not in flagged and not rse[i] <= limit]
         unident = tuple(sorted(kept, key=lambda item: names.index(item[0])))
+    fields = {f.name for f in dataclasses.fields(stats)}
+    marks = {k: v for k, v in (("covariance", "hac"), ("bandwidth", L), ("stderr_iid", stats.stderr)) if k in fields}
     return dataclasses.replace(stats, stderr=se, low=estimates - tq * se, high=estimates + tq * se,
-                               correlation=corr, unidentifiable=unident), L
+                               correlation=corr, unidentifiable=unident, **marks), L

@@ -19,10 +19,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Callable
 
 import casadi as ca
 import numpy as np
+from scipy import sparse
 from scipy.optimize import brentq, least_squares
 
 from prefriction.identify.data import ForceDisplacement
@@ -30,7 +31,7 @@ from prefriction.identify.parameters import ParameterSpace, symbolic_units
 from prefriction.identify.stepping import has_exact_step, interval_function
 from prefriction.models.base import FrictionModel
 
-__all__ = ["PrescribedProblem", "fit_prescribed", "substeps_for"]
+__all__ = ["PrescribedProblem", "fit_prescribed", "path_covariance", "substeps_for"]
 
 _VIRGIN_CALLS = 4
 """Interval calls that make up the virtual virgin loading to the initial state."""
@@ -49,7 +50,7 @@ class _Series:
 
     @classmethod
     def of(cls, data: ForceDisplacement) -> "_Series":
-        t, x = data.t, data.x
+        t, x = data.t, data.path  # the estimated true path under declared position noise
         dt, dx = np.diff(t), np.diff(x)
         s = np.sign(dx)
         first = np.flatnonzero(s)
@@ -72,7 +73,7 @@ def substeps_for(model: FrictionModel, data: ForceDisplacement, requested: int |
         return requested
     if has_exact_step(model):
         return 1
-    step = float(np.max(np.abs(np.diff(data.x)))) * model.sigma / model.Fc
+    step = float(np.max(np.abs(np.diff(data.path)))) * model.sigma / model.Fc
     return int(min(64, max(2, math.ceil(4.0 * step / 0.25))))
 
 
@@ -119,6 +120,18 @@ class PrescribedProblem:
         self.jacobian = ca.Function("jacobian", args, [ca.jacobian(r, w)])
         self.force = ca.Function("force", args, [F_model])
         self.n = n
+        self._symbols = (args, r, rows, v_end0)
+        self._path_vjp: ca.Function | None = None
+
+    def path_vjp(self) -> ca.Function:
+        """``(args..., seed) -> (d(seed . r)/d rows, d(seed . r)/d v_end0)``: how the residuals move
+        with the velocities the path gives (reverse mode; built on first use)."""
+        if self._path_vjp is None:
+            args, r, rows, v_end0 = self._symbols
+            seed = ca.MX.sym("seed", self.n)
+            dot = ca.dot(seed, r)
+            self._path_vjp = ca.Function("path_vjp", [*args, seed], [ca.gradient(dot, rows), ca.gradient(dot, v_end0)])
+        return self._path_vjp
 
     @classmethod
     def get(cls, model: FrictionModel, space: ParameterSpace, n: int, n_sub: int) -> "PrescribedProblem":
@@ -165,6 +178,7 @@ class PrescribedSolution:
     nfev: int
     message: str
     success: bool
+    extra_covariance: Callable[[np.ndarray], np.ndarray] | None = None  # errors in the positions
 
 
 def fit_prescribed(model: FrictionModel, data: ForceDisplacement, space: ParameterSpace, *,
@@ -211,4 +225,78 @@ def fit_prescribed(model: FrictionModel, data: ForceDisplacement, space: Paramet
     pred = np.asarray(problem.force(sol.x, *args)).ravel()
     message = str(sol.message) if sol.status > 0 else (
         f"stopped without converging after {sol.nfev} evaluations (max_iter = {max_iter}): {sol.message}")
-    return PrescribedSolution(sol.x, sol.fun.copy(), jac(sol.x), pred, int(sol.nfev), message, sol.status > 0)
+    extra = path_covariance(problem, sol.x, args, data) if data.noisy_positions else None
+    return PrescribedSolution(sol.x, sol.fun.copy(), jac(sol.x), pred, int(sol.nfev), message, sol.status > 0, extra)
+
+
+def _gradient_operator(t: np.ndarray) -> sparse.csr_matrix:
+    """The sparse matrix of ``numpy.gradient(x, t)`` (second order inside, first order at the ends)."""
+    n = t.size
+    h = np.diff(t)
+    h1, h2 = h[:-1], h[1:]
+    i = np.arange(1, n - 1)
+    rows = np.r_[0, 0, np.repeat(i, 3), n - 1, n - 1]
+    cols = np.r_[0, 1, np.c_[i - 1, i, i + 1].ravel(), n - 2, n - 1]
+    vals = np.r_[-1.0 / h[0], 1.0 / h[0],
+                 np.c_[-h2 / (h1 * (h1 + h2)), (h2 - h1) / (h1 * h2), h1 / (h2 * (h1 + h2))].ravel(),
+                 -1.0 / h[-1], 1.0 / h[-1]]
+    return sparse.csr_matrix((vals, (rows, cols)), shape=(n, n))
+
+
+def path_covariance(problem: PrescribedProblem, w: np.ndarray, args: list[Any],
+                    data: ForceDisplacement) -> Callable[[np.ndarray], np.ndarray]:
+    """The covariance the estimated path's error adds to the estimates (errors in variables).
+
+    With the parameters' influence weights ``W = dtheta/dr`` (shape ``(k, n)``) and the residuals'
+    sensitivity ``D = dr/dx`` to the path samples (through the interval velocities and the sample
+    velocities, reverse mode), the estimates move by ``G e`` with ``G = -W D`` for a path error
+    ``e = S_w eps`` (``S_w`` the smoother, ``eps`` white with the declared variance ``s^2``):
+    ``Cov = s^2 (G S_w)(G S_w)^T`` (``docs/identify.md#positions``, eq. P2), plus for each reversal
+    the rounding error common to the samples that dwell within one encoder step of it,
+    ``s_q^2 (G 1_dwell)(G 1_dwell)^T`` (eq. P3, :func:`prefriction.identify.positions.dwell_error_sd`).
+
+    Parameters
+    ----------
+    problem : PrescribedProblem
+        The problem fitted.
+    w : numpy.ndarray
+        The optimum.
+    args : list
+        The problem's inputs (:func:`_inputs`).
+    data : ForceDisplacement
+        The data, with ``x_noise`` or ``quantum`` declared.
+
+    Returns
+    -------
+    callable
+        ``W -> Cov`` [physical units].
+    """
+    from prefriction.identify.positions import dwell_error_sd, dwell_sets, noise_sd, smoothed_covariance_factor
+
+    vjp = problem.path_vjp()
+    t = data.t
+    dt = np.diff(t)
+    grad_t = _gradient_operator(t).T.tocsr()
+    s = noise_sd(data.x_noise, data.quantum)
+    s_dwell = dwell_error_sd(data.x_noise, data.quantum)
+    dwells = dwell_sets(data.path, data.quantum) if s_dwell > 0.0 else []
+
+    def extra(W: np.ndarray) -> np.ndarray:
+        G = np.empty_like(W)
+        for a in range(W.shape[0]):
+            g_rows, g_v0 = vjp(w, *args, W[a])
+            g_rows = np.asarray(g_rows)
+            gv = g_rows[0] / dt                       # v_k = (x_{k+1} - x_k) / dt_k
+            dx = np.zeros(t.size)
+            dx[:-1] -= gv
+            dx[1:] += gv
+            g_end = np.r_[float(g_v0), g_rows[4]]     # v_end = gradient(x, t)
+            G[a] = -(dx + grad_t @ g_end)
+        GS = smoothed_covariance_factor(G, data.path_window)
+        cov = s * s * (GS @ GS.T)
+        for idx in dwells:                            # eq. P3: one common error per reversal
+            g = G[:, idx].sum(axis=1)
+            cov += s_dwell**2 * np.outer(g, g)
+        return cov
+
+    return extra

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -14,6 +15,7 @@ from prefriction.identify.validation import model_name
 from prefriction.models.base import FrictionModel
 
 if TYPE_CHECKING:
+    from prefriction.identify.diagnostics import ResidualDiagnostics
     from prefriction.identify.validation import Validation
 
 __all__ = ["FitResult"]
@@ -21,7 +23,7 @@ __all__ = ["FitResult"]
 
 @dataclass(frozen=True, eq=False)
 class FitResult:
-    """Fitted friction model with Gauss-Newton uncertainty (:func:`prefriction.identify.fit`).
+    """Fitted friction model with its uncertainty and residual diagnostics (:func:`prefriction.identify.fit`).
 
     Attributes
     ----------
@@ -34,7 +36,8 @@ class FitResult:
     units : tuple of str
         Their units.
     estimates, stderr, low, high : numpy.ndarray
-        Estimates, standard errors and 95 % confidence intervals (t quantile), physical units;
+        Estimates, standard errors and 95 % confidence intervals (t quantile), physical units,
+        from the HAC covariance (correlated residuals, ``docs/identify.md#statistics``);
         an interval is cut where it would leave the allowed range (see :attr:`flags`).
     correlation : numpy.ndarray
         Correlation matrix of the estimates.
@@ -45,7 +48,9 @@ class FitResult:
     data : ForceDisplacement or Motion
         The data.
     statistics : Statistics
-        Residual standard deviation, degrees of freedom, condition number, unidentifiable parameters.
+        Residual standard deviation, degrees of freedom, condition number, unidentifiable
+        parameters, the covariance kind (``"hac"``), its bandwidth and the white-residual
+        standard errors.
     nuisance : dict
         Other fitted quantities (initial state, reversal times), by name.
     message : str
@@ -77,6 +82,26 @@ class FitResult:
     success: bool = True
     flags: tuple[str, ...] = ()
     notes: tuple[str, ...] = ()
+
+    @cached_property
+    def diagnostics(self) -> "ResidualDiagnostics":
+        """Residual diagnostics: runs, autocorrelation, spikes at reversals and the estimates to
+        distrust (:mod:`prefriction.identify.diagnostics`, ``docs/identify.md#diagnostics``)."""
+        from prefriction.identify.diagnostics import diagnose
+
+        if not isinstance(self.data, (ForceDisplacement, Motion)):
+            raise TypeError(f"residual diagnostics need a fit of ForceDisplacement or Motion data (records in time), "
+                            f"got {type(self.data).__name__}")
+        x = self.data.path if isinstance(self.data, ForceDisplacement) else self.data.x
+        st = self.statistics
+        times = next((np.atleast_1d(v) for k, v in self.nuisance.items() if k.startswith("reversal times")), None)
+        rev = None if times is None else np.clip(np.searchsorted(self.data.t, times), 0, len(self.data.t) - 1)
+        noise = 0.0
+        if isinstance(self.data, Motion):
+            from prefriction.identify.positions import noise_sd
+
+            noise = noise_sd(self.data.x_noise, self.data.quantum)
+        return diagnose(self.residuals, x, self.names, self.stderr, st.stderr_iid, st.influence, rev, noise)
 
     @property
     def unidentifiable(self) -> tuple[str, ...]:
@@ -164,7 +189,8 @@ class FitResult:
 
     def summary(self) -> str:
         """A few lines: the fitted model, the residual level, estimates with intervals and bound
-        flags, any unidentifiable parameter, what was compared, and non-convergence."""
+        flags, any unidentifiable parameter, the start pipeline's steps (Motion fits), residual
+        structure and the estimates to distrust, what was compared, and non-convergence."""
         st = self.statistics
         unit = "m" if isinstance(self.data, Motion) else "N"
         lines = [f"{model_name(self.model)} fitted to {len(self.residuals)} samples of "
@@ -173,6 +199,11 @@ class FitResult:
             lines.append(f"  {n:<14} {v:< 12.6g} [{lo:.6g}, {hi:.6g}] {u}" + self._flag(i, "  "))
         for n, why in st.unidentifiable:
             lines.append(f"  not identifiable: {n} ({why})")
+        lines.extend(f"  start: {step}" for step in getattr(self, "start", ()))
+        if isinstance(self.data, (ForceDisplacement, Motion)):
+            diag = self.diagnostics
+            lines.extend(f"  residual structure: {f}" for f in diag.findings)
+            lines.extend(f"  distrust {n}: {why}" for n, why in diag.distrust)
         lines.extend(f"  {note}" for note in self.notes)
         if not self.success:
             lines.append(f"  NOT CONVERGED: {self.message}")
@@ -182,12 +213,42 @@ class FitResult:
         return f"{sep}({self.flags[i]})" if i < len(self.flags) and self.flags[i] else ""
 
 
-    def report(self) -> str:
-        """A table of estimates, standard errors, 95 % intervals and relative errors, the
-        correlation matrix, the residual level and the identifiability diagnosis."""
+    def report(self, held_out: "ForceDisplacement | Motion | Validation | None" = None) -> str:
+        """What the fit did and how sure it is: the start pipeline's steps, a table of estimates,
+        standard errors (HAC and white-residual), 95 % intervals and relative errors, the
+        correlation matrix, the parameters the data cannot pin down, the residual diagnostics
+        and the estimates to distrust, and the held-out validation.
+
+        Parameters
+        ----------
+        held_out : ForceDisplacement, Motion or Validation, optional
+            A held-out record (validated with :meth:`validate` and its defaults) or the
+            :class:`Validation` of one.
+        """
         from prefriction.identify.report import report_text
 
-        return report_text(self)
+        return report_text(self, held_out)
+
+    def plot_residuals(self, path: str | Path = "residuals.png", *, show: bool = False) -> Path:
+        """The residual diagnostics figure: residuals against time with the reversals, their
+        autocorrelation, residuals against the samples since the last reversal, and a normal
+        quantile plot (``docs/identify.md#diagnostics``).
+
+        Parameters
+        ----------
+        path : str or Path, default "residuals.png"
+            Image file to write (the format from the suffix).
+        show : bool, default False
+            Also open a window.
+
+        Returns
+        -------
+        Path
+            The file written.
+        """
+        from prefriction.identify.report import plot_residuals
+
+        return plot_residuals(self, path, show)
 
     def plot(self, path: str | Path = "fit.png", *, show: bool = False) -> Path:
         """Data against fit and the residuals, saved to ``path``.

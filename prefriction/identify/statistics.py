@@ -7,17 +7,40 @@ Jacobian ``A``, multiple shooting), the estimates are approximately normal with 
 constraints) and ``s^2 = |r|^2 / (n - p)`` with ``p`` the number of free directions (Bates and
 Watts, *Nonlinear Regression Analysis and Its Applications*, Wiley 1988, ch. 2). The 95 %
 intervals use Student's t quantile with ``n - p`` degrees of freedom.
+
+That covariance assumes white residuals. Residuals of real records are not: noise on the
+positions enters the force through ``dF/dx`` as a smooth error, quantisation repeats the same
+error while the stage creeps, and a model error leaves runs. ``covariance="hac"`` (what
+:func:`prefriction.identify.fit` uses) replaces ``s^2`` by the heteroscedasticity- and
+autocorrelation-consistent (HAC) sandwich of Newey and West (*Econometrica* 55, 1987, 703-708):
+with ``M = N (N^T J^T J N)^-1 N^T`` and the influence of sample ``t`` on the parameters
+``psi_t = M_k J_t^T r_t`` (``M_k`` the parameters' rows; eq. S1),
+
+``Cov = n / (n - p) [G_0 + sum_{l=1}^{L} (1 - l / (L + 1)) (G_l + G_l^T)]``,
+``G_l = sum_t psi_t psi_{t-l}^T`` (eq. S2),
+
+the Bartlett weights keeping it positive semi-definite; the bandwidth ``L`` is Andrews' plug-in
+for the Bartlett kernel (*Econometrica* 59, 1991, 817-858, eq. 6.2) from an AR(1) fitted to each
+``psi`` series, ``L = 1.1447 (alpha n)^(1/3)`` with
+``alpha = sum 4 rho^2 v^2 / ((1 - rho)^6 (1 + rho)^2) / sum v^2 / (1 - rho)^4`` (eq. S3). With
+white residuals ``L`` is near 0 and the result is the Gauss-Newton covariance (up to
+heteroscedasticity). The Bartlett estimate is biased low in short records (its weights shrink
+the positive correlations), so no variance is taken below the white-residual one: each
+standard error is the larger of the two, the correlation the HAC one (eq. S4). Coverage is
+measured in ``docs/identify.md#coverage``.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 from scipy.linalg import null_space
 from scipy.stats import t as student_t
 
-__all__ = ["BoundWarning", "ConvergenceWarning", "IdentifiabilityWarning", "Statistics", "at_bounds", "gauss_newton"]
+__all__ = ["BoundWarning", "ConvergenceWarning", "IdentifiabilityWarning", "NoisyPositionsWarning", "ResidualWarning",
+           "Statistics", "at_bounds", "bandwidth", "gauss_newton", "hac"]
 
 SINGULAR = 1e-12
 """Eigenvalue of the Jacobi-scaled ``N^T J^T J N`` (relative to the largest) below which a
@@ -52,6 +75,15 @@ class Statistics:
         out; a parameter that changes nothing is reported as unidentifiable).
     unidentifiable : tuple of (str, str)
         Names of the parameters the data cannot identify, each with the reason.
+    covariance : str
+        ``"iid"`` (Gauss-Newton, white residuals) or ``"hac"`` (eq. S2).
+    bandwidth : int
+        The HAC bandwidth ``L`` in samples (0 for ``"iid"``).
+    stderr_iid : numpy.ndarray
+        The Gauss-Newton standard errors (white residuals), for comparison with :attr:`stderr`.
+    influence : numpy.ndarray or None
+        ``psi`` of eq. S1 in physical units, shape ``(k, n)``: how much each sample moves each
+        estimate (the residual diagnostics use it); ``None`` for ``"iid"``.
     """
 
     stderr: np.ndarray
@@ -62,10 +94,67 @@ class Statistics:
     dof: int
     condition: float
     unidentifiable: tuple[tuple[str, str], ...]
+    covariance: str = "iid"
+    bandwidth: int = 0
+    stderr_iid: np.ndarray | None = None
+    influence: np.ndarray | None = None
+
+
+def bandwidth(psi: np.ndarray) -> int:
+    """Andrews' Bartlett-kernel bandwidth (eq. S3) for the influence series ``psi`` (shape ``(k, n)``).
+
+    Parameters
+    ----------
+    psi : numpy.ndarray
+        One series per row.
+
+    Returns
+    -------
+    int
+        ``L`` in samples, between 0 and ``n // 4``.
+    """
+    k, n = psi.shape
+    num = den = 0.0
+    for a in range(k):
+        y = psi[a]
+        y0, y1 = y[:-1], y[1:]
+        d = float(y0 @ y0)
+        if d <= 0.0:
+            continue
+        rho = min(max(float(y0 @ y1) / d, -0.97), 0.97)
+        v = float(np.mean((y1 - rho * y0) ** 2))
+        num += 4.0 * rho**2 * v**2 / ((1.0 - rho) ** 6 * (1.0 + rho) ** 2)
+        den += v**2 / (1.0 - rho) ** 4
+    if den <= 0.0:
+        return 0
+    return int(min(n // 4, np.ceil(1.1447 * (num / den * n) ** (1.0 / 3.0))))
+
+
+def hac(psi: np.ndarray, L: int) -> np.ndarray:
+    """The Newey-West sum of eq. S2 (without the ``n / (n - p)`` factor).
+
+    Parameters
+    ----------
+    psi : numpy.ndarray
+        Influence series, shape ``(k, n)``.
+    L : int
+        Bandwidth [samples].
+    """
+    if L == 0:
+        return psi @ psi.T
+    k, n = psi.shape
+    # Bartlett weights are a boxcar convolved with itself: with the moving sums
+    # B_t = sum_{j=0..L} psi_{t-j} (psi zero outside the record), sum_t B_t B_t^T = sum_l (L + 1 - |l|) G_l,
+    # exactly eq. S2 times L + 1, in O(k n) instead of O(k^2 n L).
+    c = np.cumsum(np.concatenate([psi, np.zeros((k, L))], axis=1), axis=1)
+    B = c.copy()
+    B[:, L + 1:] -= c[:, : n - 1]
+    return (B @ B.T) / (L + 1.0)
 
 
 def gauss_newton(J: np.ndarray, r: np.ndarray, names: list[str], estimates: np.ndarray, scale: np.ndarray,
-                 *, constraints: np.ndarray | None = None, limit: float = 0.5) -> Statistics:
+                 *, constraints: np.ndarray | None = None, limit: float = 0.5, covariance: str = "iid",
+                 extra: Callable[[np.ndarray], np.ndarray] | None = None) -> Statistics:
     """Statistics of the parameters at the columns ``0..len(names)-1`` of ``J``.
 
     Parameters
@@ -86,6 +175,13 @@ def gauss_newton(J: np.ndarray, r: np.ndarray, names: list[str], estimates: np.n
         Jacobian of the equality constraints with respect to ``w`` (multiple shooting).
     limit : float, default 0.5
         Relative standard error above which a parameter is reported as not identifiable.
+    covariance : {"iid", "hac"}, default "iid"
+        White-residual Gauss-Newton covariance, or the HAC sandwich (eq. S2).
+    extra : callable, optional
+        ``W -> C``: a covariance [physical units] added to the parameters' one, from the influence
+        weights ``W = M_k J^T`` (physical units, shape ``(k, n)``; eq. S1 without the residual),
+        e.g. the errors of the positions the model is driven along
+        (:func:`prefriction.identify.prescribed.path_covariance`).
 
     Returns
     -------
@@ -110,8 +206,24 @@ def gauss_newton(J: np.ndarray, r: np.ndarray, names: list[str], estimates: np.n
     good = lam > SINGULAR * top
     inv = ((U[:, good] / lam[good]) @ U[:, good].T) / np.outer(d, d)
     U = U / d[:, None]  # null directions back in the coordinates of w
-    cov_w = s2 * N @ inv @ N.T
-    cov = cov_w[:k, :k] * np.outer(scale, scale)
+    M_k = (N[:k] @ inv) @ N.T   # the parameters' rows of M (eq. S1)
+    cov_iid = s2 * (M_k @ N[:k].T) * np.outer(scale, scale)
+    L, psi = 0, None
+    if covariance not in ("iid", "hac"):
+        raise ValueError(f"covariance must be 'iid' or 'hac', got {covariance!r}")
+    W = (M_k @ J.T) * scale[:, None] if covariance == "hac" or extra is not None else None
+    if covariance == "hac":
+        psi = W * r[None, :]    # eq. S1, physical units
+        L = bandwidth(psi)
+        cov = hac(psi, L) * (n / dof)
+        d_hac = np.sqrt(np.clip(np.diag(cov), 1e-300, None))
+        lift = np.maximum(np.sqrt(np.clip(np.diag(cov_iid), 0.0, None)) / d_hac, 1.0)
+        cov = cov * np.outer(lift, lift)   # never narrower than the white-residual interval (eq. S4)
+    else:
+        cov = cov_iid.copy()
+    if extra is not None:
+        cov = cov + extra(W)
+    se_iid = np.sqrt(np.clip(np.diag(cov_iid), 0.0, None))
     var = np.clip(np.diag(cov).copy(), 0.0, None)
     reasons: dict[str, str] = {}
     null_dirs = N @ U[:, ~good]
@@ -138,8 +250,9 @@ def gauss_newton(J: np.ndarray, r: np.ndarray, names: list[str], estimates: np.n
             reasons[name] = f"relative standard error {100.0 * rse[i]:.3g} % > {100.0 * limit:.3g} %"
     lam_moving = np.linalg.eigvalsh((H / np.outer(d, d))[np.ix_(moves, moves)]) if moves.any() else lam
     cond = float(lam_moving[-1] / lam_moving[0]) if lam_moving[0] > 0 else np.inf
+    se_iid[undetermined] = np.inf
     return Statistics(se, estimates - tq * se, estimates + tq * se, corr, float(np.sqrt(s2)), dof, cond,
-                      tuple((n_, reasons[n_]) for n_ in names if n_ in reasons))
+                      tuple((n_, reasons[n_]) for n_ in names if n_ in reasons), covariance, L, se_iid, psi)
 
 
 class BoundWarning(UserWarning):
@@ -190,3 +303,14 @@ def at_bounds(names: list[str], estimates: np.ndarray, low: np.ndarray, high: np
         lo_out[i], hi_out[i] = max(low[i], a), min(high[i], b)
         notes.append(note)
     return lo_out, hi_out, tuple(notes)
+
+
+class ResidualWarning(UserWarning):
+    """The residuals of a fit show structure the model does not explain (runs, correlation,
+    spikes at reversals); the message names the estimates to distrust."""
+
+
+class NoisyPositionsWarning(UserWarning):
+    """The positions of :class:`prefriction.identify.ForceDisplacement` data turn far more often
+    than the motion reverses, and no ``x_noise`` or ``quantum`` was declared: the fit integrates
+    the model along the noise and its estimates are biased (``docs/identify.md#positions``)."""

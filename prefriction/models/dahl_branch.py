@@ -282,17 +282,18 @@ def _advance(f1: np.ndarray, xi: np.ndarray, gamma: float) -> tuple[np.ndarray, 
     xi = np.asarray(xi, dtype=float)
     c = gamma - 1.0
     w1 = 1.0 - f1
-    X = xi * w1**c  # int_0^D e^{c l} dl = X
+    with np.errstate(divide="ignore", invalid="ignore"):  # w1 = 0, c < 0: already saturated (below)
+        X = xi * w1**c  # int_0^D e^{c l} dl = X
     if c == 0.0:
         return X, np.zeros(np.broadcast(f1, xi).shape)
     z = c * X
-    sat = z <= -1.0
+    sat = (z <= -1.0) | ((w1 == 0.0) & (c < 0.0))  # a branch started at f1 = 1 (gamma < 1) stays there
     zz = np.where(sat, 0.0, z)
     with np.errstate(divide="ignore", invalid="ignore"):
         small = np.abs(zz) < 1e-4
         rel = np.where(small, 1.0 - zz / 2.0 + zz * zz / 3.0 - zz**3 / 4.0, np.log1p(zz) / np.where(small, 1.0, zz))
-    D = np.where(sat, np.inf, X * rel)
-    slide = np.where(sat, xi - w1 ** (1.0 - gamma) / (1.0 - gamma), 0.0)
+        D = np.where(sat, np.inf, X * rel)
+        slide = np.where(sat, xi - w1 ** (1.0 - gamma) / (1.0 - gamma), 0.0)  # sat only if gamma < 1
     return D, slide
 
 

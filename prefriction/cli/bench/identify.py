@@ -1,4 +1,8 @@
-"""``prefriction bench --identify``: time and memory of a closed-loop Motion fit against its length.
+"""``prefriction bench --identify``: success rate, coverage, and time and memory against the length.
+
+First the tables of :mod:`prefriction.cli.bench.identify_rates` (success rate of Motion fits against
+the start distance per stage, coverage of the 95 % intervals, cost of force-displacement fits),
+then the time and memory of a closed-loop Motion fit against its length:
 
 Each size runs in a fresh Python process (``python -m prefriction.cli.bench.identify N``), so its
 memory is its own: an EMPS-like record (:func:`prefriction.identify.synthetic_loop.closed_loop_record`:
@@ -105,14 +109,19 @@ def format_rows(rows: list[dict]) -> list[str]:
 
 
 def main(quick: bool = False) -> int:
-    """Run the sizes (:data:`QUICK_SIZES` with ``quick``), print the table; 0 if the targets pass."""
+    """Print the success-rate, coverage and force-displacement cost tables
+    (:mod:`prefriction.cli.bench.identify_rates`), then run the Motion sizes (:data:`QUICK_SIZES`
+    with ``quick``) and print their table; 0 if every target passes."""
+    from prefriction.cli.bench.identify_rates import main_rates
+
+    ok = main_rates(quick)
     rows = []
     for n in QUICK_SIZES if quick else SIZES:
         print(f"bench --identify: fitting {n} samples ...", file=sys.stderr, flush=True)
         rows.append(_fresh(n))
     lines = format_rows(rows)
     print("\n".join(lines))
-    return 0 if all("PASS" in line for line in lines if line.startswith("target")) else 1
+    return 0 if ok and all("PASS" in line for line in lines if line.startswith("target")) else 1
 
 
 if __name__ == "__main__":

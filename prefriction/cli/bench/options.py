@@ -38,7 +38,7 @@ examples:
   prefriction bench --compensation   PID alone against PID with each friction compensator
                                      (writes compensation_*.png to --out)
   prefriction bench --export         exported C code: ns per step against friction_along
-  prefriction bench --identify       Motion fit time and memory against the record length
+  prefriction bench --identify       fit success rate, interval coverage, time and memory
   prefriction bench --emps DIR       identification routes on the EMPS benchmark files in DIR"""
 
 
@@ -155,8 +155,10 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
                            "the plain-C and numba references written from the equations, at matched error, in the "
                            "same run (docs/bench.md#native)")
     what.add_argument("--identify", action="store_true",
-                      help="instead: time and peak memory of a closed-loop Motion fit against the number of "
-                           "samples (1e3, 5e3, 2.5e4; --quick: 500, 1000, 2000), each in a fresh process")
+                      help="instead: success rate of Motion fits against the start distance (x1.25-x2, seeded, "
+                           "per synthetic stage, time and peak memory), coverage of the 95 %% intervals, cost of "
+                           "force-displacement fits against the samples, and time and peak memory of a closed-loop "
+                           "Motion fit against the samples (1e3, 5e3, 2.5e4; --quick: fewer fits, 500-2000 samples)")
     what.add_argument("--emps", default=None, metavar="DIR",
                       help="instead: the identification routes on the EMPS benchmark files in DIR (DATA_EMPS.mat, "
                            "DATA_EMPS_PULSES.mat; not shipped), docs/identify_closed_loop.md#emps")

@@ -1,0 +1,218 @@
+"""Coverage of the 95 % intervals of :func:`prefriction.identify.fit` on seeded synthetic records.
+
+Each case generates records from the equations, independently of the fitter, fits them from
+start values 1.3 times the truth (the closed-loop case: its own start) and counts how often
+each 95 % interval holds the true value:
+
+- ``dahl-clean``: Dahl (3.2) with ``gamma = 2``, whose branch has the closed form
+  ``w2 = w1 / (1 + w1 xi)`` in the gap ``w = 1 - s F / Fc`` and the distance
+  ``xi = sigma |dx| / Fc`` (from ``dw/dxi = -w^2``), along a sinusoid with a drift, force
+  noise 0.5 % of ``Fc``, a force offset, exact positions;
+- ``dahl-encoder``: the same with the positions read by an encoder (steps of 10 nm after 3 nm of
+  Gaussian noise; the grid shifted at random against the motion), declared as ``x_noise`` and
+  ``quantum``; ``dahl-encoder-undeclared``: the same records with the noise not declared (what a
+  fit without the errors-in-variables treatment reports);
+- ``maxwell-encoder``: Maxwell-slip with two elements (each a stop operator
+  ``z <- clip(z + k dx, -W, W)``), 100 nm steps after 30 nm of noise, declared;
+- ``closed-loop-encoder``: an EMPS-like stage (95.1 kg, Dahl + viscous + offset, PD loop at
+  1 kHz; :func:`prefriction.identify.synthetic_loop.closed_loop_record`, scipy LSODA between the
+  samples) read by a 50 nm encoder after 100 nm of noise, a :class:`Motion` fit with the mass
+  free (started at the values of ``tests/test_identify_closed_loop.py``);
+- ``dahl-decay``: the free decay of the Dahl oscillator (2.1) (:func:`prefriction.identify.synthetic.dahl_free_decay`:
+  DOP853 between the exact reversals), positions with Gaussian noise, a :class:`Motion` fit.
+
+``prefriction bench --identify`` prints the table; ``tests/test_identify_coverage.py`` runs a
+short version.
+"""
+
+from __future__ import annotations
+
+import time
+import warnings
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+__all__ = ["CASES", "CoverageRow", "coverage_table", "dahl2_force", "table_text"]
+
+
+def dahl2_force(sigma: float, Fc: float, x: np.ndarray) -> np.ndarray:
+    """Dahl force [N] with ``gamma = 2`` along ``x`` [m] (linear between samples), from zero force.
+
+    Parameters
+    ----------
+    sigma : float
+        Rest stiffness [N/m].
+    Fc : float
+        Coulomb force [N].
+    x : numpy.ndarray
+        Positions [m].
+    """
+    F = np.zeros(x.size)
+    for k in range(1, x.size):
+        dx = x[k] - x[k - 1]
+        if dx == 0.0:
+            F[k] = F[k - 1]
+            continue
+        s = 1.0 if dx > 0.0 else -1.0
+        w1 = 1.0 - s * F[k - 1] / Fc
+        w2 = w1 / (1.0 + w1 * sigma * abs(dx) / Fc)
+        F[k] = s * Fc * (1.0 - w2)
+    return F
+
+
+def _encoder(x: np.ndarray, noise: float, quantum: float, rng: np.random.Generator) -> np.ndarray:
+    shift = rng.uniform(0.0, quantum)
+    return np.round((x + shift + noise * rng.standard_normal(x.size)) / quantum) * quantum - shift
+
+
+def _dahl(encoder: bool, declared: bool = True) -> Callable:
+    def make(rng: np.random.Generator, n: int) -> tuple:
+        import prefriction as pf
+        from prefriction import identify
+
+        t = np.linspace(0.0, 4.0, n)
+        x = 3e-6 * np.sin(np.pi * t + 0.3) - 3e-6 * np.sin(0.3) + 0.2e-6 * t
+        truth = {"sigma": 2e6, "Fc": 3.0, "offset": 0.2}
+        F = dahl2_force(2e6, 3.0, x) + 0.2 + 0.015 * rng.standard_normal(n)
+        if encoder:
+            noise = {"x_noise": 3e-9, "quantum": 1e-8} if declared else {}
+            data = identify.ForceDisplacement(t, _encoder(x, 3e-9, 1e-8, rng), F, **noise)
+        else:
+            data = identify.ForceDisplacement(t, x, F)
+        start = pf.Dahl(sigma=2.6e6, Fc=3.9, gamma=2.0)
+        return data, start, truth, {"fixed": ["gamma"], "offset": True}
+    return make
+
+
+def _maxwell(rng: np.random.Generator, n: int) -> tuple:
+    import prefriction as pf
+    from prefriction import identify
+    from prefriction.identify.synthetic import maxwell_slip_force
+
+    t = np.linspace(0.0, 2.0, n)
+    x = 40e-6 * np.sin(2.0 * np.pi * t) * (0.25 + 0.75 * t / 2.0)
+    true = pf.MaxwellSlip([6e4, 2e4], [0.4, 0.6])
+    F = maxwell_slip_force(true, x) + 0.003 * rng.standard_normal(n)
+    data = identify.ForceDisplacement(t, _encoder(x, 3e-8, 1e-7, rng), F, x_noise=3e-8, quantum=1e-7)
+    truth = {"stiffness[0]": 6e4, "stiffness[1]": 2e4, "slip_force[0]": 0.4, "slip_force[1]": 0.6}
+    return data, pf.MaxwellSlip([7.8e4, 2.6e4], [0.52, 0.78]), truth, {}
+
+
+def _decay(rng: np.random.Generator, n: int) -> tuple:
+    import prefriction as pf
+    from prefriction.identify.synthetic import dahl_free_decay
+
+    true = pf.Dahl(sigma=1.5e4, Fc=1.0, gamma=1.5)
+    t = np.linspace(0.0, 0.2, n)
+    data = dahl_free_decay(true, 1.0, 0.02, t, 2e-7, rng)
+    truth = {"sigma": 1.5e4, "gamma": 1.5}
+    return data, pf.Dahl(sigma=1.9e4, Fc=1.0, gamma=1.9), truth, {"fixed": ["Fc"], "structures": "given"}
+
+
+def _closed_loop(rng: np.random.Generator, n: int) -> tuple:
+    import prefriction as pf
+    from prefriction import identify
+    from prefriction.identify.synthetic_loop import ClosedLoop, closed_loop_record
+
+    loop = ClosedLoop(pf.Dahl(sigma=1.0e6, Fc=20.39), mass=95.1, b=203.5, offset=-3.16, quantum=5e-8, noise=1e-7)
+    rec = closed_loop_record(loop, n, rng)
+    truth = {"sigma": 1.0e6, "Fc": 20.39, "b": 203.5, "mass": 95.1, "offset": -3.16}
+    start = pf.Dahl(sigma=8e5, Fc=10.0) + pf.Viscous(b=100.0)
+    return identify.Motion(rec.t, rec.x, rec.u, None), start, truth, {"fixed": ["gamma"], "mass0": 80.0,
+                                                                        "offset": True}
+
+
+CASES: dict[str, tuple[Callable, int]] = {
+    "dahl-clean": (_dahl(False), 1200),
+    "dahl-encoder": (_dahl(True), 1200),
+    "dahl-encoder-undeclared": (_dahl(True, False), 1200),
+    "maxwell-encoder": (_maxwell, 401),
+    "dahl-decay": (_decay, 400),
+    "closed-loop-encoder": (_closed_loop, 800),
+}
+"""Case name: (record maker, samples)."""
+
+
+@dataclass(frozen=True)
+class CoverageRow:
+    """One case: how often the 95 % intervals held the truth."""
+
+    case: str
+    runs: int
+    samples: int
+    held: dict
+    z_mean: dict
+    z_sd: dict
+    median_time: float
+    failures: int
+
+    @property
+    def pooled(self) -> float:
+        """Fraction of all intervals (every parameter, every run) that held the truth."""
+        return sum(self.held.values()) / max(len(self.held) * (self.runs - self.failures), 1)
+
+
+def coverage_table(cases: tuple[str, ...] = tuple(CASES), runs: int = 40, seed: int = 0,
+                   progress: Callable[[str], None] | None = None) -> list[CoverageRow]:
+    """Fit ``runs`` seeded records of each case; count the intervals that hold the truth.
+
+    Parameters
+    ----------
+    cases : tuple of str
+        Names from :data:`CASES`.
+    runs : int
+        Records per case.
+    seed : int
+        Seed of the records.
+    progress : callable, optional
+        Called with one line per case.
+
+    Returns
+    -------
+    list of CoverageRow
+    """
+    from prefriction import identify
+
+    rows = []
+    for c, name in enumerate(cases):
+        make, n = CASES[name]
+        held: dict = {}
+        zs: dict = {}
+        times, failures = [], 0
+        for j in range(runs):
+            data, start, truth, kw = make(np.random.default_rng([seed, c, j]), n)
+            t0 = time.perf_counter()
+            try:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")
+                    res = identify.fit(start, data, **kw)
+            except Exception:  # noqa: BLE001 - a failed fit is counted, not raised
+                failures += 1
+                continue
+            times.append(time.perf_counter() - t0)
+            for p, v in truth.items():
+                lo, hi = res.interval(p)
+                held[p] = held.get(p, 0) + int(lo <= v <= hi)
+                zs.setdefault(p, []).append((res.estimate(p) - v) / res.stderr[res.names.index(p)])
+        row = CoverageRow(name, runs, n, held, {p: float(np.mean(z)) for p, z in zs.items()},
+                          {p: float(np.std(z)) for p, z in zs.items()},
+                          float(np.median(times)) if times else float("nan"), failures)
+        rows.append(row)
+        if progress is not None:
+            progress(f"coverage {name}: {row.pooled:.0%} of the intervals held the truth in {runs} runs")
+    return rows
+
+
+def table_text(rows: list[CoverageRow]) -> str:
+    """The rows as a Markdown table: coverage per parameter, with the mean and standard deviation of
+    ``z = (estimate - truth) / stderr`` (an honest interval: mean 0, sd 1)."""
+    lines = ["| case | samples | runs | coverage per parameter (mean, sd of z) | pooled | median fit [s] |",
+             "|---|---:|---:|---|---:|---:|"]
+    for r in rows:
+        done = r.runs - r.failures
+        per = ", ".join(f"{p} {r.held[p] / max(done, 1):.0%} ({r.z_mean[p]:+.2f}, {r.z_sd[p]:.2f})" for p in r.held)
+        fail = f" ({r.failures} failed)" if r.failures else ""
+        lines.append(f"| {r.case} | {r.samples} | {r.runs}{fail} | {per} | {r.pooled:.0%} | {r.median_time:.2f} |")
+    return "\n".join(lines)
