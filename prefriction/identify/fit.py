@@ -41,7 +41,9 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
     data : ForceDisplacement, Motion or ForceVelocity
         :class:`ForceVelocity` (steady-sliding force against velocity): fits a
         :class:`prefriction.identify.StaticFriction` map (Coulomb + viscous + Stribeck,
-        optionally direction-dependent) by least squares (``docs/identify_motion.md#static-maps``).
+        optionally direction-dependent) by least squares (``docs/identify_motion.md#static-maps``);
+        a map with :class:`Motion` data is the inverse model with the mass
+        (:func:`prefriction.identify.fit_inverse`, ``docs/identify_closed_loop.md``).
         :class:`ForceDisplacement`: friction force along a prescribed displacement; the model's
         force along the measured ``x`` is fitted to ``F`` by least squares (trust-region
         reflective, Jacobian by CasADi). :class:`Motion`: positions of a mass under a known
@@ -158,6 +160,14 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
     """
     from prefriction.identify.static_map import StaticFriction
 
+    if isinstance(model, StaticFriction) and isinstance(data, Motion):  # the inverse model (identify/inverse.py)
+        from prefriction.identify.inverse import fit_inverse
+
+        if reversals is not None or substeps is not None:
+            raise ValueError("reversals and substeps are for the open-loop Motion fit; a StaticFriction map on Motion "
+                             "data is fitted by the inverse model (allowed: reversals=None, substeps=None)")
+        return fit_inverse(model, data, offset=offset, free=free, fixed=fixed, bounds=bounds, mass0=mass0,
+                           max_iter=max_iter, tol=tol, identifiability_limit=identifiability_limit)
     if isinstance(model, StaticFriction) != isinstance(data, ForceVelocity):
         raise TypeError(f"a StaticFriction map is fitted to ForceVelocity data and only it, got {type(model).__name__} "
                         f"and {type(data).__name__}")
