@@ -163,7 +163,7 @@ def test_inverse_route_recovers_the_truth(record):
     assert via_fit.notes[0] == "route: inverse model" and via_fit.names == ("mass", "Fc", "b", "offset")
 
 
-def test_recommend_names_the_route():
+def test_recommend_names_the_route(monkeypatch):
     t = np.arange(1000) * 1e-3
     u = 30.0 * np.sin(2.0 * np.pi * t)
     m, b, Fc = 2.0, 5.0, 3.0   # a driven mass with viscous and Coulomb friction, open loop, u held (scipy)
@@ -191,6 +191,17 @@ def test_recommend_names_the_route():
     assert closed.route == "closed-loop" and closed.horizon < n // 8 and "fit_closed_loop" in closed.reason
     assert identify.recommend(identify.Motion(np.arange(n) * dt, xq, uq, None)).route == "inverse"
     assert identify.recommend(identify.Motion(t[:100], x[:100], u[:100], None)).route == "motion"
+    # the open-loop Motion fit says which route to use when it fails on such a record
+    import prefriction.identify.shooting as shooting
+
+    def stalled(*_a, **_k):
+        raise pf.SolverError("the segments stopped meeting")
+
+    monkeypatch.setattr(shooting, "fit_motion", stalled)
+    with pytest.raises(pf.SolverError, match=r"segments stopped meeting; this record suits another route \(inverse"
+                                             r".*identify\.fit_inverse"):
+        identify.fit(pf.Dahl(sigma=1e6, Fc=10.0) + pf.Viscous(100.0), identify.Motion(np.arange(n) * dt, xq, uq, None),
+                     mass0=90.0, structures="given", fixed=["gamma"])
 
 
 def test_bad_arguments_are_named(record):

@@ -8,6 +8,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from prefriction._validation import check_bool, check_count, check_finite, check_positive
+from prefriction.errors import SolverError
 from prefriction.identify.data import ForceDisplacement, ForceVelocity, Motion
 from prefriction.identify.parameters import ParameterSpace, name_list
 from prefriction.identify.result import FitResult
@@ -268,15 +269,37 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
     scale = max(abs(float(model.Fc)), abs(start.offset))
     space = ParameterSpace(model, free, fixed, bounds, mass=start.mass if data.mass is None else None,
                            offset=scale if offset else None, offset0=start.offset)
-    sol = fit_motion(model, data, space, n_sub=substeps, max_iter=max_iter, tol=tol, reversals=reversals)
+    try:
+        sol = fit_motion(model, data, space, n_sub=substeps, max_iter=max_iter, tol=tol, reversals=reversals)
+    except SolverError as err:
+        advice = _route_advice(data)
+        if advice:
+            raise SolverError(f"{err}; {advice}") from err
+        raise
+    message = sol.message
+    if not sol.success:
+        advice = _route_advice(data)
+        message = f"{message}; {advice}" if advice else message
     values = space.values(sol.w[: space.n_free])
     est = np.array([values[n] for n in space.free])
     J, scale = space.physical_jacobian(sol.jacobian)
     stats = gauss_newton(J, sol.residuals, space.free, est, scale, constraints=sol.constraints, limit=limit,
                          covariance="hac")
     mass = values["mass"] if data.mass is None else data.mass
-    return _finish(space, values, est, stats, -sol.residuals, sol.prediction, data, mass, sol.nuisance, sol.message,
+    return _finish(space, values, est, stats, -sol.residuals, sol.prediction, data, mass, sol.nuisance, message,
                    sol.success, start=start.steps + sol.steps)
+
+
+def _route_advice(data: Motion) -> str:
+    """The route :func:`prefriction.identify.recommend` advises when it is not this open-loop fit
+    (a long closed-loop record on which an open-loop replay drifts), else ``""``."""
+    from prefriction.identify.routes import recommend
+
+    rec = recommend(data)
+    if rec.route == "motion":
+        return ""
+    call = "identify.fit_inverse" if rec.route == "inverse" else "identify.fit_closed_loop"
+    return f"this record suits another route ({rec}): use {call} (docs/identify_closed_loop.md)"
 
 
 def _finish(space: ParameterSpace, values: dict, est: np.ndarray, stats: Any, residuals: np.ndarray,
