@@ -37,8 +37,8 @@ _check_casadi(_casadi.__version__)
 if TYPE_CHECKING:  # the names below, imported on first use (module __getattr__)
     from prefriction.errors import PrefrictionError, SolverError
     from prefriction.along import AlongResult, FrictionStream, friction_along
-    from prefriction.models import (GMS, Dahl, ElastoPlastic, FrictionModel, LuGre, MaxwellSlip, Oscillator, Parallel,
-                                    Parameter, Viscous)
+    from prefriction.models import (GMS, Dahl, DirectionalViscous, ElastoPlastic, FrictionModel, LuGre, MaxwellSlip,
+                                    Oscillator, Parallel, Parameter, Viscous)
     from prefriction.reversals import ReversalTable
     from prefriction.units import Scales
     from prefriction.simulation.simulate import SimulationResult, simulate
@@ -59,8 +59,8 @@ del annotations, TYPE_CHECKING  # bound by the imports above; not part of the AP
 _WHERE = {
     **dict.fromkeys(["PrefrictionError", "SolverError"], "prefriction.errors"),
     **dict.fromkeys(["AlongResult", "FrictionStream", "friction_along"], "prefriction.along"),
-    **dict.fromkeys(["GMS", "Dahl", "ElastoPlastic", "FrictionModel", "LuGre", "MaxwellSlip", "Oscillator", "Parallel", "Parameter",
-                     "Viscous"], "prefriction.models"),
+    **dict.fromkeys(["GMS", "Dahl", "DirectionalViscous", "ElastoPlastic", "FrictionModel", "LuGre", "MaxwellSlip",
+                     "Oscillator", "Parallel", "Parameter", "Viscous"], "prefriction.models"),
     "ReversalTable": "prefriction.reversals",
     "Scales": "prefriction.units",
     **dict.fromkeys(["SimulationResult", "simulate"], "prefriction.simulation.simulate"),

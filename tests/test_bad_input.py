@@ -51,14 +51,14 @@ def _no_heavy_work():
     import prefriction.cli.bench.sweep as bench_sweep
     import prefriction.cli.bench_loops as bench_loops
     import prefriction.cli.paper as paper
-    import prefriction.simulation.run as run
+    import prefriction.simulation.build as build
 
     def sentinel(*_a: Any, **_k: Any) -> Any:
         raise ReachedWork("a bad value reached the compile / the heavy work")
 
     import importlib
 
-    patches = [(run, "integrator"), (bench, "headline"), (bench, "_models_main"), (bench_sweep, "main"),
+    patches = [(build, "integrator"), (build, "native_driver"), (build, "forced_driver"), (bench, "headline"), (bench, "_models_main"), (bench_sweep, "main"),
                (bench_loops, "run"), (paper, "run_all")]
     for module, name in [("prefriction.simulation.integrator", "build_integrator"),
                          ("prefriction.simulation.loops.compiled_loop", "build_integrator"),

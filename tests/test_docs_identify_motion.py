@@ -22,7 +22,7 @@ def _shown(after: str) -> list[str]:
 def test_every_python_block_runs_and_prints_what_the_page_shows():
     namespace: dict = {}
     blocks = list(re.finditer(r"```python\n(.*?)```", PAGE, flags=re.S))
-    assert len(blocks) == 5
+    assert len(blocks) == 6
     for b in blocks:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")

@@ -1,32 +1,50 @@
-"""Gauss-Newton for least squares with equality constraints (multiple shooting), sparse.
+"""Least squares with equality constraints (multiple shooting): an augmented Lagrangian around
+scipy's trust-region least squares, sparse.
 
 ``min 0.5 |r(w)|^2`` subject to ``g(w) = 0`` and box bounds on the first entries of ``w``. Each
-iteration solves the Levenberg-Marquardt damped KKT system
+outer iteration minimises the augmented residual vector
 
-    [ J^T J + mu D   A^T ] [dw]     [ -J^T r ]
-    [ A              0   ] [lam]  = [ -g     ]
+    R(w) = [ r(w) ; sqrt(mu) (g(w) + lam / mu) ]                                     (1)
 
-(``D`` the diagonal of ``J^T J``, ``A = dg/dw``) with scipy's sparse LU, shortens the step to
-stay inside the bounds and backtracks on the exact-penalty merit ``0.5 |r|^2 + rho |g|_1``
-(Nocedal and Wright, *Numerical Optimization*, 2nd ed., Springer 2006, 18.3 and 10.3). The
-matrices of multiple shooting are block-sparse, so the cost of a step grows linearly with
-the number of samples.
+with :func:`scipy.optimize.least_squares` (trust-region reflective, ``x_scale="jac"``, the
+sparse Jacobian ``[J ; sqrt(mu) A]`` solved by LSMR), then updates the multipliers
+``lam <- lam + mu g`` and raises ``mu`` tenfold when ``|g|`` fell by less than a factor 10
+(Nocedal and Wright, *Numerical Optimization*, 2nd ed., Springer 2006, 17.3, the method of
+multipliers). Early outer iterations hold the continuity of the shooting segments loosely: the
+fit first matches the data segment by segment and tightens the chain as it goes, which keeps it
+from the drifting open-loop simulations that trap a fit started far from the optimum. The trust
+region globalises each inner solve; the matrices of multiple shooting are block-sparse, so the
+cost of an iteration grows linearly with the number of samples.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-import warnings
 from typing import Any, Callable
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.linalg import splu
+from scipy.optimize import least_squares
 
 __all__ = ["LsqOutcome", "solve"]
 
-_MU_DONE = 1e-4
-"""Largest damping at which a short step counts as convergence (a damped step is short anyway)."""
+_DENSE = 2e9
+"""Largest ``rows x columns^2`` of the augmented Jacobian solved densely (``tr_solver="exact"``,
+an SVD per iteration: far fewer iterations than LSMR on these ill-conditioned problems, measured
+27 against 200+ Jacobian evaluations on a 1,000-sample Dahl record); larger problems use LSMR."""
+_MU0 = 0.01
+"""Initial weight of the constraints relative to the residuals at the start: small, so that the
+first inner solve matches the data segment by segment (measured: a start 2x off that weight 1
+left in a wrong basin converged from 0.01)."""
+_OUTER = 14
+"""Most multiplier updates."""
+_INNER = 40
+"""Most Jacobian evaluations of one inner solve (an early, loose one need not converge)."""
+_RESTARTS = 2
+"""Most restarts of the nuisance entries after a stalled outer iteration."""
+_RESTART_ABOVE = 1e-2
+"""Smallest constraint violation of a stalled outer iteration that restarts the nodes (below it
+a restart loses more than it gains: measured on 25,000 samples, 1.2e-5 became 5e-4)."""
 
 
 @dataclass(frozen=True)
@@ -39,15 +57,29 @@ class LsqOutcome:
     message: str
 
 
-def _merit(r: np.ndarray, g: np.ndarray, rho: float) -> float:
-    if not (np.all(np.isfinite(r)) and np.all(np.isfinite(g))) or np.abs(r).max(initial=0.0) > 1e150:
-        return np.inf
-    return 0.5 * float(r @ r) + rho * float(np.abs(g).sum())
+class _Cache:
+    """``full`` evaluated once per point: ``least_squares`` asks for the residuals and then the
+    Jacobian at the same point."""
+
+    def __init__(self, full: Callable, plain: Callable) -> None:
+        self.full, self.plain = full, plain
+        self.w: np.ndarray | None = None
+        self.value: Any = None
+        self.jacobians = 0
+
+    def at(self, w: np.ndarray) -> Any:
+        if self.w is None or not np.array_equal(w, self.w):
+            self.value = self.full(w)
+            self.w = w.copy()
+            self.jacobians += 1
+        return self.value
 
 
 def solve(full: Callable, plain: Callable, w0: np.ndarray, lo: np.ndarray, hi: np.ndarray, *, max_iter: int,
-          tol: float, gtol: float = 1e-9, progress: Callable[[str], None] | None = None) -> LsqOutcome:
-    """Constrained Gauss-Newton from ``w0``.
+          tol: float, gtol: float = 1e-9, weight: float = _MU0,
+          restart: Callable[[np.ndarray], np.ndarray] | None = None,
+          progress: Callable[[str], None] | None = None) -> LsqOutcome:
+    """Constrained least squares from ``w0`` by the method of multipliers (1).
 
     Parameters
     ----------
@@ -60,94 +92,89 @@ def solve(full: Callable, plain: Callable, w0: np.ndarray, lo: np.ndarray, hi: n
     lo, hi : numpy.ndarray
         Bounds of the leading entries.
     max_iter : int
-        Most iterations (Jacobian evaluations).
+        Most Jacobian evaluations over all outer iterations.
     tol : float
-        Convergence: the step (relative to ``1 + |w|``) below ``tol``, or a full step that
-        decreases ``|r|^2`` by less than ``tol`` relative and moves less than ``1000 tol``,
-        with ``|g| <= gtol``.
+        Relative tolerance of the inner solves (``xtol``, ``ftol``).
     gtol : float, default 1e-9
         Largest constraint violation at convergence (in the scaled units of ``g``).
+    weight : float, default :data:`_MU0`
+        Initial constraint weight ``mu`` relative to ``|r|^2 / |g|^2`` at ``w0``: small to let the
+        segments first match the data (a start far from the optimum), larger for a start near it.
+    restart : callable, optional
+        ``w -> w'``: a new start of the nuisance entries at the parameters of ``w`` (the shooting
+        nodes simulated from the data), used when an outer iteration stalls (no step, constraints
+        violated by more than :data:`_RESTART_ABOVE`): at a kink of the motion (a reversal that
+        moves between sub-steps) the trust region can shrink to nothing. At most :data:`_RESTARTS` times, each reported.
     progress : callable, optional
-        Called with one line per iteration.
-
-    Notes
-    -----
-    A trial step is accepted when the merit decreases (by at least ``1e-4`` of the decrease the
-    linear model predicts); convergence is declared only at a damping ``mu <= 1e-4``; a rejected full step first gets a second-order correction (the
-    constraints' curvature, the Maratos effect), then a larger damping ``mu``.
+        Called with one line per outer iteration.
     """
-    w = np.array(w0, dtype=float)
+    cache = _Cache(full, plain)
     nb = lo.size
-    mu, rho = 1e-2, 0.0
-    r, J, g, A = full(w)
-    for it in range(1, max_iter + 1):
-        f0 = 0.5 * float(r @ r)
-        JtJ = (J.T @ J).tocsc()
-        grad = J.T @ r
-        diag = np.maximum(JtJ.diagonal(), 1e-12 * max(float(JtJ.diagonal().max()), 1e-300))
-        accepted = False
-        while not accepted and mu < 1e12:
-            lu = _factor(JtJ, diag, mu, A)
-            if lu is None:
-                mu *= 10.0
-                continue
-            sol = lu.solve(-np.concatenate([grad, g]))
-            d, lam = sol[: w.size], sol[w.size:]
-            rho = max(rho, 1.1 * float(np.abs(lam).max(initial=0.0)))
-            phi0 = _merit(r, g, rho)
-            Jd = J @ d
-            pred = -(float(grad @ d) + 0.5 * float(Jd @ Jd)) + rho * float(np.abs(g).sum())
-            alpha = _to_bounds(w[:nb], d[:nb], lo, hi)
-            wt = w + alpha * d
-            rt, gt = plain(wt)
-            phi = _merit(rt, gt, rho)
-            if not phi0 - phi >= 0.1 * alpha * pred and np.isfinite(phi):
-                corr = lu.solve(np.concatenate([np.zeros(w.size), -gt]))[: w.size]
-                beta = _to_bounds(wt[:nb], corr[:nb], lo, hi)
-                ws = wt + beta * corr
-                rs, gs = plain(ws)
-                if _merit(rs, gs, rho) < phi:
-                    wt, rt, gt, phi = ws, rs, gs, _merit(rs, gs, rho)
-            ratio = (phi0 - phi) / max(alpha * pred, 1e-300)
-            if ratio >= 1e-4:
-                accepted = True
-                mu = max(mu / 3.0, 1e-12) if ratio > 0.25 else mu
+    lower = np.r_[lo, np.full(w0.size - nb, -np.inf)]
+    upper = np.r_[hi, np.full(w0.size - nb, np.inf)]
+    w = np.clip(np.array(w0, dtype=float), lower, upper)
+    inside = (w <= lower) | (w >= upper)
+    w[inside] = np.where(np.isfinite(lower[inside]) & np.isfinite(upper[inside]),
+                         0.5 * (lower[inside] + upper[inside]), w[inside])
+    r, g = plain(w)
+    dense = float(r.size + g.size) * w.size**2 <= _DENSE
+    lam = np.zeros(g.size)
+    mu = weight * max(1.0, float(r @ r)) / max(1.0, float(g @ g)) if g.size else 1.0
+    mu = float(np.clip(mu, 1e-4, 1e6))
+    gmax_prev = np.inf
+    message = ""
+    restarts = []
+    outer = 0
+    while outer < _OUTER:
+        outer += 1
+        root = np.sqrt(mu)
+
+        def fun(x: np.ndarray) -> np.ndarray:
+            if cache.w is not None and np.array_equal(x, cache.w):
+                rr, _J, gg, _A = cache.value
             else:
-                mu *= 10.0
-        if not accepted:
-            return LsqOutcome(w, False, it, "no decrease of the merit function at any damping")
-        moved = float(np.max(np.abs(wt - w) / (1.0 + np.abs(w))))
-        w = wt
-        r, J, g, A = full(w)
-        f1 = 0.5 * float(r @ r)
+                rr, gg = plain(x)
+            out = np.concatenate([rr, root * gg + lam / root])
+            return out if np.all(np.isfinite(out)) else np.full(out.size, 1e150)
+
+        def jac(x: np.ndarray) -> Any:
+            _r, J, _g, A = cache.at(x)
+            out = sp.vstack([J, root * A], format="csr")
+            return out.toarray() if dense else out
+
+        budget = max_iter - cache.jacobians
+        if budget < 1:
+            message = f"max_iter = {max_iter} Jacobian evaluations reached"
+            break
+        final = outer > 1 and gmax_prev <= 10.0 * gtol
+        sol = least_squares(fun, w, jac=jac, bounds=(lower, upper), method="trf",
+                            tr_solver="exact" if dense else "lsmr",
+                            x_scale="jac", xtol=tol if final else max(tol, 1e-8), ftol=tol if final else 1e-8,
+                            gtol=1e-12, max_nfev=max(min(budget, _INNER) * 2, 2))
+        stalled = np.array_equal(sol.x, w) or sol.nfev <= 1
+        w = sol.x
+        r, g = plain(w)
         gmax = float(np.abs(g).max(initial=0.0))
+        if stalled and gmax > _RESTART_ABOVE and restart is not None and len(restarts) < _RESTARTS:
+            w = restart(w)
+            r, g = plain(w)
+            lam = np.zeros(g.size)
+            restarts.append(f"restart {len(restarts) + 1} of the nodes after outer iteration {outer} "
+                            f"(stalled at |g| = {gmax:.2e})")
+            if progress is not None:
+                progress(restarts[-1])
+            gmax_prev = np.inf
+            continue
         if progress is not None:
-            progress(f"iteration {it}: 0.5 |r|^2 = {f1:.6g}, |g| = {gmax:.2e}, step {moved:.2e}, damping {mu:.2g}")
-        if gmax <= gtol and (moved <= tol or (alpha == 1.0 and f0 - f1 <= tol * f0 and moved <= 1e3 * tol)):
-            if mu <= _MU_DONE:
-                return LsqOutcome(w, True, it, f"converged after {it} Gauss-Newton iterations")
-            mu = 1e-2 * _MU_DONE  # a short step of a heavily damped system is no optimum: try Gauss-Newton
-    return LsqOutcome(w, False, max_iter, f"no convergence after max_iter = {max_iter} Gauss-Newton iterations")
-
-
-def _factor(JtJ: sp.csc_matrix, diag: np.ndarray, mu: float, A: sp.csr_matrix) -> Any:
-    """Sparse LU of the damped KKT matrix, or None if it is singular."""
-    K = sp.bmat([[JtJ + sp.diags(mu * diag), A.T], [A, None]], format="csc")
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            return splu(K)
-    except RuntimeError:
-        return None
-
-
-def _to_bounds(x: np.ndarray, d: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> float:
-    """Largest ``alpha <= 1`` that keeps ``x + alpha d`` within 99.5 % of the way to the bounds."""
-    alpha = 1.0
-    with np.errstate(divide="ignore", invalid="ignore"):
-        up = np.where(d > 0, (hi - x) / d, np.inf)
-        down = np.where(d < 0, (lo - x) / d, np.inf)
-    lim = float(np.min(np.concatenate([up, down, [np.inf]])))
-    if lim < 1.0:
-        alpha = 0.995 * lim
-    return alpha
+            progress(f"outer iteration {outer}: 0.5 |r|^2 = {0.5 * float(r @ r):.6g}, |g| = {gmax:.2e}, "
+                     f"weight {mu:.2g}, {sol.nfev} evaluations ({sol.message})")
+        if final and gmax <= gtol and sol.status > 0:
+            return LsqOutcome(w, True, cache.jacobians, f"converged after {outer} multiplier updates and "
+                                                        f"{cache.jacobians} Jacobian evaluations"
+                              + "".join(f"; {line}" for line in restarts))
+        lam = lam + mu * g
+        if gmax > 0.1 * gmax_prev:
+            mu = min(10.0 * mu, 1e12)
+        gmax_prev = gmax
+        message = f"constraint violation {gmax:.2e} after {outer} multiplier updates"
+    return LsqOutcome(w, False, cache.jacobians, (message or "no convergence") + "".join(f"; {x}" for x in restarts))

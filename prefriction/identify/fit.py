@@ -7,7 +7,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from prefriction._validation import check_bool, check_count, check_positive
+from prefriction._validation import check_bool, check_count, check_finite, check_positive
 from prefriction.identify.data import ForceDisplacement, ForceVelocity, Motion
 from prefriction.identify.parameters import ParameterSpace, name_list
 from prefriction.identify.result import FitResult
@@ -27,7 +27,7 @@ MAX_ITER = 100_000
 
 def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequence[str] | None = None,
         fixed: Sequence[str] | None = None, bounds: dict[str, tuple[float, float]] | None = None,
-        offset: bool = False, structures: str = "both", mass0: float | None = None,
+        offset: bool = False, structures: str = "both", mass0: float | None = None, offset0: float | None = None,
         reversals: Sequence[float] | None = None, substeps: int | None = None, max_iter: int = 200,
         tol: float = 1e-10, identifiability_limit: float = 0.5) -> FitResult:
     """Fit a friction model's parameters to measured data.
@@ -41,14 +41,17 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
     data : ForceDisplacement, Motion or ForceVelocity
         :class:`ForceVelocity` (steady-sliding force against velocity): fits a
         :class:`prefriction.identify.StaticFriction` map (Coulomb + viscous + Stribeck,
-        optionally direction-dependent) by least squares (``docs/identify_motion.md#static-maps``).
+        optionally direction-dependent) by least squares (``docs/identify_motion.md#static-maps``);
+        a map with :class:`Motion` data is the inverse model with the mass
+        (:func:`prefriction.identify.fit_inverse`, ``docs/identify_closed_loop.md``).
         :class:`ForceDisplacement`: friction force along a prescribed displacement; the model's
         force along the measured ``x`` is fitted to ``F`` by least squares (trust-region
         reflective, Jacobian by CasADi). :class:`Motion`: positions of a mass under a known
         force ``u`` (a free decay for ``u = 0``), held or linear between samples as
         ``data.hold`` says; fitted by multiple shooting over segments of 50 samples with
-        constrained Gauss-Newton (``docs/identify_motion.md``: time and memory grow linearly
-        with the samples).
+        scipy's trust-region least squares in an augmented Lagrangian, records of more than 4,000
+        samples after a fit of their 2,000 with the most reversals (``docs/identify_motion.md``: time and memory
+        grow linearly with the samples).
     free : sequence of str, optional
         Parameters to fit (names of ``type(model).parameters``; ``"stiffness[0]"`` for an
         array entry; ``"mass"``). Default: every parameter not in ``fixed``.
@@ -70,11 +73,14 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
         the smaller residual, and says in ``FitResult.notes`` what it compared; ``"given"`` fits
         the start model's structure only.
     mass0 : float, optional
-        Start value of the mass [kg] when ``data.mass`` is ``None`` (the mass is then fitted). For
-        a forced record (``u`` not zero) the static least-squares fit of the force balance
-        (``docs/identify_motion.md#start-values``) gives the start values of the mass, of the
-        force level ``Fc`` (and ``Fs`` in proportion), of the viscous coefficient and of the
-        offset where they are free and come out positive; ``mass0`` is the fallback.
+        Start value of the mass [kg] when ``data.mass`` is ``None`` (the mass is then fitted).
+        Default: the static least-squares fit of the force balance of a forced record
+        (``docs/identify_motion.md#start-values``). The start values the user gives (``mass0``,
+        ``offset0``, the start model's parameters) are the ones the fit uses; the static
+        estimates fill in only what is not given, and :attr:`FitResult.start` says what set each.
+    offset0 : float, optional
+        Start value of the offset [N] of a :class:`Motion` fit with ``offset=True``; default: the
+        static least-squares estimate (0 for a record that slides one way only).
     reversals : sequence of float, optional
         Approximate velocity reversal times [s] of :class:`Motion` data: the direction of
         motion at each shooting node is taken from them; default: the sign of a smoothed
@@ -84,7 +90,8 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
         the start values (1 for Maxwell-slip on force-displacement data, where one step is the
         exact stop operator).
     max_iter : int, default 200
-        Most solver iterations (function evaluations for force-displacement data), 1 to 100 000.
+        Most solver iterations (Jacobian evaluations of a :class:`Motion` fit, function
+        evaluations for force-displacement data), 1 to 100 000.
         A fit that stops there returns with ``success = False`` and a :class:`ConvergenceWarning`.
     tol : float, default 1e-10
         Solver tolerance (relative), ``1e-14 <= tol <= 1e-6``: looser tolerances stop before the
@@ -105,9 +112,12 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
         has the wrong type (unknown keyword arguments included).
     ValueError
         For unknown parameter names, bounds outside the declared range, a missing ``mass0``
-        when the mass is free, or a model the data type cannot fit (the message says why).
+        when the mass is free and the record gives no static estimate, or a model the data type
+        cannot fit (the message says why).
     prefriction.SolverError
-        If the solver fails; the message names where and what to try.
+        If the model's motion or force is not finite at the start values; the message names
+        where and what to try. A solver that stops without converging returns the last
+        estimates with ``success = False`` and a :class:`ConvergenceWarning`.
 
     Warns
     -----
@@ -115,7 +125,8 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
         Naming every estimate that ends on a bound (the declared range, a user bound, or a
         structure boundary such as Dahl's ``gamma = 1``); its interval starts at the bound.
     ConvergenceWarning
-        If the solver stops at ``max_iter`` without converging.
+        If the solver stops without converging (``max_iter``, or a Motion fit that cannot
+        close the continuity of its segments); the result holds the last estimates.
     NoisyPositionsWarning
         For :class:`ForceDisplacement` data whose positions turn far more often than the motion
         reverses, with neither ``x_noise`` nor ``quantum`` declared.
@@ -149,6 +160,14 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
     """
     from prefriction.identify.static_map import StaticFriction
 
+    if isinstance(model, StaticFriction) and isinstance(data, Motion):  # the inverse model (identify/inverse.py)
+        from prefriction.identify.inverse import fit_inverse
+
+        if reversals is not None or substeps is not None:
+            raise ValueError("reversals and substeps are for the open-loop Motion fit; a StaticFriction map on Motion "
+                             "data is fitted by the inverse model (allowed: reversals=None, substeps=None)")
+        return fit_inverse(model, data, offset=offset, free=free, fixed=fixed, bounds=bounds, mass0=mass0,
+                           max_iter=max_iter, tol=tol, identifiability_limit=identifiability_limit)
     if isinstance(model, StaticFriction) != isinstance(data, ForceVelocity):
         raise TypeError(f"a StaticFriction map is fitted to ForceVelocity data and only it, got {type(model).__name__} "
                         f"and {type(data).__name__}")
@@ -178,13 +197,17 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
         return fit_static(model, data, free=free, fixed=fixed, bounds=bounds, offset=offset, max_iter=max_iter,
                           tol=tol, limit=limit)
     if isinstance(data, Motion):
-        return _fit_motion(model, data, free, fixed, bounds, mass0, reversals, substeps, max_iter, tol, limit, offset)
+        return _fit_motion(model, data, free, fixed, bounds, mass0, offset0, reversals, substeps, max_iter, tol, limit,
+                           offset)
     if reversals is not None:
         raise ValueError("reversals is for Motion data; force-displacement data have their directions from dx "
                          "(allowed: reversals=None)")
     if mass0 is not None:
         raise ValueError(f"mass0 = {mass0!r} is for Motion data with a free mass; force-displacement data "
                          f"involve no mass (allowed: mass0=None)")
+    if offset0 is not None:
+        raise ValueError(f"offset0 = {offset0!r} is for Motion data; a force-displacement offset starts at 0 "
+                         f"(allowed: offset0=None)")
     from prefriction.identify.positions import noisy_positions_message
     from prefriction.identify.structures import fit_structures, gamma_entry
 
@@ -213,51 +236,58 @@ def _fit_prescribed(model: FrictionModel, data: ForceDisplacement, free: Any, fi
     sol = fit_prescribed(model, data, space, n_sub=substeps, max_iter=max_iter, tol=tol)
     values = space.values(sol.w[:-1])
     est = np.array([values[n] for n in space.free])
-    stats = gauss_newton(sol.jacobian, sol.residuals, space.free, est, space.scale, limit=limit, covariance="hac",
+    J, scale = space.physical_jacobian(sol.jacobian)
+    stats = gauss_newton(J, sol.residuals, space.free, est, scale, limit=limit, covariance="hac",
                          extra=sol.extra_covariance)
     nuisance = {"initial force F0 [N]": float(sol.prediction[0])}
     return _finish(space, values, est, stats, -sol.residuals, sol.prediction, data, None, nuisance, sol.message,
                    sol.success, level=6)
 
 
-def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bounds: Any, mass0: Any, reversals: Any,
-                substeps: int | None, max_iter: int, tol: float, limit: float, offset: bool) -> FitResult:
+def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bounds: Any, mass0: Any, offset0: Any,
+                reversals: Any, substeps: int | None, max_iter: int, tol: float, limit: float,
+                offset: bool) -> FitResult:
     from prefriction.identify.motion_start import start_values
     from prefriction.identify.shooting import fit_motion
 
     if data.mass is None:
-        if mass0 is None:
-            raise ValueError("mass0 must be given when data.mass is None (the mass is fitted and needs a start "
-                             "value [kg], 0 < mass0 < inf)")
-        mass0 = check_positive("mass0", mass0)
+        if mass0 is not None:
+            mass0 = check_positive("mass0", mass0)
     elif mass0 is not None:
         raise ValueError(f"mass0 = {mass0!r} is only for a free mass, but data.mass = {data.mass!r} is known "
                          f"(allowed: mass0=None)")
     if offset and data.free_decay:
         raise ValueError("offset=True needs an applied force: in a free decay (u = 0) a force offset cannot be told "
                          "from the rest position (allowed: offset=False)")
-    model, mass0, offset0, scale = start_values(model, data, mass0, free, fixed, bounds)
-    space = ParameterSpace(model, free, fixed, bounds, mass=mass0, offset=scale if offset else None)
-    sol = fit_motion(model, data, space, n_sub=substeps, max_iter=max_iter, tol=tol, reversals=reversals,
-                     offset0=offset0)
+    if offset0 is not None:
+        if not offset:
+            raise ValueError(f"offset0 = {offset0!r} is the start of a fitted offset: give offset=True "
+                             f"(allowed without it: offset0=None)")
+        offset0 = check_finite("offset0", offset0)
+    start = start_values(model, data, mass0, offset0, offset)
+    scale = max(abs(float(model.Fc)), abs(start.offset))
+    space = ParameterSpace(model, free, fixed, bounds, mass=start.mass if data.mass is None else None,
+                           offset=scale if offset else None, offset0=start.offset)
+    sol = fit_motion(model, data, space, n_sub=substeps, max_iter=max_iter, tol=tol, reversals=reversals)
     values = space.values(sol.w[: space.n_free])
     est = np.array([values[n] for n in space.free])
-    stats = gauss_newton(sol.jacobian, sol.residuals, space.free, est, space.scale,
-                         constraints=sol.constraints, limit=limit, covariance="hac")
+    J, scale = space.physical_jacobian(sol.jacobian)
+    stats = gauss_newton(J, sol.residuals, space.free, est, scale, constraints=sol.constraints, limit=limit,
+                         covariance="hac")
     mass = values["mass"] if data.mass is None else data.mass
     return _finish(space, values, est, stats, -sol.residuals, sol.prediction, data, mass, sol.nuisance, sol.message,
-                   getattr(sol, "success", True))
+                   sol.success, start=start.steps + sol.steps)
 
 
 def _finish(space: ParameterSpace, values: dict, est: np.ndarray, stats: Any, residuals: np.ndarray,
             fitted: np.ndarray, data: Any, mass: float | None, nuisance: dict, message: str,
-            success: bool = True, level: int = 4) -> FitResult:
+            success: bool = True, level: int = 4, start: tuple[str, ...] = ()) -> FitResult:
     fitted_model = space.build(values)
     for name, why in stats.unidentifiable:
         warnings.warn(f"the data cannot identify {name}: {why}; its interval is meaningless. Fix it (fixed=[{name!r}]) "
                       f"or record data that excite it (docs/identify.md#identifiability)",
                       IdentifiabilityWarning, stacklevel=level)
-    low, high, flags = at_bounds(space.free, est, stats.low, stats.high, space.scale, space.low, space.high,
+    low, high, flags = at_bounds(space.free, est, stats.low, stats.high, space.scale, *space.limits(values),
                                  space.why_low, space.why_high)
     for name, value, flag in zip(space.free, est, flags):
         if flag.startswith("on its"):
@@ -270,7 +300,7 @@ def _finish(space: ParameterSpace, values: dict, est: np.ndarray, stats: Any, re
                       stacklevel=level)
     res = FitResult(fitted_model, mass, tuple(space.free), tuple(space.units[n] for n in space.free), est,
                     stats.stderr, low, high, stats.correlation, residuals, fitted, data, stats,
-                    nuisance, message, success=success, flags=flags)
+                    nuisance, message, success=success, flags=flags, start=start)
     _warn_structure(res, level)
     return res
 

@@ -5,24 +5,25 @@ balance ``u = m a + Fc sign(v) + b v + F_off`` (Coulomb, viscous and offset; ``a
 a Savitzky-Golay fit of the positions) is linear in ``m``, ``Fc``, ``b`` and ``F_off``: ordinary
 least squares over the samples that move faster than a tenth of the largest speed gives them
 without any start value. A record that slides in one direction only cannot tell the offset
-from ``Fc``: its offset starts at 0. The dynamic fit starts from them, so it never starts where the model
-has no meaning (a negative force level, a NaN).
+from ``Fc``: its offset starts at 0. These estimates fill in the start values the user did not
+give (the mass, the offset) and are otherwise reported as checks beside the user's values, with
+the pre-sliding stiffness from the transients after the reversals: the fit starts where the user
+says, and :attr:`prefriction.identify.FitResult.start` says what set each start value.
 """
 
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import dataclass
-from typing import Any
-
 import numpy as np
 from scipy.signal import savgol_filter
 
 from prefriction.identify.data import Motion
 from prefriction.models.base import FrictionModel
 
-__all__ = ["StaticStart", "derivatives", "start_model", "start_values", "static_start"]
+__all__ = ["Start", "StaticStart", "derivatives", "start_values", "static_start", "stiffness_from_reversals"]
 
+_RESOLVED = 8
+"""Fewest samples in the first third of a reversal transient for a stiffness estimate."""
 _WINDOW = 21
 """Samples of the Savitzky-Golay window (cubic) of the velocity and acceleration estimates."""
 
@@ -82,56 +83,123 @@ def static_start(data: Motion) -> StaticStart | None:
     return StaticStart(mass, float(coef[0]), float(coef[1]), float(coef[2]))
 
 
-def start_values(model: FrictionModel, data: Motion, mass0: float | None, free: Any, fixed: Any,
-                 bounds: Any) -> tuple[FrictionModel, float | None, float, float]:
-    """Start model, start mass [kg], start offset [N] and offset scale [N] of a Motion fit.
+@dataclass(frozen=True)
+class Start:
+    """Start values of a Motion fit and what set each of them (:func:`start_values`).
 
-    The static estimates (:func:`static_start`) replace the start model's ``Fc`` (``Fs`` in
-    proportion), its viscous coefficient (``sigma2`` of LuGre, ``b`` of a
-    :class:`prefriction.Viscous` term) and ``mass0`` where they are positive and the name is
-    fitted, not fixed and not bounded by the user.
+    Attributes
+    ----------
+    mass : float or None
+        Start mass [kg] (``None``: the mass is known, ``data.mass``).
+    offset : float
+        Start offset [N].
+    steps : tuple of str
+        One line per step of the start pipeline: what was set, and from what.
+    """
+
+    mass: float | None
+    offset: float
+    steps: tuple[str, ...]
+
+
+def start_values(model: FrictionModel, data: Motion, mass0: float | None, offset0: float | None,
+                 offset: bool) -> Start:
+    """Start mass and offset of a Motion fit; the user's values are kept, the static estimates
+    (:func:`static_start`) only fill in what the user did not give, and every step is reported.
+
+    The start model's parameters are always the user's: the static Coulomb force, viscous
+    coefficient and the pre-sliding stiffness (:func:`stiffness_from_reversals`) are reported as
+    checks beside them.
+
+    Raises
+    ------
+    ValueError
+        If the mass is free, ``mass0`` is not given and the static fit finds no physical mass.
     """
     fit = static_start(data)
-    keep = set(_list(fixed)) | set(bounds or {})
-    if free is not None:
-        keep |= {p.name for p in type(model).parameters} - set(_list(free))
-    model = start_model(model, fit, keep)
-    if fit is not None and mass0 is not None and fit.mass is not None and fit.mass > 0.0 and "mass" not in keep:
-        mass0 = fit.mass
-    offset0 = fit.offset if fit is not None else 0.0
-    return model, mass0, offset0, float(model.Fc)
-
-
-def _list(names: Any) -> list[str]:
-    if names is None:
-        return []
-    return [names] if isinstance(names, str) else list(names)
-
-
-def start_model(model: FrictionModel, fit: StaticStart | None, keep: set[str]) -> FrictionModel:
-    """``model`` with its force level (``Fc``, and ``Fs`` in proportion) and viscous coefficient
-    (``sigma2``, or ``b`` of a :class:`prefriction.Viscous` term of a sum) replaced by the static
-    estimates where positive, except the names in ``keep``."""
-    from prefriction.models.parallel import Parallel
-
+    steps = []
     if fit is None:
-        return model
-    if isinstance(model, Parallel):
-        levels = [m for m in model.models if "Fc" in {p.name for p in type(m).parameters}]
-        share = StaticStart(fit.mass, fit.Fc / max(len(levels), 1), fit.b, fit.offset)
-        terms = [start_model(m, share, keep if "b" in {p.name for p in type(m).parameters} else set(keep) | {"b"})
-                 for m in model.models]
-        return Parallel(tuple(terms))
-    names = {p.name for p in type(model).parameters}
-    new: dict[str, float] = {}
-    if "Fc" in names and "Fc" not in keep and fit.Fc > 0.0:
-        new["Fc"] = fit.Fc
-        if "Fs" in names and "Fs" not in keep:
-            new["Fs"] = getattr(model, "Fs") * fit.Fc / model.Fc
-    for visc in ("sigma2", "b"):
-        if visc in names and visc not in keep and fit.b > 0.0:
-            new[visc] = fit.b
-    try:
-        return dataclasses.replace(model, **new) if new else model
-    except ValueError:  # e.g. Fs below the new Fc when Fs is kept: start from the user's model
-        return model
+        why = ("a free decay (u = 0) has no force balance to fit" if data.free_decay
+               else "the record does not excite the force balance (too few sliding samples, or a mass, Coulomb "
+                    "force or viscous coefficient that comes out not positive)")
+        steps.append(f"static least squares: none ({why})")
+    else:
+        steps.append(f"static least squares of u = m a + Fc sign(v) + b v + F_off over the sliding samples: "
+                     + (f"mass {fit.mass:.4g} kg, " if fit.mass is not None else "")
+                     + f"Fc {fit.Fc:.4g} N, b {fit.b:.4g} N s/m, offset {fit.offset:.4g} N")
+    if data.mass is not None:
+        steps.append(f"mass {data.mass:.6g} kg known (data.mass), not fitted")
+    elif mass0 is not None:
+        steps.append(f"mass {mass0:.6g} kg as given (mass0)" + _check(fit and fit.mass, "kg"))
+    elif fit is not None and fit.mass is not None:
+        mass0 = fit.mass
+        steps.append(f"mass {mass0:.6g} kg from static least squares (no mass0 given)")
+    else:
+        raise ValueError(f"mass0 must be given when data.mass is None and the static least squares finds no mass "
+                         f"({steps[0]}): the mass is fitted and needs a start value [kg], 0 < mass0 < inf")
+    if offset:
+        if offset0 is not None:
+            steps.append(f"offset {offset0:.6g} N as given (offset0)" + _check(fit and fit.offset, "N"))
+        elif fit is not None:
+            offset0 = fit.offset
+            steps.append(f"offset {offset0:.6g} N from static least squares (no offset0 given)"
+                         + (" (the record slides one way only: 0)" if fit.offset == 0.0 else ""))
+        else:
+            offset0 = 0.0
+            steps.append("offset 0 N (no offset0 given, no static estimate)")
+    names = {p.name for p in type(model).parameters} | set(getattr(model, "parameter_names", ()))
+    checks = []
+    if fit is not None:
+        checks.append(f"Fc {model.Fc:.4g} N (static: {fit.Fc:.4g} N)")
+        if "sigma2" in names or "b" in names:
+            b = getattr(model, "sigma2", None)
+            if b is None:
+                b = sum(getattr(m, "b", 0.0) for m in getattr(model, "models", ()))
+            checks.append(f"viscous {b:.4g} N s/m (static: {fit.b:.4g} N s/m)")
+    k = stiffness_from_reversals(data, mass0 if data.mass is None else data.mass, offset0 or 0.0)
+    if k is not None:
+        checks.append(f"stiffness {model.sigma:.4g} N/m (rough check from {k[1]} reversal transients: {k[0]:.4g} N/m)")
+    steps.append("friction parameters as given by the start model" + (": " + ", ".join(checks) if checks else ""))
+    return Start(mass0, float(offset0 or 0.0), tuple(steps))
+
+
+def _check(value: float | None, unit: str) -> str:
+    return "" if value is None else f"; static least squares says {value:.4g} {unit} (a check only, not used)"
+
+
+def stiffness_from_reversals(data: Motion, mass: float, offset: float) -> tuple[float, int] | None:
+    """Pre-sliding stiffness [N/m] from the transients after the velocity reversals of a forced
+    record, and the number of transients used.
+
+    After a reversal the friction force ``F = u - m a - F_off`` (``a`` from the smoothed
+    positions) moves from one sliding level to the other; its slope against the position over
+    the first third of that change is the pre-sliding stiffness (``dF/dx = sigma`` at a reversal
+    of Dahl (3.2) and LuGre). The median over the reversals is returned; ``None`` for a free
+    decay or when no transient spans :data:`_RESOLVED` samples (at 1 kHz a stage's transient
+    lasts a few samples and the smoothing spans it: the slope came out 50 times too stiff).
+    """
+    if data.free_decay:
+        return None
+    xs, v, a = derivatives(data.t, data.x)
+    F = data.u - mass * a - offset
+    moving = np.abs(v) > 0.05 * float(np.max(np.abs(v)))
+    sgn = np.sign(v)
+    idx = np.flatnonzero((sgn[1:] * sgn[:-1] < 0.0))
+    slopes = []
+    for k in idx:
+        s = sgn[k + 1]
+        end = k + 1 + int(np.argmax(moving[k + 1:])) if np.any(moving[k + 1:]) else data.x.size - 1
+        seg = slice(k, max(end, k + 3))
+        Fs, xseg = F[seg], xs[seg]
+        if xseg.size < 4:
+            continue
+        span = float(np.ptp(Fs))
+        near = np.abs(Fs - Fs[0]) <= span / 3.0
+        if np.count_nonzero(near) < _RESOLVED or np.ptp(xseg[near]) <= 0.0:
+            continue
+        slope = np.polyfit(xseg[near], Fs[near], 1)[0] * s
+        if slope > 0.0:
+            slopes.append(slope)
+    if not slopes:
+        return None
+    return float(np.median(slopes)), len(slopes)

@@ -99,8 +99,7 @@ def _units_function(model: FrictionModel, space: ParameterSpace, mass_free: bool
     scale = ca.SX.sym("scale", space.n_free)
     fixed = ca.SX.sym("fixed", len(space.fixed))
     mass_in = ca.SX.sym("mass")
-    values = {n: theta[i] * scale[i] for i, n in enumerate(space.free)}
-    values.update({n: fixed[i] for i, n in enumerate(space.fixed)})
+    values = space.symbols(theta, fixed, scale)
     mass = values["mass"] if mass_free else mass_in
     sigma, Fc, q = symbolic_units(model, values, mass)
     off = values.get("offset", 0.0)

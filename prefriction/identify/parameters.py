@@ -82,8 +82,31 @@ def _structure_bound(model: FrictionModel, name: str, value: float) -> tuple[str
     return "the declared range", "the declared range"
 
 
+def _relations(model: FrictionModel) -> list[tuple[str, str]]:
+    """``(low, high)`` entry names with ``value[high] >= value[low]`` required by the model's
+    constructor: ``Fs >= Fc`` of LuGre and GMS (each term of a sum under its qualified names)."""
+    from prefriction.models.gms import GMS
+    from prefriction.models.lugre import LuGre
+    from prefriction.models.parallel import Parallel
+
+    if isinstance(model, Parallel):
+        entries = _entries(model)
+        out = []
+        for i, m in enumerate(model.models):
+            local = {e.local: e.name for e in entries if e.part == i}
+            out += [(local[a], local[b]) for a, b in _relations(m)]
+        return out
+    return [("Fc", "Fs")] if isinstance(model, (LuGre, GMS)) else []
+
+
 class ParameterSpace:
     """Which of a model's parameters (and the mass) a fit moves, their start values and bounds.
+
+    Relations between parameters that the model's constructor checks (``Fs >= Fc`` of LuGre
+    and GMS) are part of the problem, so a fit always returns a model that constructs: with
+    ``Fs`` fixed, ``Fc`` is bounded by it (and ``Fs`` by a fixed ``Fc``); with both free, the
+    fit moves ``Fc`` and the excess ``Fs - Fc >= 0`` (bounded below by 0), and the statistics are
+    transformed back to ``Fs`` (:meth:`physical_jacobian`).
 
     Parameters
     ----------
@@ -99,8 +122,10 @@ class ParameterSpace:
         Start value [kg] of a fitted mass (``"mass"`` becomes a free entry); ``None`` if the mass
         is known or not involved.
     offset : float or None
-        Scale [N] of a fitted force offset (``"offset"`` becomes a free entry, started at 0 and
-        moved as ``offset / scale``); ``None`` for no offset.
+        Scale [N] of a fitted force offset (``"offset"`` becomes a free entry, started at
+        ``offset0`` and moved as ``offset / scale``); ``None`` for no offset.
+    offset0 : float, default 0.0
+        Start value [N] of the fitted offset.
 
     Raises
     ------
@@ -110,13 +135,14 @@ class ParameterSpace:
     """
 
     def __init__(self, model: FrictionModel, free: Sequence[str] | None, fixed: Sequence[str] | None,
-                 bounds: dict | None, mass: float | None = None, offset: float | None = None) -> None:
+                 bounds: dict | None, mass: float | None = None, offset: float | None = None,
+                 offset0: float = 0.0) -> None:
         self.model = model
         entries = _entries(model)
         if mass is not None:
             entries.append(_Entry("mass", "mass", None, "kg", float(mass), _OPEN * float(mass), math.inf))
         if offset is not None:
-            entries.append(_Entry("offset", "offset", None, "N", 0.0, -math.inf, math.inf))
+            entries.append(_Entry("offset", "offset", None, "N", float(offset0), -math.inf, math.inf))
         self.entries = entries
         names = [e.name for e in entries]
         free_l = _names("free", free, names, model)
@@ -147,10 +173,33 @@ class ParameterSpace:
             self.why_low[e.name], self.why_high[e.name] = _structure_bound(owner, e.local or e.name, e.value)
         for name, lim in _bound_items(bounds):
             self._set_bound(name, lim, names)
+        self.excess: dict[str, str] = {}
+        """``{high: low}`` of the relations with both ends free: ``high`` is moved as ``high - low``."""
+        for lo_name, hi_name in _relations(model):
+            self._relate(lo_name, hi_name)
         for name in self.free:
             if self._scale[name] == 0.0:
                 raise ValueError(f"the start value of {name} is 0: a fitted parameter needs a non-zero start "
                                  f"value (its scale); give the model a small positive {name}")
+
+    def _relate(self, lo_name: str, hi_name: str) -> None:
+        """Make ``value[hi_name] >= value[lo_name]`` part of the problem (see the class text)."""
+        free = set(self.free)
+        why = f"{hi_name} >= {lo_name}"
+        if lo_name in free and hi_name not in free:
+            if self.start[hi_name] < self.high[lo_name]:
+                self.high[lo_name], self.why_high[lo_name] = self.start[hi_name], f"the fixed {hi_name} ({why})"
+            if self.start[lo_name] > self.high[lo_name]:
+                raise ValueError(f"the start value {lo_name} = {self.start[lo_name]!r} exceeds the fixed "
+                                 f"{hi_name} = {self.start[hi_name]!r}: the model needs {why}")
+        elif hi_name in free and lo_name not in free:
+            if self.start[lo_name] > self.low[hi_name]:
+                self.low[hi_name], self.why_low[hi_name] = self.start[lo_name], f"the fixed {lo_name} ({why})"
+        elif hi_name in free and lo_name in free:
+            self.excess[hi_name] = lo_name
+            gap = self.start[hi_name] - self.start[lo_name]
+            self._scale[hi_name] = gap if gap > _OPEN * abs(self.start[hi_name]) else 0.1 * abs(self.start[hi_name])
+            self.why_low[hi_name] = f"{lo_name} ({why})"
 
     def _set_bound(self, name: str, lim: Any, names: list[str]) -> None:
         if name not in names:
@@ -177,40 +226,78 @@ class ParameterSpace:
 
     @property
     def scale(self) -> np.ndarray:
-        """Scales of the free entries (their start values; the offset's force scale): the fit
-        moves ``theta = p / scale``."""
+        """Scales of the free entries (their start values; the offset's force scale; the start
+        excess of a related ``high`` entry): the fit moves ``theta = p / scale``
+        (``theta = (p_high - p_low) / scale`` for a related pair)."""
         return np.array([self._scale[n] for n in self.free])
 
     @property
     def theta0(self) -> np.ndarray:
-        """The scaled start values ``p_start / scale`` (1, or 0 for the offset)."""
-        return np.array([self.start[n] for n in self.free]) / self.scale
+        """The scaled start values (1, or ``offset0 / scale``, or the start excess over its scale)."""
+        return np.array([(self.start[n] - self.start[self.excess[n]]) / self._scale[n] if n in self.excess
+                         else self.start[n] / self._scale[n] for n in self.free])
 
     def theta_bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        """Bounds of the scaled free entries ``p / scale``."""
+        """Bounds of the scaled free entries (an excess: ``[0, inf)``)."""
         sc = self.scale
-        lo = np.array([self.low[n] for n in self.free]) / sc
-        hi = np.array([self.high[n] for n in self.free]) / sc
+        lo = np.array([0.0 if n in self.excess else self.low[n] / sc[i] for i, n in enumerate(self.free)])
+        hi = np.array([math.inf if n in self.excess else self.high[n] / sc[i] for i, n in enumerate(self.free)])
         return np.minimum(lo, hi), np.maximum(lo, hi)
 
     def fixed_values(self) -> np.ndarray:
         return np.array([self.start[n] for n in self.fixed])
 
-    def symbols(self, theta: Any, fixed: Any) -> dict[str, Any]:
-        """Physical values by name from the scaled free entries and the fixed values (symbols)."""
+    def symbols(self, theta: Any, fixed: Any, scale: Any = None) -> dict[str, Any]:
+        """Physical values by name from the scaled free entries and the fixed values (CasADi
+        symbols or numbers); ``scale`` defaults to :attr:`scale`."""
+        scale = self.scale if scale is None else scale
         out = {}
         for i, n in enumerate(self.free):
-            out[n] = theta[i] * self._scale[n]
+            out[n] = theta[i] * scale[i]
         for i, n in enumerate(self.fixed):
             out[n] = fixed[i]
+        for hi_name, lo_name in self.excess.items():
+            out[hi_name] = out[lo_name] + out[hi_name]
         return out
 
     def values(self, theta: np.ndarray) -> dict[str, float]:
-        """Physical values by name of the scaled free entries ``theta`` (fixed ones at start)."""
+        """Physical values by name of the scaled free entries ``theta`` (fixed ones at start),
+        clipped to the allowed ranges (a value a rounding error past a bound is the bound)."""
         out = dict(self.start)
+        sc = self.scale
         for i, n in enumerate(self.free):
-            out[n] = float(theta[i]) * self._scale[n]
+            out[n] = min(max(float(theta[i]) * sc[i], self.low[n]), self.high[n]) if n not in self.excess \
+                else max(float(theta[i]) * sc[i], 0.0)
+        for hi_name, lo_name in self.excess.items():
+            out[hi_name] = min(out[lo_name] + out[hi_name], self.high[hi_name])
         return out
+
+    def limits(self, values: dict[str, float]) -> tuple[dict[str, float], dict[str, float]]:
+        """The allowed range of every entry at ``values``: a related ``high`` entry moved as an
+        excess is bounded below by its partner's value."""
+        low = dict(self.low)
+        for hi_name, lo_name in self.excess.items():
+            low[hi_name] = max(low[hi_name], values[lo_name])
+        return low, dict(self.high)
+
+    def physical_jacobian(self, J: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``J`` (columns: the scaled free entries first) with respect to ``p / s`` instead,
+        ``s`` the start values (the offset's force scale), and ``s``: what the statistics of the
+        physical parameters need when a related pair is moved as an excess."""
+        s = np.array([abs(self.start[n]) if n in self.excess else self._scale[n] for n in self.free])
+        if not self.excess:
+            return J, s
+        k = self.n_free
+        M = np.eye(k)
+        sc = self.scale
+        for hi_name, lo_name in self.excess.items():
+            i, j = self.free.index(hi_name), self.free.index(lo_name)
+            M[i, i] = s[i] / sc[i]       # d theta_excess / d (p_high / s_high)
+            M[i, j] = -s[j] / sc[i]      # d theta_excess / d (p_low / s_low)
+            M[j, j] = s[j] / sc[j]
+        J = np.array(J, dtype=float, copy=True)
+        J[:, :k] = J[:, :k] @ M
+        return J, s
 
     def build(self, values: dict[str, float]) -> FrictionModel:
         """A model of the start model's class with ``values`` (the constructor validates them).

@@ -93,8 +93,7 @@ class PrescribedProblem:
         v_end0 = ca.MX.sym("v_end0")
         v_ref = ca.MX.sym("v_ref")
         F_data = ca.MX.sym("F", n)
-        values = {name: w[i] * scale[i] for i, name in enumerate(space.free)}
-        values.update({name: fixed[i] for i, name in enumerate(space.fixed)})
+        values = space.symbols(w, fixed, scale)
         sigma, Fc, q = symbolic_units(model, values, 1.0)
         T = ca.sqrt(1.0 / sigma)      # time unit for a unit mass (the mass drops out of F(x))
         V = Fc / ca.sqrt(sigma)       # velocity unit

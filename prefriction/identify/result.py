@@ -62,6 +62,9 @@ class FitResult:
         interval was cut.
     notes : tuple of str
         What the fit compared (both Dahl structures) and other remarks.
+    start : tuple of str
+        What the start pipeline of a :class:`Motion` fit did, one line per step: what was set and
+        from what (the user's value, a static least-squares estimate, a continuation stage).
     """
 
     model: FrictionModel
@@ -82,6 +85,7 @@ class FitResult:
     success: bool = True
     flags: tuple[str, ...] = ()
     notes: tuple[str, ...] = ()
+    start: tuple[str, ...] = ()
 
     @cached_property
     def diagnostics(self) -> "ResidualDiagnostics":

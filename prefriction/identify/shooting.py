@@ -5,9 +5,11 @@ node with a free position, velocity and model state and is simulated sample by s
 (:mod:`prefriction.identify.motion_step`: ``m x'' + F + F_off = u`` (2.1), the applied force held
 or linear over each sample as the data say, reversals located inside the sub-steps); the end
 of a segment must meet the next node. The objective is the sum of squared position residuals,
-minimised by constrained Gauss-Newton on sparse matrices
-(:mod:`prefriction.identify.constrained_lsq`), with forward sensitivities propagated sample
-by sample. Nothing holds more than a few numbers per sample and sensitivity column, so the
+minimised subject to the continuity of the segments by scipy's trust-region least squares in an
+augmented Lagrangian on sparse matrices (:mod:`prefriction.identify.constrained_lsq`), with
+forward sensitivities propagated sample by sample. A record longer than ``2 WINDOW`` samples
+fits its :data:`WINDOW` samples with the most reversals first and starts the full record from
+their estimates (continuation). Nothing holds more than a few numbers per sample and sensitivity column, so the
 time and the memory of a fit grow linearly with the samples (measured:
 ``docs/identify_motion.md``).
 
@@ -18,6 +20,7 @@ sensitivities node to node gives it with respect to the parameters and the first
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import sys
 from dataclasses import dataclass
@@ -40,6 +43,12 @@ __all__ = ["LONG", "SEGMENT", "MotionSolution", "fit_motion"]
 
 SEGMENT = 50
 """Samples per shooting segment."""
+GTOL = 1e-5
+"""Largest continuity defect of a converged fit, in the node scales (``1e-5`` of the pre-sliding
+distance ``Fc / sigma`` in position, of the velocity unit, of the normalised state)."""
+WINDOW = 2_000
+"""Samples of the window a longer record fits first (continuation): the full record starts from
+its estimates, so it needs few iterations and its cost stays linear in the samples."""
 LONG = 5_000
 """Records of at least this many samples report each iteration on stderr (long work)."""
 _NODE_WINDOW = 7
@@ -58,6 +67,8 @@ class MotionSolution:
     prediction: np.ndarray
     nuisance: dict
     message: str
+    success: bool = True
+    steps: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -256,15 +267,13 @@ def _progress(line: str) -> None:
 
 
 def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_sub: int | None, max_iter: int,
-               tol: float, reversals: Any = None, offset0: float = 0.0, verbose: bool = False) -> MotionSolution:
+               tol: float, reversals: Any = None, verbose: bool = False) -> MotionSolution:
     """Multiple-shooting least-squares fit of ``space``'s free parameters to ``data``.
 
     Parameters
     ----------
-    offset0 : float, default 0.0
-        Start value of a fitted force offset [N] (if ``"offset"`` is a free entry of ``space``).
     verbose : bool, default False
-        One line per Gauss-Newton iteration on stderr (always for records of :data:`LONG`
+        One line per outer iteration of the solver on stderr (always for records of :data:`LONG`
         samples or more).
 
     Raises
@@ -273,25 +282,73 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
         If the model has in-branch events (not supported for motion data) or given reversal
         times are invalid.
     prefriction.SolverError
-        If the residuals are not finite at the start or Gauss-Newton does not converge; the
-        message says where and what to try.
+        If the motion is not finite at the start values (a fit that does not converge returns
+        with ``success = False`` instead).
     """
     if model.n_events or model.n_flags:
         raise ValueError(f"Motion fits support models without in-branch events or flags (Dahl with gamma >= 1, "
                          f"LuGre, ElastoPlastic(..., crossings=False)); {type(model).__name__} has {model.n_events} events: "
                          f"fit it to ForceDisplacement data{_without_events(model)}")
+    steps: list[str] = []
+    theta0 = space.theta0
+    progress = _progress if verbose or len(data) >= LONG else None
+    if len(data) > 2 * WINDOW:
+        k0 = _busiest_window(data)
+        part = slice(k0, k0 + WINDOW)
+        head = Motion(data.t[part], data.x[part], data.u[part], data.mass, data.hold)
+        given = None if reversals is None else [r for r in reversals if head.t[0] < r < head.t[-1]]
+        first = _solve_record(model, head, space, theta0, n_sub, max_iter, tol, given, progress, 0.01)
+        if first.success:
+            theta0 = first.w[: space.n_free]
+            vals = space.values(theta0)
+            model = space.build(vals)  # the sub-steps of the full record from the window's estimates
+            steps.append(f"continuation: samples {k0} to {k0 + WINDOW - 1} fitted first ({first.message}); the "
+                         f"full record started from their estimates ({_at(space, first.w)})")
+        else:
+            steps.append(f"continuation: the fit of samples {k0} to {k0 + WINDOW - 1} did not converge "
+                         f"({first.message}); the full record started from the start values")
+    sol = _solve_record(model, data, space, theta0, n_sub, max_iter, tol, reversals, progress,
+                        0.01 if not steps or "did not" in steps[0] else 10.0)
+    return dataclasses.replace(sol, steps=tuple(steps))
+
+
+def _busiest_window(data: Motion) -> int:
+    """First sample of the :data:`WINDOW`-sample window (starts every ``WINDOW / 4`` samples) with
+    the most velocity reversals of the smoothed positions, then the most travel: the part of the
+    record that excites the friction most."""
+    _x, v, _a = derivatives(data.t, data.x)
+    moving = np.abs(v) > 0.05 * float(np.max(np.abs(v)))
+    sv = np.where(moving, np.sign(v), 0.0)
+    nz = np.flatnonzero(sv)
+    flips = np.zeros(len(data))
+    flips[nz[1:][sv[nz[1:]] != sv[nz[:-1]]]] = 1.0
+    travel = np.abs(np.diff(data.x, prepend=data.x[0]))
+    best, key = 0, (-1.0, -1.0)
+    for k in range(0, len(data) - WINDOW + 1, WINDOW // 4):
+        cand = (float(flips[k:k + WINDOW].sum()), float(travel[k:k + WINDOW].sum()))
+        if cand > key:
+            best, key = k, cand
+    return best
+
+
+def _solve_record(model: FrictionModel, data: Motion, space: ParameterSpace, theta0: np.ndarray,
+                  n_sub: int | None, max_iter: int, tol: float, reversals: Any, progress: Any,
+                  weight: float) -> MotionSolution:
+    """One multiple-shooting fit of ``data`` from the scaled parameters ``theta0``; ``model``
+    (values at ``theta0``) sets the node scales and the sub-steps."""
     mass_free = "mass" in space.start and "mass" in space.free
-    mass = space.start["mass"] if "mass" in space.start else float(data.mass)
+    mass = space.values(theta0)["mass"] if mass_free else float(data.mass)
     xsm, v, a = derivatives(data.t, data.x, _NODE_WINDOW)
     directions = _directions(data.t, data.x, v, reversals)
     n_sub = _substeps(model, data, mass, float(np.max(np.abs(v))), n_sub)
     X, V = model.Fc / model.sigma, model.Fc / math.sqrt(mass * model.sigma)
+    offset0 = space.values(theta0).get("offset", 0.0)
     lay = _layout(data, min(SEGMENT, len(data) - 1), directions, np.array([X, V]))
     xs = max(float(np.ptp(data.x)) * 1e-3, 1e-300)
     prob = _Problem(model, space, data, lay, n_sub, mass_free, mass, xs)
     single = segment_functions(model, space, lay.K, n_sub, mass_free)[0]
     for level in (0.5, 0.0):  # node states of the force balance, else of zero force (see _start)
-        w0 = prob.carry_states(_start(model, data, space, lay, xsm, v, a, mass, offset0, level), single)
+        w0 = prob.carry_states(_start(model, data, theta0, lay, xsm, v, a, mass, offset0, level), single)
         prob.weigh(w0)
         r0, g0 = prob.plain_eval(w0)
         if np.all(np.isfinite(r0)) and np.all(np.isfinite(g0)):
@@ -300,11 +357,15 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
         raise SolverError(f"the model's motion is not finite at the start values ({_at(space, w0)}); give start "
                           f"values closer to the data or bounds")
     lo, hi = space.theta_bounds()
-    out = solve(prob.full_eval, prob.plain_eval, w0, lo, hi, max_iter=max_iter, tol=tol,
-                progress=_progress if verbose or len(data) >= LONG else None)
-    if not out.success:
-        raise SolverError(f"the Motion fit did not converge ({out.message}), at {_at(space, out.w)}; try start "
-                          f"values closer to the data, bounds, fixing a parameter, more max_iter or a looser tol")
+
+    def restart(w: np.ndarray) -> np.ndarray:
+        th = w[: space.n_free]
+        at = space.values(th)
+        fresh = _start(space.build(at), data, th, lay, xsm, v, a, at.get("mass", mass), at.get("offset", 0.0), 0.5)
+        return prob.carry_states(fresh, single)
+
+    out = solve(prob.full_eval, prob.plain_eval, w0, lo, hi, max_iter=max_iter, tol=tol, gtol=GTOL,
+                weight=weight, restart=restart, progress=progress)
     w = out.w
     r, _g, res = prob.residuals(w)
     Jred = prob.reduced_jacobian(w)
@@ -313,8 +374,8 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
     vel = Xv[1, prob.rows]
     nuisance = _nuisance(model, space, w, prob, data, vel, mass_free, mass)
     return MotionSolution(w, r * xs, Jred * xs, None, pred, nuisance,
-                          f"Gauss-Newton (multiple shooting, {lay.J} segments of {lay.K} samples, {n_sub} RK4 "
-                          f"sub-steps per sample): {out.message}")
+                          f"multiple shooting, {lay.J} segments of {lay.K} samples, {n_sub} RK4 sub-steps per "
+                          f"sample, scipy least_squares in an augmented Lagrangian: {out.message}", out.success)
 
 
 def _at(space: ParameterSpace, w: np.ndarray) -> str:
@@ -334,13 +395,11 @@ def _directions(t: np.ndarray, x: np.ndarray, v: np.ndarray, given: Any) -> np.n
     return s
 
 
-def _start(model: FrictionModel, data: Motion, space: ParameterSpace, lay: _Layout, xsm: np.ndarray,
+def _start(model: FrictionModel, data: Motion, theta: np.ndarray, lay: _Layout, xsm: np.ndarray,
            v: np.ndarray, a: np.ndarray, mass: float, offset0: float, level: float) -> np.ndarray:
     """Start vector: scaled parameters, then each node's ``[x / X, v / V, z]`` from the smoothed
     data, ``z`` the state of the force balance's friction ``u - m a - F_off`` clipped to
     ``+-level Fc``."""
-    theta = np.array([offset0 / space.scale[i] if n == "offset" else space.start[n] / space.scale[i]
-                      for i, n in enumerate(space.free)])
     X, V = lay.scl
     nodes = []
     for k, s in zip(lay.nodes, lay.s):

@@ -4,11 +4,11 @@ The classic steady-sliding friction (FrictionModels.jl ``CoulombModel``, ``Visco
 ``StribeckModel``; Olsson et al., *Friction models and friction compensation*, Eur. J. Control
 4(3), 1998, (7))::
 
-    F(v) = s (Fc_s + (Fs_s - Fc_s) exp(-|v / vs|^delta)) + b v,   s = sign(v),      (1)
+    F(v) = s (Fc_s + (Fs_s - Fc_s) exp(-|v / vs|^delta)) + b_s v,   s = sign(v),      (1)
 
-with the Coulomb level ``Fc_s`` and the static level ``Fs_s`` of the direction ``s``: the same
-for both directions by default, ``Fc_neg``, ``Fs_neg`` for ``v < 0`` when given (EMPS and most
-drives are asymmetric). Without ``Fs`` the map is Coulomb + viscous, linear in its parameters.
+with the Coulomb level ``Fc_s``, the static level ``Fs_s`` and the viscous coefficient ``b_s`` of
+the direction ``s``: the same for both directions by default, ``Fc_neg``, ``Fs_neg``, ``b_neg``
+for ``v < 0`` when given (EMPS and most drives are asymmetric). Without ``Fs`` the map is Coulomb + viscous, linear in its parameters.
 Fitted to :class:`prefriction.identify.ForceVelocity` data by :func:`prefriction.identify.fit`.
 """
 
@@ -23,7 +23,8 @@ from prefriction._validation import check_nonnegative, check_positive
 
 __all__ = ["StaticFriction"]
 
-_UNITS = {"Fc": "N", "b": "N s/m", "Fs": "N", "vs": "m/s", "delta": "-", "Fc_neg": "N", "Fs_neg": "N"}
+_UNITS = {"Fc": "N", "b": "N s/m", "Fs": "N", "vs": "m/s", "delta": "-", "Fc_neg": "N", "Fs_neg": "N",
+          "b_neg": "N s/m"}
 
 
 @dataclass(frozen=True)
@@ -47,6 +48,8 @@ class StaticFriction:
     Fc_neg, Fs_neg : float or None, default None
         Coulomb and static force magnitudes [N] for ``v < 0``; ``None``: the same as for ``v > 0``.
         ``Fs_neg`` needs ``Fs``.
+    b_neg : float or None, default None
+        Viscous coefficient [N s/m] for ``v < 0``, ``0 <= b_neg < inf``; ``None``: ``b``.
 
     Raises
     ------
@@ -71,11 +74,14 @@ class StaticFriction:
     delta: float = 2.0
     Fc_neg: float | None = None
     Fs_neg: float | None = None
+    b_neg: float | None = None
 
     def __post_init__(self) -> None:
         for name in ("Fc", "vs", "delta") + tuple(n for n in ("Fs", "Fc_neg", "Fs_neg") if getattr(self, n) is not None):
             object.__setattr__(self, name, check_positive(name, getattr(self, name)))
         object.__setattr__(self, "b", check_nonnegative("b", self.b))
+        if self.b_neg is not None:
+            object.__setattr__(self, "b_neg", check_nonnegative("b_neg", self.b_neg))
         if self.Fs_neg is not None and self.Fs is None:
             raise ValueError(f"Fs_neg = {self.Fs_neg!r} needs a Stribeck term: give Fs too (or Fs_neg=None)")
 
@@ -83,7 +89,7 @@ class StaticFriction:
     def names(self) -> tuple[str, ...]:
         """The parameters the map uses (``Fs``, ``vs``, ``delta`` only with a Stribeck term)."""
         out = ["Fc", "b"] + (["Fs", "vs", "delta"] if self.Fs is not None else [])
-        return tuple(out + [n for n in ("Fc_neg", "Fs_neg") if getattr(self, n) is not None])
+        return tuple(out + [n for n in ("Fc_neg", "Fs_neg", "b_neg") if getattr(self, n) is not None])
 
     @staticmethod
     def unit(name: str) -> str:
@@ -96,7 +102,7 @@ class StaticFriction:
 
     def replace(self, values: dict[str, float]) -> "StaticFriction":
         """A map with ``values`` (by name) in place of these (checked as on construction)."""
-        kw = {n: getattr(self, n) for n in ("Fc", "b", "Fs", "vs", "delta", "Fc_neg", "Fs_neg")}
+        kw = {n: getattr(self, n) for n in ("Fc", "b", "Fs", "vs", "delta", "Fc_neg", "Fs_neg", "b_neg")}
         kw.update(values)
         return StaticFriction(**kw)
 
@@ -114,8 +120,13 @@ class StaticFriction:
         col = {n: i for i, n in enumerate(names)}
         lv = {"Fc": np.where(pos, self.Fc, self.Fc if self.Fc_neg is None else self.Fc_neg)}
         cname = np.where(pos, "Fc", "Fc" if self.Fc_neg is None else "Fc_neg")
-        F = self.b * v
-        J[:, col["b"]] = v
+        if self.b_neg is None:
+            F = self.b * v
+            J[:, col["b"]] = v
+        else:
+            F = np.where(pos, self.b, self.b_neg) * v
+            J[:, col["b"]] = np.where(pos, v, 0.0)
+            J[:, col["b_neg"]] = np.where(pos, 0.0, v)
         if self.Fs is None:
             F = F + s * lv["Fc"]
             for n in set(cname.tolist()):

@@ -2,9 +2,11 @@
 
 A stage of mass ``m`` moved by a digital PD loop at ``1 / dt``: at each sample ``k`` the loop
 reads the encoder (the position rounded to steps of ``quantum``), computes
-``u_k = Kp (r_k - x_k) - Kd (x_k - x_{k-1}) / dt`` [N] and holds it until the next sample; the
-stage obeys ``m x'' + F + F_off = u`` (2.1) with the friction ``F`` of a LuGre model
-(Canudas de Wit et al. 1995, (1)-(3)) or a Dahl model (3.2) with a viscous term ``b v``. scipy's
+``u_k = Kp (r_k - x_k) - Kd sum_j c_j (x_{k-j} - x_{k-j-1}) / dt`` [N] (velocity filter taps
+``c``, default one: the backward difference) and applies ``u_{k-d}`` (``d`` samples of delay,
+default 0) until the next sample; the stage obeys ``m x'' + F + F_off = u`` (2.1) with the
+friction ``F`` of a LuGre model (Canudas de Wit et al. 1995, (1)-(3)) or a Dahl model (3.2) with
+a viscous term ``b v`` (``b_neg v`` for ``v < 0`` if given). scipy's
 ``solve_ivp`` (LSODA, ``rtol = 1e-10``) integrates each sample interval separately (``u`` jumps
 at the samples) and restarts at every velocity reversal inside it (a terminal event; ``|v|`` has
 its kink there). The reference is a series of point-to-point moves with cosine velocity
@@ -51,6 +53,12 @@ class ClosedLoop:
     noise : float
         Standard deviation [m] of Gaussian noise added to the position before the encoder
         rounds it (0: rounding only).
+    taps : tuple of float
+        Velocity filter of the loop (EMPS: ``(0.5, 0.5)``).
+    delay : int
+        Samples between computing a force and applying it.
+    b_neg : float or None
+        Viscous coefficient [N s/m] of a Dahl stage for ``v < 0`` (``None``: ``b``).
     """
 
     friction: FrictionModel
@@ -62,6 +70,9 @@ class ClosedLoop:
     quantum: float = 5e-8
     dt: float = 1e-3
     noise: float = 0.0
+    taps: tuple = (1.0,)
+    delay: int = 0
+    b_neg: float | None = None
 
 
 def reference_moves(n: int, dt: float, rng: np.random.Generator, stroke: float = 0.2) -> np.ndarray:
@@ -93,10 +104,13 @@ def _rhs(loop: ClosedLoop):
             return [v, (u - F - loop.offset) / m, dz]
         return rhs
     if isinstance(f, Dahl) and f.gamma >= 1.0:
+        b_neg = loop.b if loop.b_neg is None else loop.b_neg
+
         def rhs(_t: float, y: np.ndarray, u: float) -> list[float]:
             v, F = y[1], y[2]
             gap = max(1.0 - np.sign(v) * F / f.Fc, 0.0)
-            return [v, (u - F - loop.b * v - loop.offset) / m, f.sigma * v * gap ** f.gamma]
+            b = loop.b if v > 0.0 else b_neg
+            return [v, (u - F - b * v - loop.offset) / m, f.sigma * v * gap ** f.gamma]
         return rhs
     raise TypeError(f"friction must be a LuGre or a Dahl model with gamma >= 1, got {f!r}")
 
@@ -118,7 +132,8 @@ def closed_loop_record(loop: ClosedLoop, n: int, rng: np.random.Generator, *, rt
     Returns
     -------
     Motion
-        Encoder positions, the held motor force ``u`` (``hold="zoh"``) and the known mass.
+        Encoder positions, the computed motor force ``u`` (``hold="zoh"``; applied ``loop.delay``
+        samples later) and the known mass.
     """
     rhs = _rhs(loop)
     dt = loop.dt
@@ -126,15 +141,18 @@ def closed_loop_record(loop: ClosedLoop, n: int, rng: np.random.Generator, *, rt
     x = np.empty(n)
     u = np.empty(n)
     y = np.array([r[0], 0.0, 0.0])
-    xq_prev = np.round(r[0] / loop.quantum) * loop.quantum
+    taps = len(loop.taps)
+    past = [np.round(r[0] / loop.quantum) * loop.quantum] * taps   # x_{k-1}, ..., x_{k-taps}
     e = loop.noise * rng.standard_normal(n)
     for k in range(n):
         xq = np.round((y[0] + e[k]) / loop.quantum) * loop.quantum
         x[k] = xq
-        u[k] = loop.Kp * (r[k] - xq) - loop.Kd * (xq - xq_prev) / dt
-        xq_prev = xq
+        xs = [xq] + past
+        u[k] = loop.Kp * (r[k] - xq) - loop.Kd * sum(c * (xs[j] - xs[j + 1]) for j, c in enumerate(loop.taps)) / dt
+        past = xs[:taps]
         if k < n - 1:
-            y = _interval(rhs, y, k * dt, (k + 1) * dt, u[k], rtol)
+            applied = u[k - loop.delay] if k >= loop.delay else 0.0
+            y = _interval(rhs, y, k * dt, (k + 1) * dt, applied, rtol)
     return Motion(np.arange(n) * dt, x, u, loop.mass, hold="zoh")
 
 

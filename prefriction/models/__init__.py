@@ -13,6 +13,7 @@
 - ``element_curves.py``: the virgin curve of parallel elements and the energies on its branches;
 - ``stribeck.py``: the Stribeck curve of GMS, in SI units and normalised;
 - :class:`Viscous` (``viscous.py``): viscous friction ``F = b v``;
+- :class:`DirectionalViscous` (``directional.py``): a viscous coefficient per direction;
 - :class:`Parallel` (``parallel.py``): models in parallel, ``a + b`` (forces summed);
 - :class:`Oscillator` (``oscillator.py``): mass, friction model and input force.
 """
@@ -25,7 +26,9 @@ from prefriction.models.lugre import LuGre
 from prefriction.models.maxwell_slip import MaxwellSlip
 from prefriction.models.parallel import Parallel
 from prefriction.models.viscous import Viscous
+from prefriction.models.directional import DirectionalViscous
 from prefriction.models.oscillator import Oscillator, check_dahl_oscillator, check_oscillator
 
-__all__ = ["Dahl", "ElastoPlastic", "FrictionModel", "GMS", "LuGre", "MaxwellSlip", "Oscillator", "Parallel", "Parameter", "Viscous",
+__all__ = ["Dahl", "DirectionalViscous", "ElastoPlastic", "FrictionModel", "GMS", "LuGre", "MaxwellSlip", "Oscillator",
+           "Parallel", "Parameter", "Viscous",
            "check_dahl_oscillator", "check_oscillator"]

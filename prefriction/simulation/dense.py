@@ -3,7 +3,7 @@
 The samples go into a :class:`SampleBuffer`: one preallocated float column per quantity, grown
 in place (``ndarray.resize``) to an estimate of the final count and trimmed in place at the end,
 so a run's memory stays close to the arrays it returns (no Python float or tuple per sample).
-Outputs of one integrator call (:data:`~prefriction.simulation.run.N_DENSE` of them) are
+Outputs of one integrator call (:data:`N_DENSE` of them) are
 converted together; only the columns with a reversal and the last one go through the run's
 per-column bookkeeping.
 """
@@ -15,15 +15,15 @@ from typing import TYPE_CHECKING, Iterator, Optional, Sequence
 
 import numpy as np
 
-from prefriction.simulation.run import N_DENSE
-
 if TYPE_CHECKING:
     from prefriction.simulation.run import Run
 
-__all__ = ["DENSE_STEP", "SampleBuffer", "dense", "dense_loop", "samples_si"]
+__all__ = ["DENSE_STEP", "N_DENSE", "SampleBuffer", "dense", "dense_loop", "samples_si"]
 
 DENSE_STEP = 2.0 * np.pi / 64.0
 """Normalised spacing of ``dense=True`` samples (64 per small cycle)."""
+N_DENSE = 16
+"""Output times per call of the dense-output integrator."""
 
 _BLOCK = 4096  # requested times integrated per pass (bounds the temporaries of the time grid)
 _MIN_CAPACITY = 1024

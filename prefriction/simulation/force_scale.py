@@ -1,4 +1,5 @@
-"""Size of the applied force of a run, for the error-control scale of forced runs and loops."""
+"""Size of the applied force of a run, for the error-control scale of forced runs and loops, and
+the range of motion amplitudes a run accepts (:func:`check_amplitude`)."""
 
 from __future__ import annotations
 
@@ -11,6 +12,13 @@ from prefriction.signals import Chirp, Signal, Sine, Sum
 from prefriction.simulation.feedback import LinearFeedback
 from prefriction.models import Oscillator
 from prefriction.units import Scales
+
+MIN_AMPLITUDE = 1e-150
+"""Least nonzero amplitude of the motion (normalised units) that :func:`prefriction.simulate` accepts: the
+energies, ``A^2``, and the scaled states stay normal doubles."""
+MAX_AMPLITUDE = 1e100
+"""Largest amplitude of the motion (normalised units) that :func:`prefriction.simulate` accepts: energies
+``A^2`` and first excursions ``~A^2 / 2`` stay far from the double-precision range."""
 
 
 def applied_force_scale(system: Oscillator, fb: Optional[LinearFeedback], x0: float, t_end: float) -> float:
@@ -46,3 +54,24 @@ def motion_bound(u: Signal, t_end: float, t_unit: float) -> float:
     if isinstance(u, Chirp):
         return abs(u.amplitude) / max(1.0, 2.0 * math.pi * min(u.f0, u.f1) * t_unit)
     return u.bound(t_end)
+
+
+def check_amplitude(v0: float, F0: float, force_scale: float, sc: Scales) -> None:
+    """``ValueError`` if the motion is nonzero but smaller than :data:`MIN_AMPLITUDE` (normalised
+    initial velocity ``v0`` [m/s], force ``F0`` [N] and applied force scale): its scaled states, energies and steps
+    would leave the double-precision range (a denormal ``v0 = 5e-324`` m/s gave reversal times
+    12 % wrong, ``1e-300`` m/s a failed integrator); or larger than :data:`MAX_AMPLITUDE`."""
+    if abs(v0 / sc.v) > MAX_AMPLITUDE:
+        raise ValueError(f"v0 must satisfy |v0| <= {MAX_AMPLITUDE * sc.v:.3g} m/s ({MAX_AMPLITUDE:g} velocity units "
+                         f"Fc/sqrt(m sigma): energies stay in the double-precision range), got {v0!r}")
+    if force_scale > MAX_AMPLITUDE:
+        raise ValueError(f"the applied force (input u and feedback) must stay below {MAX_AMPLITUDE * sc.F:.3g} N "
+                         f"({MAX_AMPLITUDE:g} Fc), got a force scale of {force_scale * sc.F:.3g} N")
+    amplitude = max(math.hypot(v0 / sc.v, F0 / sc.F), force_scale)
+    if 0.0 < amplitude < MIN_AMPLITUDE:
+        raise ValueError(
+            f"v0 = {v0!r} m/s and F0 = {F0!r} N (with the applied force) give a motion of "
+            f"{amplitude:.3g} normalised units, too small to simulate in double precision: the amplitude "
+            f"hypot(v0 / (Fc/sqrt(m sigma)), F0 / Fc) must be 0 or >= {MIN_AMPLITUDE:g}, that is "
+            f"|v0| >= {MIN_AMPLITUDE * sc.v:.3g} m/s or |F0| >= {MIN_AMPLITUDE * sc.F:.3g} N"
+        )

@@ -12,7 +12,7 @@ import numpy as np
 from prefriction.models.sizes import check_sizes
 from prefriction.simulation.compiled import compiled, jit_available
 from prefriction.simulation.per_thread import PerThread
-from prefriction.simulation.plant import Layout, PlantSpec, build_integrator
+from prefriction.simulation.plant import PlantSpec, build_integrator
 
 _CACHE = PerThread()  # one Function per structure and process, its buffers per thread
 INTEGRATOR_FAILED = (
@@ -24,12 +24,13 @@ INTEGRATOR_FAILED = (
 class BufferedIntegrator:
     """A CasADi integrator with persistent argument and result arrays (calls cost ~2 us, not ~50 us)."""
 
-    def __init__(self, fun: ca.Function, L: Layout, n_out: int) -> None:
+    def __init__(self, fun: ca.Function) -> None:
         self.fun = fun
-        self.X0 = np.zeros(L.nx)
-        self.P = np.zeros(L.np)
-        self.U = np.zeros((n_out, L.nu))  # row j = column j of CasADi's column-major u
-        self.out = np.zeros(n_out * L.nx)
+        nx, n_p, (nu, n_out) = fun.size1_in(0), fun.size1_in(2), fun.size_in(3)  # the plant's Layout sizes
+        self.X0 = np.zeros(nx)
+        self.P = np.zeros(n_p)
+        self.U = np.zeros((n_out, nu))  # row j = column j of CasADi's column-major u
+        self.out = np.zeros(n_out * nx)
         self.buf, self.trigger = fun.buffer()
         self.buf.set_arg(0, memoryview(self.X0))
         self.buf.set_arg(2, memoryview(self.P))
@@ -43,7 +44,7 @@ def integrator(spec: PlantSpec, jit: bool) -> tuple[BufferedIntegrator, float, s
     inputs), called through buffers of the calling thread: runs in threads do not interfere."""
     jit = jit and jit_available()  # PREFRICTION_NO_JIT may change between calls
     call, (_, mode, setup), built = _CACHE.get(
-        (spec, jit), lambda: _build(spec, jit), lambda made: BufferedIntegrator(made[0], Layout(spec), spec.n_out))
+        (spec, jit), lambda: _build(spec, jit), lambda made: BufferedIntegrator(made[0]))
     if built:
         return call, setup, mode
     return call, 0.0, mode if mode == "interpreted" else "cached"
@@ -52,13 +53,14 @@ def integrator(spec: PlantSpec, jit: bool) -> tuple[BufferedIntegrator, float, s
 def _build(spec: PlantSpec, jit: bool) -> tuple[Any, str, float]:
     """The Function of ``spec`` (compiled or loaded from the cache if ``jit``), its mode and setup time."""
     start = time.perf_counter()
+    what = _describe(spec)  # for the compile message
     check_sizes(spec.model)  # a user model's sizes, once per structure
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", FutureWarning)
         fun = build_integrator(spec)
     mode = "interpreted"
     if jit:
-        fun, info = compiled(fun, _describe(spec))
+        fun, info = compiled(fun, what)
         mode = info.mode
     return fun, mode, time.perf_counter() - start
 

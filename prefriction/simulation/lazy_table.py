@@ -11,7 +11,7 @@ table (sweeps pack plain tables, :mod:`prefriction.simulation.packed`).
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Optional, Union
 
 import numpy as np
 
@@ -19,7 +19,7 @@ from prefriction.models import Oscillator
 from prefriction.reversals import ReversalTable
 from prefriction.units import Scales
 
-__all__ = ["LazyReversalTable", "energies"]
+__all__ = ["LazyReversalTable", "energies", "reversal_table"]
 
 _ENERGY_BLOCK = 4096  # reversals per branch_energy_of_force call: temporaries of ~2 MB (Dahl: 57 doubles each)
 
@@ -107,3 +107,22 @@ class _Columns:
 
     def __init__(self, t: Any, x: Any, F: Any, nan: np.ndarray) -> None:
         self.t, self.x, self.F, self.E_p, self.E_d, self.E_0 = t, x, F, nan, nan, 0.0
+
+
+def reversal_table(rev: Union[list, tuple], system: Oscillator, s0: float, v0: float, F0: float,
+                   sc: Optional[Scales] = None) -> tuple[ReversalTable, np.ndarray]:
+    """The reversals as a :class:`ReversalTable` in SI (its energies ``E_p`` (3.9), ``E_d``
+    (2.10), ``E_0`` computed on first use: :class:`LazyReversalTable`),
+    and the input's work over each half-cycle [J].
+
+    ``rev``: a list of ``(t~, x~, F~, W~)`` tuples, or the four columns
+    (:meth:`~prefriction.simulation.reversal_log.ReversalLog.columns`; writable columns are
+    converted to SI in place, so that a long run holds them once); ``sc``: the system's scales,
+    if known."""
+    sc = Scales.of(system) if sc is None else sc
+    if isinstance(rev, list):
+        R = np.array(rev, dtype=float).reshape(-1, 4)
+        rev = (R[:, 0], R[:, 1], R[:, 2], R[:, 3])
+    t_r, x_r, F_r, W_r = (np.multiply(col, unit, out=col if col.flags.writeable else None)
+                          for col, unit in zip(rev, (sc.t, sc.x, sc.F, sc.E)))
+    return LazyReversalTable(t_r, x_r, F_r, W_r, system, s0, v0, F0), W_r

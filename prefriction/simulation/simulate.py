@@ -23,8 +23,10 @@ factor such that the error of reversal times, positions and forces over 50 rever
 below ``rtol`` (``prefriction bench``); global errors grow linearly with the number of cycles,
 as for any one-step method.
 
-This module validates the arguments and assembles the result; the integration loop is
-:mod:`prefriction.simulation.run`, the compiled integrator and its buffers
+This module validates the arguments and assembles the result: the plant (its layout and
+driver) is built in :mod:`prefriction.simulation.build`, run by
+:func:`~prefriction.simulation.run.drive` in :mod:`prefriction.simulation.run`, the reversal table
+:mod:`prefriction.simulation.lazy_table`, the compiled integrator and its buffers
 :mod:`prefriction.simulation.integrator`, the force scale of forced runs
 :mod:`prefriction.simulation.force_scale`.
 """
@@ -39,17 +41,16 @@ import numpy as np
 
 from prefriction.signals import Constant, compiled_form
 from prefriction.simulation.feedback import LinearFeedback
-from prefriction.simulation.dense import SampleBuffer, dense_loop, samples_si
+from prefriction.simulation.dense import N_DENSE, samples_si
 from prefriction.simulation.rest import initial_direction
-from prefriction.simulation.native.forced import linear_pieces, run_forced
-from prefriction.simulation.run import N_DENSE, Run
-from prefriction.simulation.plant import Layout, PlantSpec
-from prefriction.simulation.force_scale import applied_force_scale
+from prefriction.simulation.run import RAMP_ROUNDOFF, Run, check_ramps, drive
+from prefriction.simulation.plant import PlantSpec
+from prefriction.simulation.force_scale import MAX_AMPLITUDE, MIN_AMPLITUDE, applied_force_scale, check_amplitude
 from prefriction.simulation.budget import check_input_budget
+from prefriction.simulation.build import build_plant
 from prefriction._validation import check_count, check_finite, check_positive
 from prefriction.models import Oscillator, check_oscillator
-from prefriction.reversals import ReversalTable
-from prefriction.simulation.lazy_table import LazyReversalTable
+from prefriction.simulation.lazy_table import reversal_table
 from prefriction.simulation.result import RunStats, SimulationResult
 from prefriction.units import Scales
 
@@ -63,20 +64,10 @@ and ``"erk"`` (CasADi's integrator, the reference the native driver is tested ag
 _K = 2  # reversals recorded per integrator call (register length; forced or dense runs)
 _MIN_ORDER = 2  # continuous controllers are padded to this order (one plant for P, PD, PID)
 _ZERO = Constant(0.0)  # the input of a sampled loop without an input force (the hold is added)
-MIN_AMPLITUDE = 1e-150
-"""Least nonzero amplitude of the motion (normalised units) that :func:`simulate` accepts: the
-energies, ``A^2``, and the scaled states stay normal doubles."""
-MAX_AMPLITUDE = 1e100
-"""Largest amplitude of the motion (normalised units) that :func:`simulate` accepts: energies
-``A^2`` and first excursions ``~A^2 / 2`` stay far from the double-precision range."""
 MAX_REVERSALS = 10**7
 """Most reversals of one :func:`simulate` call, requested or reached by ``t_end`` (the run holds
 its table in memory: about 100 bytes per reversal at the peak, so about 1 GB;
 ``docs/simulator.md#limits``)."""
-RAMP_ROUNDOFF = 0.3
-"""Largest force error from the round-off of the time in a ramp of the input force, in units of
-the run's error level ``eps`` times the force scale (:func:`simulate` refuses steeper ramps:
-they started spurious reversal pairs at a rest, or NaN in CasADi's event transition)."""
 MAX_PERIODS = 10**7
 """Most sample periods ``t_end / Ts`` of a sampled controller (one Python step and one sample each)."""
 _CAL = 0.1  # calibration of the run-time tolerance eps: global error over 50 reversals ~ 0.7 rtol
@@ -225,11 +216,18 @@ def simulate(
         method="erk", compact=True,
     )
     force_scale = applied_force_scale(system, feedback, x0, t_end_si) / Fc if forced else 0.0
-    _check_amplitude(v0, F0, force_scale, sc)
-    L = Layout(spec)
+    check_amplitude(v0, F0, force_scale, sc)
+    breaks = []
+    if system.forced:
+        breaks.append(np.asarray(system.u.breaks()) / sc.t)
+    if fb_kind == "continuous":
+        breaks.append(np.asarray(feedback.reference.breaks()) / sc.t)
+    breaks = _sample_times(np.unique(np.concatenate(breaks)) if breaks else np.zeros(0))
+    t_end_n = t_end_si / sc.t
+    plant = build_plant(system.friction, spec, feedback, jit, native=method == "native")
     # error control on states scaled by amplitude * eps (the plant's run-time tolerance)
-    eps = min(rtol, atol) * _CAL * math.sqrt(L.n_active / L.nx)
-    run = Run(system, spec, feedback, eps, jit, native=method == "native", sc=sc, L=L)
+    eps = min(rtol, atol) * _CAL * math.sqrt(plant.L.n_active / plant.L.nx)
+    run = Run(system, spec, feedback, eps, plant, sc=sc)
     run.eps_native = min(rtol, atol) * _CAL  # the native drivers' RMS norm runs over the active states only
     run.snap = rtol
     run.P0 = run._constant_params(run.L)
@@ -237,28 +235,11 @@ def simulate(
 
     xc0 = np.array(feedback.xc0, dtype=float) if feedback is not None else np.zeros(0)
     run.st, s0 = _initial_state(run, x0, v0, F0, xc0, stops=forced or t_end is not None)
-    breaks = []
-    if system.forced:
-        breaks.append(np.asarray(system.u.breaks()) / sc.t)
-    if fb_kind == "continuous":
-        breaks.append(np.asarray(feedback.reference.breaks()) / sc.t)
-    t_end_n = t_end_si / sc.t
-    run.breaks = _sample_times(np.unique(np.concatenate(breaks)) if breaks else np.zeros(0))
-    _check_ramps(run, t_end_n, rtol)
+    run.breaks = breaks
+    check_ramps(run, t_end_n, rtol)
 
     start = time.perf_counter()
-    u_hist: list = []
-    if run.native_forced is not None:
-        samples = SampleBuffer(0, len(times_si) if times_si is not None else 1024) if want_dense else []
-        run_forced(run, t_end_n, n_target, None if times_si is None else times_si / sc.t,
-                   samples if want_dense else None)
-    elif fb_kind == "sampled":
-        samples, u_hist = _sampled_loop(run, xc0, t_end_n, n_target)
-    elif want_dense:
-        samples = dense_loop(run, None if times_si is None else times_si / sc.t, t_end_n, n_target)
-    else:
-        samples = []
-        run.advance(t_end_n, n_target)
+    samples, u_hist = drive(run, t_end_n, n_target, None if times_si is None else times_si / sc.t, want_dense, xc0)
     if reversals is None and len(run.rev) >= n_target:
         raise ValueError(
             f"t_end = {t_end_si:.6g} s needs more than {MAX_REVERSALS:_} reversals (the reversal table is held in "
@@ -273,7 +254,7 @@ def simulate(
     wall = time.perf_counter() - start
 
     n_rev = int(min(len(run.rev), n_target))
-    table, W_r = _reversal_table(run.rev.columns(n_rev, writable=True), system, s0, v0, F0, run.sc)
+    table, W_r = reversal_table(run.rev.columns(n_rev, writable=True), system, s0, v0, F0, run.sc)
     events = np.array(run.rev_events[:n_rev], dtype=int)
     # after the last reversal: the events up to t_end (a run stopped at its reversal has none)
     total = int(events.sum()) + (int(run.st.get("ne", 0)) if len(run.rev) <= n_rev else 0)
@@ -284,25 +265,6 @@ def simulate(
                             events=events, **extra)
 
 
-def _check_amplitude(v0: float, F0: float, force_scale: float, sc: Scales) -> None:
-    """``ValueError`` if the motion is nonzero but smaller than :data:`MIN_AMPLITUDE` (normalised
-    initial velocity ``v0`` [m/s], force ``F0`` [N] and applied force scale): its scaled states, energies and steps
-    would leave the double-precision range (a denormal ``v0 = 5e-324`` m/s gave reversal times
-    12 % wrong, ``1e-300`` m/s a failed integrator); or larger than :data:`MAX_AMPLITUDE`."""
-    if abs(v0 / sc.v) > MAX_AMPLITUDE:
-        raise ValueError(f"v0 must satisfy |v0| <= {MAX_AMPLITUDE * sc.v:.3g} m/s ({MAX_AMPLITUDE:g} velocity units "
-                         f"Fc/sqrt(m sigma): energies stay in the double-precision range), got {v0!r}")
-    if force_scale > MAX_AMPLITUDE:
-        raise ValueError(f"the applied force (input u and feedback) must stay below {MAX_AMPLITUDE * sc.F:.3g} N "
-                         f"({MAX_AMPLITUDE:g} Fc), got a force scale of {force_scale * sc.F:.3g} N")
-    amplitude = max(math.hypot(v0 / sc.v, F0 / sc.F), force_scale)
-    if 0.0 < amplitude < MIN_AMPLITUDE:
-        raise ValueError(
-            f"v0 = {v0!r} m/s and F0 = {F0!r} N (with the applied force) give a motion of "
-            f"{amplitude:.3g} normalised units, too small to simulate in double precision: the amplitude "
-            f"hypot(v0 / (Fc/sqrt(m sigma)), F0 / Fc) must be 0 or >= {MIN_AMPLITUDE:g}, that is "
-            f"|v0| >= {MIN_AMPLITUDE * sc.v:.3g} m/s or |F0| >= {MIN_AMPLITUDE * sc.F:.3g} N"
-        )
 
 
 def _sample_times(breaks: np.ndarray) -> np.ndarray:
@@ -314,36 +276,6 @@ def _sample_times(breaks: np.ndarray) -> np.ndarray:
     return b[keep]
 
 
-def _check_ramps(run: Run, t_end: float, rtol: float) -> None:
-    """ValueError if a piece of a piecewise-linear input force is so steep that the round-off of
-    its time makes a force error above :data:`RAMP_ROUNDOFF` of the run's error level.
-
-    The plant evaluates a piece as ``a + b (t - t_k)`` from the normalised time ``t``, which
-    carries a round-off of about ``2^-53 t``; a slope ``b`` turns it into a force error
-    ``2^-53 |b| t``. Near a rest the net force is compared with the error level ``eps`` times the
-    force scale (:data:`prefriction.simulation.plant.EPS_REST`): a larger error started the mass
-    backwards (a spurious reversal pair), or made CasADi's event transition return NaN.
-    """
-    sig, sc = run.spec.u_sig, run.sc
-    if sig is None or sig.key != ("PiecewiseLinear",):
-        return
-    level = run.eps * max(run.force_scale, 1e-300)  # error level of the net force (normalised)
-    t = np.concatenate(([0.0], run.breaks[run.breaks < t_end], [t_end]))
-    _, slopes = linear_pieces(sig, t[:-1] * sc.t, t[1:] * sc.t)  # vectorised: one pass over the pieces
-    slopes = np.abs(slopes) * (sc.t / sc.F)  # normalised
-    errs = slopes * t[1:] * 2.0 ** -53
-    for k in np.flatnonzero(errs > RAMP_ROUNDOFF * level)[:1]:
-        ta, tb, slope, err = float(t[k]), float(t[k + 1]), float(slopes[k]), float(errs[k])
-        if err > RAMP_ROUNDOFF * level:
-            rise = abs(slope) * (tb - ta) * sc.F
-            shortest = rise / sc.F * tb * 2.0 ** -53 / (RAMP_ROUNDOFF * level) * sc.t
-            raise ValueError(
-                f"system.u ramps by {rise:.3g} N over {(tb - ta) * sc.t:.3g} s (from t = {ta * sc.t:.12g} s): at rtol = "
-                f"{rtol:g} that is too steep to simulate, because the round-off of the time there (2^-53 t) makes a "
-                f"force error of {err * sc.F:.3g} N, more than RAMP_ROUNDOFF = {RAMP_ROUNDOFF:g} times the error "
-                f"level of the net force ({level * sc.F:.3g} N) at which a resting mass starts to move. Spread the "
-                f"ramp over at least {shortest:.3g} s, loosen rtol, or drop one of its two samples (a jump)"
-            )
 
 
 def _dense_times(dense: Any, t_end: float) -> np.ndarray:
@@ -387,51 +319,6 @@ def _initial_state(run: Run, x0: float, v0: float, F0: float, xc0: np.ndarray, *
     return st, s0
 
 
-def _sampled_loop(run: Run, xc0: np.ndarray, t_end: float, n_target: float) -> tuple[SampleBuffer, list]:
-    """Closed loop with a sampled controller: hold its output over each period ``Ts`` up to the
-    normalised time ``t_end`` or ``n_target`` reversals; returns the samples at ``k Ts`` and the
-    total applied force there [N]."""
-    system, feedback, sc = run.system, run.fb, run.sc
-    samples = SampleBuffer(len(xc0))
-    u_hist: list = []
-    Ts = feedback.Ts / sc.t
-    xc = xc0.copy()
-    k = 0
-    while True:
-        tk = min(k * Ts, t_end)
-        t_si = tk * sc.t
-        e = float(feedback.reference(t_si)) - run.st["x"] * sc.x
-        uk = float(feedback.C[0] @ xc + feedback.D[0, 0] * e)
-        run.st["uhold"] = uk
-        run.st["xc"] = xc.copy()
-        samples.append(run.sample())
-        u_hist.append(uk + (float(system.u(t_si)) if system.forced else 0.0))
-        if tk >= t_end * (1 - 1e-12):
-            break
-        xc = feedback.A @ xc + feedback.B[:, 0] * e
-        if run.advance(min((k + 1) * Ts, t_end), n_target):
-            break
-        k += 1
-    return samples, u_hist
-
-
-def _reversal_table(rev: Union[list, tuple], system: Oscillator, s0: float, v0: float, F0: float,
-                    sc: Optional[Scales] = None) -> tuple[ReversalTable, np.ndarray]:
-    """The reversals as a :class:`ReversalTable` in SI (its energies ``E_p`` (3.9), ``E_d``
-    (2.10), ``E_0`` computed on first use: :class:`~prefriction.simulation.lazy_table.LazyReversalTable`),
-    and the input's work over each half-cycle [J].
-
-    ``rev``: a list of ``(t~, x~, F~, W~)`` tuples, or the four columns
-    (:meth:`~prefriction.simulation.reversal_log.ReversalLog.columns`; writable columns are
-    converted to SI in place, so that a long run holds them once); ``sc``: the system's scales,
-    if known."""
-    sc = Scales.of(system) if sc is None else sc
-    if isinstance(rev, list):
-        R = np.array(rev, dtype=float).reshape(-1, 4)
-        rev = (R[:, 0], R[:, 1], R[:, 2], R[:, 3])
-    t_r, x_r, F_r, W_r = (np.multiply(col, unit, out=col if col.flags.writeable else None)
-                          for col, unit in zip(rev, (sc.t, sc.x, sc.F, sc.E)))
-    return LazyReversalTable(t_r, x_r, F_r, W_r, system, s0, v0, F0), W_r
 
 
 def _padded(fb: LinearFeedback, order: int) -> LinearFeedback:

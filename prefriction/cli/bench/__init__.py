@@ -89,6 +89,10 @@ def main(argv: Optional[list[str]] = None) -> int:
         text = export_bench.run(args.repeats or 5)
         print(text)
         return 0 if text.rstrip().endswith("PASS") else 1
+    if args.emps is not None:
+        from prefriction.cli.bench import emps
+
+        return emps.main(args.emps)
     if args.native:
         from prefriction.cli.bench import native_rows
 

@@ -68,7 +68,7 @@ def measure(n: int, seed: int = 1) -> dict:
     traced = tracemalloc.get_traced_memory()[1] / 2**20
     tracemalloc.stop()
     z = max(abs(res.estimate(k) - v) / res.stderr[res.names.index(k)] for k, v in T.items())
-    it = re.search(r"after (\d+) Gauss-Newton", res.message)
+    it = re.search(r"(\d+) Jacobian evaluations", res.message)
     seg = re.search(r"(\d+) segments of (\d+) samples, (\d+) RK4", res.message)
     return {"n": n, "generate_s": gen, "fit_s": elapsed, "rss_before_mb": rss0, "rss_peak_mb": _rss_mb(),
             "traced_mb": traced, "z_max": z, "iterations": int(it.group(1)) if it else -1,

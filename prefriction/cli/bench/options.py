@@ -38,7 +38,8 @@ examples:
   prefriction bench --compensation   PID alone against PID with each friction compensator
                                      (writes compensation_*.png to --out)
   prefriction bench --export         exported C code: ns per step against friction_along
-  prefriction bench --identify       fit success rate, interval coverage, time and memory"""
+  prefriction bench --identify       fit success rate, interval coverage, time and memory
+  prefriction bench --emps DIR       identification routes on the EMPS benchmark files in DIR"""
 
 
 def repeats(text: str) -> int:
@@ -158,6 +159,9 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
                            "per synthetic stage, time and peak memory), coverage of the 95 %% intervals, cost of "
                            "force-displacement fits against the samples, and time and peak memory of a closed-loop "
                            "Motion fit against the samples (1e3, 5e3, 2.5e4; --quick: fewer fits, 500-2000 samples)")
+    what.add_argument("--emps", default=None, metavar="DIR",
+                      help="instead: the identification routes on the EMPS benchmark files in DIR (DATA_EMPS.mat, "
+                           "DATA_EMPS_PULSES.mat; not shipped), docs/identify_closed_loop.md#emps")
     args = ap.parse_args(argv)
     if args.compensation and (args.quick or args.repeats is not None):
         ap.error("--quick and --repeats do not apply to --compensation")

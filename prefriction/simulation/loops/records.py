@@ -11,6 +11,7 @@ from prefriction.models import FrictionModel, Oscillator
 from prefriction.simulation.feedback import LinearFeedback
 from prefriction.simulation.plant import PlantSpec
 from prefriction.simulation.rest import initial_direction
+from prefriction.simulation.build import build_plant
 from prefriction.simulation.run import Run
 from prefriction.units import Scales
 
@@ -76,7 +77,7 @@ def finish_in_python(system: Oscillator, fb: LinearFeedback, plant: PlantSpec, e
     already recorded); return the state after it: the plant's from the Python loop, the
     controller's, the compensator's and the measurements' from ``after`` (the compiled step's)."""
     ix = LL.state
-    run = Run(system, plant, fb, eps, jit)
+    run = Run(system, plant, fb, eps, build_plant(system.friction, plant, fb, jit))
     run.snap = rtol
     run.P0 = run._constant_params(run.L)
     run.force_scale = par[LL.param["force_scale"]]

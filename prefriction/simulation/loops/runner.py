@@ -27,7 +27,8 @@ from prefriction.simulation.force_scale import applied_force_scale
 from prefriction.simulation.per_thread import PerThread
 from prefriction.simulation.plant import Layout, PlantSpec
 from prefriction.simulation.result import RunStats, SimulationResult
-from prefriction.simulation.simulate import _CAL, _reversal_table
+from prefriction.simulation.lazy_table import reversal_table
+from prefriction.simulation.simulate import _CAL
 from prefriction.units import Scales
 
 from .compiled_loop import MAX_DELAY, NSTOP, LoopLayout, LoopSpec, NoCompensation, loop_function
@@ -328,7 +329,7 @@ def run_sampled(
         k += upto
     wall = time.perf_counter() - start
     integrated = int(np.count_nonzero(recs[:, LL.rec["moved"]] > 0.5))
-    table, W_r = _reversal_table(rev, system, s0, v0, F0)
+    table, W_r = reversal_table(rev, system, s0, v0, F0)
     ix = LL.state
     t = tk * sc.t
     x, v = recs[:, ix["x"]] * sc.x, recs[:, ix["v"]] * sc.v

@@ -1,0 +1,335 @@
+"""The closed-loop output-error route: the model simulated inside the known digital loop.
+
+A record taken under feedback (the EMPS stage under its PD loop) is simulated the way it was
+measured: at each sample ``k`` the loop reads the simulated position ``x_k``, computes
+
+    u_k = Kp (r_k - x_k) - Kd sum_j c_j (x_{k-j} - x_{k-j-1}) / dt + e_k,   |u_k| <= u_max      (1)
+
+(``r`` the recorded reference, ``c_j`` the velocity filter's taps, ``e`` an optional recorded
+additive force, e.g. EMPS's pulses), or any linear law on the error ``r - x``
+(:class:`prefriction.identify.DigitalLoop`, e.g. from a :class:`prefriction.controllers.PID`),
+and applies ``u_{k-d}`` (``d`` samples of delay) held over the
+next sample interval to the stage ``m x'' + F + F_off = u`` (2.1) with any friction model
+(one sample of :func:`prefriction.identify.motion_step.step_function`: Runge-Kutta sub-steps
+cut at the reversals). The feedback keeps the simulation on the record, so it cannot drift
+however long the record (unlike the open-loop Motion fit, which integrates the recorded force
+through the mass).
+
+The parameters (model, mass, offset) minimise ``sum (x_k - x_meas_k)^2 / w_x^2 +
+(u_k - u_meas_k)^2 / w_u^2`` by ``scipy.optimize.least_squares`` (trust-region reflective) with
+the exact Jacobian from forward sensitivities carried along the record (CasADi ``mapaccum``:
+time and memory linear in the samples). The channel weights ``w`` are the residual standard
+deviations of the start model, updated once after a first fit. Uncertainty: the Gauss-Newton
+statistics with Newey-West standard errors (:mod:`prefriction.identify.hac`) on the per-sample
+scores, since closed-loop residuals are strongly correlated in time.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import warnings
+from typing import Any, Sequence
+
+import casadi as ca
+import numpy as np
+
+from prefriction._validation import check_count, check_positive
+from prefriction.identify.data import Motion
+from prefriction.identify.digital_loop import DigitalLoop
+from prefriction.identify.hac import sandwich
+from prefriction.identify.result import FitResult
+from prefriction.identify.statistics import ConvergenceWarning, IdentifiabilityWarning, at_bounds, gauss_newton
+from prefriction.models.base import FrictionModel
+
+__all__ = ["fit_closed_loop", "simulate_closed_loop"]
+
+_CACHE: dict[Any, tuple[ca.Function, int]] = {}
+COMPILE_FROM = 5000
+"""Records of this many samples or more run the loop's step compiled (``prefriction.simulation.compiled``);
+shorter ones interpreted (the compilation would take longer than it saves)."""
+
+
+def _controller(loop: DigitalLoop, x: Any, mem: Any, r: Any, e: Any) -> tuple[Any, list[Any]]:
+    """The force at a sample and the controller's memory after it (CasADi SX).
+
+    Memory: the law (1)'s last ``len(taps)`` positions; the law (2)'s last ``len(num) - 1`` errors
+    and ``len(den) - 1`` unsaturated outputs.
+    """
+    if not loop.linear:
+        xs = [x] + [mem[j] for j in range(len(loop.taps))]
+        v = sum(c * (xs[j] - xs[j + 1]) for j, c in enumerate(loop.taps)) / loop.dt
+        return loop.Kp * (r - x) - loop.Kd * v + e, xs[:len(loop.taps)]
+    nb, na = len(loop.num) - 1, len(loop.den) - 1
+    eps = [r - x] + [mem[j] for j in range(nb)]
+    outs = [mem[nb + j] for j in range(na)]
+    lin = (sum(b * ej for b, ej in zip(loop.num, eps)) - sum(a * uj for a, uj in zip(loop.den[1:], outs))) / loop.den[0]
+    return lin + e, eps[:nb] + ([lin] + outs[:na - 1] if na else [])
+
+
+def _memory(loop: DigitalLoop, x0: float) -> np.ndarray:
+    """The controller's memory before the record: at rest at ``x0``, no error, no force."""
+    if not loop.linear:
+        return np.full(len(loop.taps), x0)
+    return np.zeros(len(loop.num) + len(loop.den) - 2)
+
+
+def _loop_function(model: FrictionModel, loop: DigitalLoop, space: Any, n_sub: int, mass_free: bool
+                   ) -> tuple[ca.Function, int]:
+    """One sample of the loop with forward sensitivities: ``(c, r, e, theta, scale, fixed, mass) -> c+, out``."""
+    from prefriction.identify.motion_step import _units_function, step_function
+
+    ny, nd, nm = 2 + model.n_states, loop.delay, _memory(loop, 0.0).size
+    step = step_function(model, n_sub)
+    units = _units_function(model, space, mass_free)
+    nth = space.n_free
+    y = ca.SX.sym("y", ny)
+    s = ca.SX.sym("s")
+    mem = ca.SX.sym("mem", nm)       # the controller's memory
+    uh = ca.SX.sym("uh", nd)         # u_{k-1}, ..., u_{k-d}
+    r, e = ca.SX.sym("r"), ca.SX.sym("e")
+    theta, scale = ca.SX.sym("theta", nth), ca.SX.sym("scale", nth)
+    fixed, mass = ca.SX.sym("fixed", len(space.fixed)), ca.SX.sym("mass")
+    pp = units(theta, scale, fixed, mass)
+    u, mem1 = _controller(loop, y[0], mem, r, e)
+    if math.isfinite(loop.limit):
+        u = ca.fmin(ca.fmax(u, -loop.limit), loop.limit)
+    applied = uh[nd - 1] if nd else u
+    y1 = step(ca.vertcat(y, s), applied, applied, loop.dt, pp)
+    cont = ca.vertcat(y, mem, uh)
+    cont1 = ca.vertcat(y1[:ny], *mem1, *([u] + [uh[j] for j in range(nd - 1)] if nd else []))
+    S = ca.SX.sym("S", cont.numel(), nth)
+    S1 = ca.mtimes(ca.jacobian(cont1, cont), S) + ca.jacobian(cont1, theta)
+    out = ca.vertcat(y[0], u)
+    dout = ca.mtimes(ca.jacobian(out, cont), S) + ca.jacobian(out, theta)
+    c = ca.vertcat(cont, s, ca.vec(S))
+    c1 = ca.vertcat(cont1, y1[ny], ca.vec(S1))
+    f = ca.Function("loop_step", [c, r, e, theta, scale, fixed, mass], [c1, ca.vertcat(out, ca.vec(dout.T))])
+    return f, cont.numel()
+
+
+class _Simulator:
+    """The record-long loop simulation with sensitivities (cached per model structure)."""
+
+    def __init__(self, model: FrictionModel, loop: DigitalLoop, space: Any, n: int, n_sub: int,
+                 mass_free: bool) -> None:
+        key = (model.structure_key(), loop, tuple(space.free), tuple(space.fixed), n_sub, mass_free,
+               n >= COMPILE_FROM)
+        if key not in _CACHE:
+            from prefriction.simulation.compiled import compiled
+            f, nc = _loop_function(model, loop, space, n_sub, mass_free)
+            # compiling costs about 10 s once per structure and saves about 150 us a sample per evaluation
+            _CACHE[key] = (compiled(f, "closed-loop fit step")[0] if n >= COMPILE_FROM else f, nc)
+        f, self.nc = _CACHE[key]
+        self.acc = f.mapaccum("loop_record", n)
+        self.model, self.loop, self.space, self.n = model, loop, space, n
+
+    def run(self, theta: np.ndarray, x0: float, r: np.ndarray, e: np.ndarray, mass: float
+            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Simulated positions and forces at every sample and their derivatives in ``theta``."""
+        vals = self.space.values(theta)
+        start = self.space.build(vals)
+        z0, _ = start.initial_state(0.0, 1.0)
+        nz, nd, nth = self.model.n_states, self.loop.delay, self.space.n_free
+        cont = np.concatenate(([x0, 0.0], np.asarray(z0, dtype=float)[:nz], _memory(self.loop, x0), np.zeros(nd)))
+        c0 = np.concatenate((cont, [1.0], np.zeros(self.nc * nth)))
+        _, O = self.acc(c0, r[None, :], e[None, :], theta, self.space.scale, self.space.fixed_values(), mass)
+        O = np.asarray(O)
+        return O[0], O[1], O[2:2 + nth].T, O[2 + nth:2 + 2 * nth].T
+
+
+def _series(name: str, value: Any, n: int, unit: str) -> np.ndarray:
+    """A finite 1-D array of ``n`` samples, or a ValueError naming it."""
+    arr = np.asarray(value, dtype=float)
+    if arr.shape != (n,) or not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} must be finite [{unit}] with one value per sample ({n}), got shape {arr.shape}")
+    return arr
+
+
+def _check_spacing(t: np.ndarray, loop: DigitalLoop) -> None:
+    dts = np.diff(t)
+    if dts.size == 0 or np.max(np.abs(dts - loop.dt)) > 1e-3 * loop.dt:
+        raise ValueError(f"the sample interval of t ({dts.min(initial=0.0):.6g} to {dts.max(initial=0.0):.6g} s) "
+                         f"is not loop.dt = {loop.dt!r} s")
+
+
+def simulate_closed_loop(model: FrictionModel, loop: DigitalLoop, t: Any, r: Any, *, mass: float, offset: float = 0.0,
+                         x0: float | None = None, extra: Any = None, substeps: int = 2
+                         ) -> tuple[np.ndarray, np.ndarray]:
+    """Positions [m] and forces [N] of ``model`` on a mass in ``loop`` following the reference ``r``.
+
+    Parameters
+    ----------
+    model : FrictionModel
+        Friction of the stage (started on a virgin branch at zero force).
+    loop : DigitalLoop
+        The controller.
+    t, r : array_like
+        Sample times [s] (spaced ``loop.dt``) and reference positions [m].
+    mass : float
+        Moving mass [kg].
+    offset : float, default 0.0
+        Force offset [N] (``m x'' + F + offset = u``).
+    x0 : float, optional
+        Initial position [m] (at rest); default ``r[0]``.
+    extra : array_like, optional
+        Force [N] added to the controller's output at each sample.
+    substeps : int, default 2
+        Runge-Kutta sub-steps per sample (1 to 64).
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray)
+        Positions and forces at every sample.
+    """
+    from prefriction.identify.parameters import ParameterSpace
+
+    if not isinstance(loop, DigitalLoop):
+        raise TypeError(f"loop must be a DigitalLoop (the known controller), got {type(loop).__name__}")
+    t = np.asarray(t, dtype=float)
+    r = _series("r", r, t.size, "m")
+    _check_spacing(t, loop)
+    e = np.zeros_like(r) if extra is None else _series("extra", extra, t.size, "N")
+    space = ParameterSpace(model, None, None, None, offset=1.0)
+    sim = _Simulator(model, loop, space, r.size, check_count("substeps", substeps, 1, 64), False)
+    theta = space.theta0.copy()
+    theta[space.free.index("offset")] = offset
+    x, u, _, _ = sim.run(theta, float(r[0] if x0 is None else x0), r, e, check_positive("mass", mass))
+    return x, u
+
+
+def fit_closed_loop(model: FrictionModel, data: Motion, loop: DigitalLoop, reference: Any, *, offset: bool = True,
+                    extra: Any = None, free: Sequence[str] | None = None, fixed: Sequence[str] | None = None,
+                    bounds: dict | None = None, mass0: float | None = None, offset0: float = 0.0,
+                    forces: bool = True, substeps: int = 2, max_iter: int = 100, tol: float = 1e-8,
+                    identifiability_limit: float = 0.5) -> FitResult:
+    """Fit a friction model (and mass, offset) to a closed-loop record by simulating the loop.
+
+    Parameters
+    ----------
+    model : FrictionModel
+        The friction model; its values are the start values (as given; see
+        :func:`prefriction.identify.inverse.inverse_start` for start values from the record).
+    data : Motion
+        Measured positions [m] and the recorded controller force [N]; ``data.mass`` known holds
+        the mass, ``None`` fits it (``mass0`` its start).
+    loop : DigitalLoop
+        The known controller (1).
+    reference : array_like
+        Reference positions [m] at the samples.
+    offset : bool, default True
+        Fit the force offset ``"offset"`` [N] (started at ``offset0``).
+    extra : array_like, optional
+        Recorded force [N] added to the controller's output (pulses).
+    free, fixed, bounds :
+        As :func:`prefriction.identify.fit`.
+    mass0 : float, optional
+        Start of a fitted mass [kg] (required when ``data.mass`` is None).
+    offset0 : float, default 0.0
+        Start of the offset [N].
+    forces : bool, default True
+        Fit the recorded forces too (both channels weighted by their residual spread).
+    substeps : int, default 2
+        Runge-Kutta sub-steps per sample (1 to 64).
+    max_iter : int, default 100
+        Most solver evaluations (per pass; two passes).
+    tol : float, default 1e-8
+        Solver tolerance.
+    identifiability_limit : float, default 0.5
+        Relative standard error above which a parameter is reported as not identifiable.
+
+    Returns
+    -------
+    FitResult
+        Estimates with Newey-West 95 % intervals; ``fitted`` the simulated positions, ``residuals``
+        the position residuals [m]; ``nuisance["force"]`` the simulated forces.
+
+    Raises
+    ------
+    TypeError, ValueError
+        For arguments of the wrong kind or out of range (named).
+    """
+    from prefriction.identify.parameters import ParameterSpace, name_list
+    from scipy.optimize import least_squares
+
+    if not isinstance(model, FrictionModel):
+        raise TypeError(f"model must be a prefriction.FrictionModel, got {type(model).__name__}")
+    if not isinstance(data, Motion):
+        raise TypeError(f"data must be prefriction.identify.Motion, got {type(data).__name__}")
+    from prefriction.identify.inverse import _check_solver
+
+    _check_solver(max_iter, tol, identifiability_limit)
+    if not isinstance(loop, DigitalLoop):
+        raise TypeError(f"loop must be a DigitalLoop (the known controller), got {type(loop).__name__}")
+    r = _series("reference", reference, data.t.size, "m")
+    _check_spacing(data.t, loop)
+    if data.mass is None and mass0 is None:
+        raise ValueError("data.mass is None: give mass0 (e.g. from identify.inverse.inverse_start)")
+    e = np.zeros_like(r) if extra is None else _series("extra", extra, data.t.size, "N")
+    fscale = max(float(np.std(data.u)), 1e-300)
+    space = ParameterSpace(model, name_list("free", free), name_list("fixed", fixed), bounds,
+                           mass=mass0 if data.mass is None else None, offset=fscale if offset else None)
+    sim = _Simulator(model, loop, space, data.t.size, check_count("substeps", substeps, 1, 64), data.mass is None)
+    theta0 = space.theta0.copy()
+    if offset:
+        theta0[space.free.index("offset")] = offset0 / fscale
+    mass = float(data.mass) if data.mass is not None else 0.0
+    xm, um = data.x, data.u
+
+    memo: dict[bytes, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = {}
+
+    def channels(th: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        key = np.asarray(th, dtype=float).tobytes()
+        if key not in memo:   # the solver asks the Jacobian where it evaluated the residuals
+            memo.clear()
+            x, u, dx, du = sim.run(th, float(data.x[0]), r, e, mass)
+            memo[key] = (x - xm, u - um, dx, du)
+        return memo[key]
+
+    rx, ru, _, _ = channels(theta0)
+    w = [max(float(np.std(rx)), 1e-15), max(float(np.std(ru)), 1e-12)]
+    lo, hi = space.theta_bounds()
+    theta, sol = theta0, None
+    for _ in range(2):   # weights from the start, then from the first fit
+        def res(th: np.ndarray) -> np.ndarray:
+            a, b, _, _ = channels(th)
+            return np.concatenate((a / w[0], b / w[1])) if forces else a / w[0]
+
+        def jac(th: np.ndarray) -> np.ndarray:
+            _, _, dx, du = channels(th)
+            return np.vstack((dx / w[0], du / w[1])) if forces else dx / w[0]
+
+        sol = least_squares(res, theta, jac=jac, bounds=(lo, hi), method="trf", x_scale=1.0, xtol=tol, ftol=tol,
+                            gtol=tol, max_nfev=max_iter)
+        theta = sol.x
+        rx, ru, _, _ = channels(theta)
+        w = [max(float(np.std(rx)), 1e-15), max(float(np.std(ru)), 1e-12)]
+    J, rr = jac(theta), res(theta)
+    est = theta * space.scale
+    names = list(space.free)
+    stats = gauss_newton(J, rr, names, est, space.scale, limit=identifiability_limit)
+    stats, lag = sandwich(J, rr, stats, est, space.scale, channels=2 if forces else 1, names=names,
+                          limit=identifiability_limit)
+    for name, reason in stats.unidentifiable:
+        warnings.warn(f"the data cannot identify {name}: {reason}; fix it or excite it", IdentifiabilityWarning,
+                      stacklevel=2)
+    lows = {n: space.low[n] for n in names}
+    highs = {n: space.high[n] for n in names}
+    low, high, flags = at_bounds(names, est, stats.low, stats.high, space.scale, lows, highs,
+                                 {n: space.why_low.get(n, "the declared range") for n in names},
+                                 {n: space.why_high.get(n, "the declared range") for n in names})
+    if not sol.status > 0:
+        warnings.warn(f"fit_closed_loop stopped without converging ({sol.message}); the estimates are its last: "
+                      f"raise max_iter or start closer (identify.inverse_start)", ConvergenceWarning, stacklevel=2)
+    vals = space.values(theta)
+    fitted_mass = vals["mass"] if data.mass is None else float(data.mass)
+    x_sim, u_sim, _, _ = sim.run(theta, float(data.x[0]), r, e, mass)
+    stats = dataclasses.replace(stats, sigma_hat=float(np.sqrt(np.sum(rx ** 2) / stats.dof)))
+    notes = ("route: closed-loop output error",
+             f"fitted to positions{' and forces' if forces else ''} with channel weights {w[0]:.3g} m and "
+             f"{w[1]:.3g} N (the residual sd shown is of the positions; forces: rms {np.sqrt(np.mean(ru ** 2)):.4g} N)",
+             f"Newey-West standard errors, lag {lag}")
+    return FitResult(space.build(vals), fitted_mass, tuple(names), tuple(space.units[n] for n in names), est,
+                     stats.stderr, low, high, stats.correlation, xm - x_sim, x_sim, data, stats,
+                     {"force": u_sim, "force_rms": float(np.sqrt(np.mean(ru ** 2)))},
+                     f"least_squares: {sol.message}", success=bool(sol.status > 0), flags=flags, notes=notes)
