@@ -272,14 +272,15 @@ def plant_source(system: Oscillator, name: str, directory: Any, *, Ts: float, F0
                  force_scale: Optional[float] = None) -> CSource:
     """Write ``<name>.h`` and ``<name>.c``: the stage over one sample period, for hardware in the loop.
 
-    The header defines ``<name>_state`` (the loop state ``w``, the sample index ``k`` and, after
-    each period, ``x`` [m], ``v`` [m/s], ``F`` [N]) and declares
-    ``void <name>_reset(<name>_state *s, double x0, double v0)`` and
+    The header defines ``<name>_state`` (the loop state ``w``, the integrator's run state
+    ``run``, the sample index ``k`` and, after each period, ``x`` [m], ``v`` [m/s], ``F`` [N])
+    and declares ``void <name>_reset(<name>_state *s, double x0, double v0)`` and
     ``int <name>_step(<name>_state *s, double u)``: the force ``u`` [N] held over one period
     ``Ts``, every reversal and model event located (module notes); it returns 0, or 1 if the
-    period held more than two reversals (the state is then where the plant stopped), or 2 if
-    the integrator failed. Generated from :func:`plant_function` (CasADi generates its ``erk``
-    integrator); the numbers of the system are constants.
+    period held more than ``CAP`` (48) reversals (the state is then where the plant stopped), or
+    2 if the integrator failed (the state unchanged). The code is the simulator's native driver
+    (:mod:`prefriction.export.native_plant`), the period of :func:`plant_function` integrated
+    with the step size carried over; the numbers of the system are constants.
 
     Parameters
     ----------
