@@ -22,7 +22,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
-from typing import Callable, Optional
+from typing import Any, Callable, Optional
 
 import numpy as np
 
@@ -186,11 +186,11 @@ def _loop_rows(rounds: int) -> list[NativeRow]:
         rows.append(NativeRow(name + " (per sample)", f"numba({chosen:.0e})", sim_s / n, ref_s / n, sim_err, ref_err,
                               3.0, erk_s=erk_s / n))
         if kind == nr.DAHL:
-            rows.append(_exported_row(stage, Cd, r, Ts, stroke, exact, chosen, ref_err, reference, rounds))
+            rows.append(_exported_row(stage, r, Ts, stroke, exact, chosen, ref_err, reference, rounds))
     return rows
 
 
-def _exported_row(stage, Cd, r: np.ndarray, Ts: float, stroke: float, exact: np.ndarray, chosen: float,
+def _exported_row(stage: Any, r: np.ndarray, Ts: float, stroke: float, exact: np.ndarray, chosen: float,
                   ref_err: float, reference: Callable, rounds: int) -> NativeRow:
     """The exported C loop (``controller_source`` + ``plant_source``, ``-O2``, timed in C over its
     passes, process CPU time) next to the numba loop of the same row, timed in the same run."""
