@@ -4,10 +4,16 @@ The period is the one of the compiled sampled loop (:mod:`prefriction.simulation
 ``docs/controllers.md#compiled-loop``): the force ``u`` [N] held over ``[t_k, t_k + Ts]``, a mass
 at rest that the net force moves leaves rest (a reversal if it leaves backwards), and CasADi's
 ``erk`` integrator of the event-locating plant (:func:`prefriction.simulation.plant.build_integrator`)
-carries ``m x'' = u - F`` over the period with each reversal and model event located. CasADi
-generates the integrator's code; the period stops after two reversals (the plant's register),
-which the C code reports as status 1 (a shorter ``Ts``, or a model stiffer than the loop can
-follow, is the cure: in a stable loop that does not happen).
+carries ``m x'' = u - F`` over the period with each reversal and model event located.
+
+Two forms of one period: :func:`plant_function` is CasADi's ``erk`` integrator of it (the period
+stops after two reversals, the plant's register; :func:`prefriction.export.evaluate_plant` runs
+it), and :func:`plant_source` writes the simulator's own native driver
+(:mod:`prefriction.export.native_plant`: the same Dormand-Prince 5(4) with dense-output event
+location, the step size carried from period to period) with the system's numbers as constants;
+it resolves up to ``CAP`` (48) reversals per period and reports more as status 1 (a shorter
+``Ts``, or a model stiffer than the loop can follow, is the cure: in a stable loop that does
+not happen).
 """
 
 from __future__ import annotations
@@ -28,7 +34,8 @@ from prefriction.simulation.loops.records import plant_state
 from prefriction.simulation.simulate import _CAL
 from prefriction.units import Scales
 
-from ._codegen import c_text, check_name, check_sample_time, comment_text, work_sizes, write_export
+from ._codegen import check_name, check_sample_time, comment_text, write_export
+from .native_plant import CAP, plant_body, run_width
 from .source import CSource
 
 __all__ = ["plant_function", "plant_initial_state", "plant_source"]
@@ -53,13 +60,13 @@ class _Period:
         self.model, self.sc, self.Ts = model, sc, Ts
         plant = PlantSpec.of(model, Constant(0.0), None, fb="none", n_c=0, energy=False, K=_K, n_out=1,
                              method="erk", compact=True)
-        spec = LoopSpec(plant, 0, 1)
+        self.spec = spec = LoopSpec(plant, 0, 1)
         self.LL = LL = LoopLayout(spec)
         L = Layout(plant)
         self.step = _step(spec, LL)
         par = np.zeros(LL.npar)
         P0 = par[LL.p_plant]
-        P0[L.param["eps"]] = rtol * _CAL * math.sqrt(L.n_active / L.nx)
+        P0[L.param["eps"]] = eps = rtol * _CAL * math.sqrt(L.n_active / L.nx)
         P0[L.param["snap"]] = rtol
         P0[L.param["tunit"]], P0[L.param["xunit"]], P0[L.param["Fc"]] = sc.t, sc.x, sc.F
         P0[L.q] = model.runtime_params_for(sc)
@@ -70,6 +77,8 @@ class _Period:
         par[LL.p_delay.start] = 1.0     # the measurement of this sample (no delay; unused: no controller)
         self.par = par
         self.q = model.runtime_params_for(sc)
+        # the native driver's numbers (forced.c cfg[]): the sampled loop's (loops/runner.py)
+        self.cfg = np.array([rtol * _CAL, eps, rtol, sc.t, 1.0 / sc.F, par[LL.param["force_scale"]], 0.0, 1.0, 0.0])
 
     def function(self) -> ca.Function:
         """``(w, u, k) -> (w_next, y)``, ``y = [x, v, F, reversals, complete]`` at ``t_{k+1}`` (SI)."""
@@ -180,11 +189,12 @@ _HEADER = """\
  *   status = {name}_step(&s, u);     hold the force u [N] over one period Ts = {Ts!r} s
  *   s.x, s.v, s.F                    position [m], velocity [m/s], friction force [N] after it
  *
- * status: 0 the period was integrated to its end; 1 the plant stopped after {nstop} reversals
+ * status: 0 the period was integrated to its end; 1 the plant stopped after {cap} reversals
  * inside the period (s is where it stopped, not the period's end: use a shorter Ts);
  * 2 the integrator failed (s is unchanged).
  * The friction starts at F0 = {F0!r} N (fixed at export). s.w is the normalised loop state,
- * s.k the sample index, s.reversals the reversals in the last period.
+ * s.run the integrator's run state (the step size carried from period to period), s.k the
+ * sample index, s.reversals the reversals in the last period.
  */
 #ifndef {guard}
 #define {guard}
@@ -195,6 +205,7 @@ extern "C" {{
 
 typedef struct {{
   double w[{n}];
+  double run[{nrun}];
   double k;
   double x, v, F;
   double reversals;
@@ -261,14 +272,15 @@ def plant_source(system: Oscillator, name: str, directory: Any, *, Ts: float, F0
                  force_scale: Optional[float] = None) -> CSource:
     """Write ``<name>.h`` and ``<name>.c``: the stage over one sample period, for hardware in the loop.
 
-    The header defines ``<name>_state`` (the loop state ``w``, the sample index ``k`` and, after
-    each period, ``x`` [m], ``v`` [m/s], ``F`` [N]) and declares
-    ``void <name>_reset(<name>_state *s, double x0, double v0)`` and
+    The header defines ``<name>_state`` (the loop state ``w``, the integrator's run state
+    ``run``, the sample index ``k`` and, after each period, ``x`` [m], ``v`` [m/s], ``F`` [N])
+    and declares ``void <name>_reset(<name>_state *s, double x0, double v0)`` and
     ``int <name>_step(<name>_state *s, double u)``: the force ``u`` [N] held over one period
     ``Ts``, every reversal and model event located (module notes); it returns 0, or 1 if the
-    period held more than two reversals (the state is then where the plant stopped), or 2 if
-    the integrator failed. Generated from :func:`plant_function` (CasADi generates its ``erk``
-    integrator); the numbers of the system are constants.
+    period held more than ``CAP`` (48) reversals (the state is then where the plant stopped), or
+    2 if the integrator failed (the state unchanged). The code is the simulator's native driver
+    (:mod:`prefriction.export.native_plant`), the period of :func:`plant_function` integrated
+    with the step size carried over; the numbers of the system are constants.
 
     Parameters
     ----------
@@ -310,15 +322,11 @@ def plant_source(system: Oscillator, name: str, directory: Any, *, Ts: float, F0
     initial = _initial_function(per, F0)
     path = output_dir(directory)
     n = per.LL.nS
-    sizes = work_sizes(fun)
-    isz = work_sizes(initial)
     what = comment_text(f"{type(system.friction).__name__} stage of {system.mass:.6g} kg, Ts = {Ts!r} s, "
                         f"rtol = {rtol!r}, period with every reversal located")
-    header = _HEADER.format(name=name, what=what, Ts=Ts, nstop=int(NSTOP), F0=F0, guard=f"{name.upper()}_H", n=n)
-    body = (c_text({f"{name}_period": fun, f"{name}_initial": initial}, f"{name}_casadi")
-            + _WRAPPER.format(name=name, n=n, sz_arg=max(isz[0], 2), sz_res=max(isz[1], 2), sz_iw0=max(isz[2], 1),
-                              sz_w0=max(isz[3], 1), sz_arg1=max(sizes[0], 3), sz_res1=max(sizes[1], 2),
-                              sz_iw1=max(sizes[2], 1), sz_w1=max(sizes[3], 1)))
+    header = _HEADER.format(name=name, what=what, Ts=Ts, cap=CAP, F0=F0, guard=f"{name.upper()}_H", n=n,
+                            nrun=run_width(per))
+    body = f'#include "{name}.h"\n' + plant_body(per, initial, per.cfg, name)
     h_path, c_path, digest = write_export(path, name, header, body)
     options = {"Ts": per.Ts, "F0": F0, "rtol": rtol, "force_scale": force_scale}
     return CSource(name, h_path, c_path, "plant", what, fun, n, system, options, digest)

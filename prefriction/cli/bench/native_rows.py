@@ -13,7 +13,8 @@ machine), and prints the ratio (``docs/bench.md#native``):
   that of ``simulate``, both errors measured against the reference at ``rtol = 1e-13``.
 
 Targets: unforced headline <= 2x, forced sine rows <= 2x, Samples and dense rows
-<= 3x, loose-tolerance headline <= 3x.
+<= 3x, loose-tolerance headline <= 3x, the exported C loop (``prefriction.export``, the same
+native driver) <= 2x the numba loop.
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
-from typing import Callable, Optional
+from typing import Any, Callable, Optional
 
 import numpy as np
 
@@ -184,7 +185,32 @@ def _loop_rows(rounds: int) -> list[NativeRow]:
         n = len(tk) - 1
         rows.append(NativeRow(name + " (per sample)", f"numba({chosen:.0e})", sim_s / n, ref_s / n, sim_err, ref_err,
                               3.0, erk_s=erk_s / n))
+        if kind == nr.DAHL:
+            rows.append(_exported_row(stage, r, Ts, stroke, exact, chosen, ref_err, reference, rounds))
     return rows
+
+
+def _exported_row(stage: Any, r: np.ndarray, Ts: float, stroke: float, exact: np.ndarray, chosen: float,
+                  ref_err: float, reference: Callable, rounds: int) -> NativeRow:
+    """The exported C loop (``controller_source`` + ``plant_source``, ``-O2``, timed in C over its
+    passes, process CPU time) next to the numba loop of the same row, timed in the same run."""
+    import tempfile
+
+    from prefriction import controllers, export
+
+    pid = controllers.design_pid(stage, wn=2 * np.pi * 150.0, zeta=0.7)
+    n = r.size - 1
+    with tempfile.TemporaryDirectory(prefix="prefriction-bench-") as tmp:
+        ctl = export.controller_source(pid, "ctl", tmp, Ts=Ts)
+        plant = export.plant_source(stage, "stage", tmp, Ts=Ts, rtol=1e-8)
+        c_s, ref_s = math.inf, math.inf
+        for _ in range(3):  # interleaved: a C run of several passes, then the reference
+            run = export.run_loop_c(ctl, plant, r, rounds=max(2, rounds // 6))
+            c_s = min(c_s, run.ns_per_sample * 1e-9)
+            _, ref_t = _interleaved(lambda: None, lambda: reference(chosen), 2)
+            ref_s = min(ref_s, ref_t / n)
+    err = float(np.max(np.abs(run.x - exact[: run.x.size]))) / stroke
+    return NativeRow("exported C loop around Dahl (per sample)", f"numba({chosen:.0e})", c_s, ref_s, err, ref_err, 2.0)
 
 
 def _along_rows(rounds: int) -> list[NativeRow]:

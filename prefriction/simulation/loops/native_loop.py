@@ -31,7 +31,7 @@ from prefriction.simulation.native.forced import FORCED_SOURCE, FHEAD, input_fun
 from prefriction.simulation.native.library import _DRIVER
 from prefriction.simulation.native.model_code import model_source
 
-__all__ = ["CAPACITY", "LoopDriver", "loop_driver", "run_blocks"]
+__all__ = ["CAPACITY", "LoopDriver", "loop_driver", "loop_source", "run_blocks"]
 
 _LOOP = (Path(__file__).parent.parent / "native" / "loop.c").read_text()  # with the driver's other C files
 _D = np.ctypeslib.ndpointer(dtype=np.float64, flags="C_CONTIGUOUS")
@@ -85,17 +85,7 @@ def loop_driver(spec: LoopSpec) -> tuple[Optional[LoopDriver], float]:
             return _CACHE[key], 0.0
         start = time.perf_counter()
         check_sizes(model)
-        LL = LoopLayout(spec)
-        u_sig = compiled_form(Constant(0.0))
-        ix, inp, rec = LL.state, LL.inp, LL.rec
-        defs = {"PF_FORCED": 1, "PF_NPC": 3, "PF_LNS": LL.nS, "PF_LNW": LL.nw, "PF_LNREC": LL.nrec,
-                "PF_LI_T0": inp["t0"], "PF_LI_T1": inp["t1"], "PF_LI_ACTIVE": inp["active"], "PF_LI_TL": inp["tl"],
-                "PF_LI_DA": inp["da"], "PF_LI_DB": inp["db"], "PF_LS_S": ix["s"], "PF_LR_F": rec["F"],
-                "PF_LR_U": rec["u"], "PF_LR_MOVED": rec["moved"], "PF_LR_Y": rec["y"], "PF_LR_COMP": rec["comp"]}
-        assert ix["rest"] == ix["s"] + 1 and ix["W"] == ix["s"] + 2 and ix["Amax"] == ix["s"] + 3  # loop.c reads them so
-        head = "".join(f"#define {k} {v}\n" for k, v in defs.items())
-        code = model_source(model, (input_function(u_sig), _control_function(spec, LL)))
-        source = head + code + _DRIVER + FORCED_SOURCE + _LOOP
+        source = loop_source(spec)
         name = f"native_{type(model).__name__.lower()}_loop{spec.n_c}"
         if spec.comp.n_state or spec.comp.n_param:
             name += "_" + spec.comp.function().name()
@@ -103,6 +93,22 @@ def loop_driver(spec: LoopSpec) -> tuple[Optional[LoopDriver], float]:
         driver = None if handle is None else LoopDriver(handle, spec, info)
         _CACHE[key] = driver
         return driver, time.perf_counter() - start
+
+
+def loop_source(spec: LoopSpec, extra: tuple[ca.Function, ...] = ()) -> str:
+    """The C source of the native loop of ``spec``: the layout's sizes, the model's generated code
+    with the input, ``pf_ctrl`` and the ``extra`` Functions, ``driver.c``, ``forced.c`` and ``loop.c``."""
+    LL = LoopLayout(spec)
+    u_sig = compiled_form(Constant(0.0))
+    ix, inp, rec = LL.state, LL.inp, LL.rec
+    defs = {"PF_FORCED": 1, "PF_NPC": 3, "PF_LNS": LL.nS, "PF_LNW": LL.nw, "PF_LNREC": LL.nrec,
+            "PF_LI_T0": inp["t0"], "PF_LI_T1": inp["t1"], "PF_LI_ACTIVE": inp["active"], "PF_LI_TL": inp["tl"],
+            "PF_LI_DA": inp["da"], "PF_LI_DB": inp["db"], "PF_LS_S": ix["s"], "PF_LR_F": rec["F"],
+            "PF_LR_U": rec["u"], "PF_LR_MOVED": rec["moved"], "PF_LR_Y": rec["y"], "PF_LR_COMP": rec["comp"]}
+    assert ix["rest"] == ix["s"] + 1 and ix["W"] == ix["s"] + 2 and ix["Amax"] == ix["s"] + 3  # loop.c reads them so
+    head = "".join(f"#define {k} {v}\n" for k, v in defs.items())
+    code = model_source(spec.plant.model, (input_function(u_sig), _control_function(spec, LL)) + tuple(extra))
+    return head + code + _DRIVER + FORCED_SOURCE + _LOOP
 
 
 def _load_loop(lib: Path, key: str) -> tuple[Optional[ctypes.CDLL], str]:

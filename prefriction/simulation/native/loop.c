@@ -11,7 +11,9 @@
  * PF_LR_MOVED, PF_LR_Y, PF_LR_COMP (record).
  */
 
+#ifndef PF_LOOP_ROOM
 #define PF_LOOP_ROOM 64L /* least free reversal slots before a period is started */
+#endif
 
 /* nblk sample periods from the loop state S (in and out) and the native run state fst (in and
  * out: carries the step size). Wb: nblk rows of PF_LNW inputs; R: nblk records of PF_LNREC;
