@@ -98,16 +98,14 @@ def test_coverage_fast():
 
 
 @pytest.mark.slow
-def test_coverage_at_least_90_percent():
-    """Over the five cases (about 320 intervals, a binomial sd near 1.2 %) at least 90 % hold the
-    truth; each case at least 80 % (20 records: a case's own coverage is known to about +-5 %)."""
-    rows = coverage_table(("dahl-clean", "dahl-encoder", "maxwell-encoder", "dahl-decay", "closed-loop-encoder"),
-                          runs=20, seed=0)
-    held = sum(sum(r.held.values()) for r in rows)
-    total = sum(len(r.held) * (r.runs - r.failures) for r in rows)
-    assert held / total >= 0.90, [(r.case, r.held) for r in rows]
-    for r in rows:
-        assert r.pooled >= 0.80 and r.failures <= 2, (r.case, r.held, r.failures)
+@pytest.mark.parametrize("case", ["dahl-clean", "dahl-encoder", "maxwell-encoder", "dahl-decay", "closed-loop-encoder"])
+def test_coverage_at_least_90_percent(case):
+    """Each case (20 seeded records, 40-80 intervals) holds the truth in at least 90 % of its 95 %
+    intervals, with at most 2 fits that raise; one case a test, so the cases run in parallel."""
+    (row,) = coverage_table((case,), runs=20, seed=0)
+    held = sum(row.held.values())
+    total = len(row.held) * (row.runs - row.failures)
+    assert held / total >= 0.90 and row.failures <= 2, (row.case, row.held, row.failures)
 
 
 def misfit_result():
