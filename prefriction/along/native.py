@@ -10,6 +10,7 @@ of the result (no per-block assembly; ``docs/along.md``).
 from __future__ import annotations
 
 import ctypes
+import functools
 import os
 import tempfile
 import threading
@@ -49,19 +50,6 @@ def _source(fun: ca.Function, nx: int) -> str:
     return "".join(f"#define {k} {v}\n" for k, v in head.items()) + code + _SOURCE
 
 
-def _load_along(lib: Path, key: str) -> tuple[Optional[ctypes.CDLL], str]:
-    """The verified library loaded with ctypes, or None and what is wrong with it."""
-    problem = store.verify(lib, key)
-    if problem:
-        return None, "" if problem == "missing" else problem
-    try:
-        handle = ctypes.CDLL(str(lib))
-        handle.pf_along
-    except (OSError, AttributeError) as exc:
-        return None, f"{lib} could not be loaded ({exc})"
-    return handle, ""
-
-
 def along_driver(model: FrictionModel, substeps: Optional[int]) -> Optional[ctypes.CDLL]:
     """The library of ``model``'s structure (``substeps``: None for a model with an exact step),
     built once per process; None without a C compiler or if the build fails."""
@@ -73,7 +61,8 @@ def along_driver(model: FrictionModel, substeps: Optional[int]) -> Optional[ctyp
             fun = counted_interval_function(model, 16 if substeps is None else substeps)
             fun = ca.Function("pf_step", fun.sx_in(), fun.call(fun.sx_in()))
             handle, _ = library(f"along_native_{type(model).__name__.lower()}",
-                                _source(fun, model.n_states + model.n_flags), "friction_along in C", _load_along,
+                                _source(fun, model.n_states + model.n_flags), "friction_along in C",
+                                functools.partial(store.load_verified, symbols=("pf_along",)),
                                 "the CasADi block Function")
             if handle is not None:
                 handle.pf_along.restype = None

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import atexit
 import contextlib
+import ctypes
 import hashlib
 import os
 import shutil
@@ -97,6 +98,25 @@ def verify(lib: Path, key: str) -> str:
     if stored[:1] != [actual]:
         return f"{lib} does not match its checksum (truncated, damaged or replaced)"
     return ""
+
+
+def load_verified(lib: Path, key: str, symbols: tuple[str, ...]) -> tuple[Optional[ctypes.CDLL], str]:
+    """The stored library ``lib`` of ``key`` loaded with ctypes once :func:`verify` passes, if it
+    exports every name in ``symbols``; else None and what is wrong (``""`` if there is none yet).
+
+    Every compiled library of the toolbox is loaded here (bind ``symbols`` with
+    :func:`functools.partial` to get the loader :func:`library` takes)."""
+    problem = verify(lib, key)
+    if problem:
+        return None, "" if problem == "missing" else problem
+    try:
+        handle = ctypes.CDLL(str(lib))
+    except OSError as exc:
+        return None, f"{lib} could not be loaded ({exc})"
+    missing = [name for name in symbols if not hasattr(handle, name)]
+    if missing:
+        return None, f"{lib} has no {', '.join(missing)}"
+    return handle, ""
 
 
 def load(fun: ca.Function, lib: Path, key: str) -> tuple[Optional[ca.Function], str]:

@@ -13,6 +13,7 @@ carried over from period to period.
 from __future__ import annotations
 
 import ctypes
+import functools
 import math
 import threading
 import time
@@ -25,9 +26,10 @@ import numpy as np
 from prefriction.errors import SolverError
 from prefriction.models.sizes import check_sizes
 from prefriction.signals import Constant, compiled_form
+from prefriction.simulation import library_store as store
 from prefriction.simulation.compiled import CompileInfo, jit_available, library
 from .compiled_loop import LoopLayout, LoopSpec, control_law
-from prefriction.simulation.native.forced import FORCED_SOURCE, FHEAD, input_function, load_forced
+from prefriction.simulation.native.forced import FORCED_SOURCE, FHEAD, input_function
 from prefriction.simulation.native.library import _DRIVER
 from prefriction.simulation.native.model_code import model_source
 
@@ -89,7 +91,9 @@ def loop_driver(spec: LoopSpec) -> tuple[Optional[LoopDriver], float]:
         name = f"native_{type(model).__name__.lower()}_loop{spec.n_c}"
         if spec.comp.n_state or spec.comp.n_param:
             name += "_" + spec.comp.function().name()
-        handle, info = library(name, source, "sampled loops in C", _load_loop, "the CasADi block Function")
+        handle, info = library(name, source, "sampled loops in C",
+                               functools.partial(store.load_verified, symbols=("pf_run", "pf_forced", "pf_loop")),
+                               "the CasADi block Function")
         driver = None if handle is None else LoopDriver(handle, spec, info)
         _CACHE[key] = driver
         return driver, time.perf_counter() - start
@@ -109,14 +113,6 @@ def loop_source(spec: LoopSpec, extra: tuple[ca.Function, ...] = ()) -> str:
     head = "".join(f"#define {k} {v}\n" for k, v in defs.items())
     code = model_source(spec.plant.model, (input_function(u_sig), _control_function(spec, LL)) + tuple(extra))
     return head + code + _DRIVER + FORCED_SOURCE + _LOOP
-
-
-def _load_loop(lib: Path, key: str) -> tuple[Optional[ctypes.CDLL], str]:
-    """The verified library with ``pf_loop`` loaded with ctypes, or None and what is wrong."""
-    handle, problem = load_forced(lib, key)
-    if handle is not None and not hasattr(handle, "pf_loop"):
-        return None, f"{lib} has no pf_loop"
-    return handle, problem
 
 
 _WHY = {

@@ -16,6 +16,7 @@ table of its :meth:`~prefriction.signals.Signal.piece` numbers.
 from __future__ import annotations
 
 import ctypes
+import functools
 import math
 import threading
 import time
@@ -29,7 +30,8 @@ from prefriction.models.base import FrictionModel
 from prefriction.models.sizes import check_sizes
 from prefriction.simulation.compiled import CompileInfo, jit_available, library
 from prefriction.simulation.native.advance import BLOCK
-from prefriction.simulation.native.library import _DRIVER, _load
+from prefriction.simulation import library_store as store
+from prefriction.simulation.native.library import _DRIVER
 from prefriction.simulation.native.model_code import model_source
 
 if TYPE_CHECKING:
@@ -37,7 +39,7 @@ if TYPE_CHECKING:
     from prefriction.simulation.run import Run
 
 __all__ = ["FORCED_SOURCE", "ForcedDriver", "SAMPLE_BLOCK", "forced_driver", "input_function", "linear_pieces",
-           "load_forced", "run_forced"]
+           "run_forced"]
 
 FHEAD = 14  # run-state entries before z and m (forced.c: st[])
 SAMPLE_BLOCK = 1 << 14  # requested times per C call (4 x 128 kB of output)
@@ -96,18 +98,12 @@ def forced_driver(model: FrictionModel, u_sig: Any) -> tuple[Optional[ForcedDriv
         head = f"#define PF_FORCED {int(u_sig is not None)}\n#define PF_NPC {0 if u_sig is None else u_sig.n_piece}\n"
         source = head + model_source(model, extra) + _DRIVER + FORCED_SOURCE
         name = f"native_{type(model).__name__.lower()}_{'forced' if u_sig is not None else 'dense'}"
-        handle, info = library(name, source, "forced and dense runs in C", load_forced, "the CasADi integrator loop")
+        handle, info = library(name, source, "forced and dense runs in C",
+                              functools.partial(store.load_verified, symbols=("pf_run", "pf_forced")),
+                              "the CasADi integrator loop")
         driver = None if handle is None else ForcedDriver(handle, model, u_sig, info)
         _CACHE[key] = driver
         return driver, time.perf_counter() - start
-
-
-def load_forced(lib: Path, key: str) -> tuple[Optional[ctypes.CDLL], str]:
-    """The verified library with ``pf_forced`` loaded with ctypes, or None and what is wrong."""
-    handle, problem = _load(lib, key)
-    if handle is not None and not hasattr(handle, "pf_forced"):
-        return None, f"{lib} has no pf_forced"
-    return handle, problem
 
 
 def linear_pieces(sig: Any, ta: np.ndarray, tb: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -10,6 +10,7 @@ driver keeps no static mutable data, so threads run it in parallel.
 from __future__ import annotations
 
 import ctypes
+import functools
 import threading
 import time
 from pathlib import Path
@@ -46,19 +47,6 @@ class NativeDriver:
                              _D, _D, _D, _D, _L, _L]
 
 
-def _load(lib: Path, key: str) -> tuple[Optional[ctypes.CDLL], str]:
-    """The verified library loaded with ctypes, or None and what is wrong with it."""
-    problem = store.verify(lib, key)
-    if problem:
-        return None, "" if problem == "missing" else problem
-    try:
-        handle = ctypes.CDLL(str(lib))
-        handle.pf_run
-    except (OSError, AttributeError) as exc:
-        return None, f"{lib} could not be loaded ({exc})"
-    return handle, ""
-
-
 def native_driver(model: FrictionModel) -> tuple[Optional[NativeDriver], float]:
     """The native driver of ``model``'s structure (built once per process) and the setup time
     [s] of this call, or ``(None, 0)`` if it cannot be used: no C compiler, ``PREFRICTION_NO_JIT``,
@@ -74,7 +62,9 @@ def native_driver(model: FrictionModel) -> tuple[Optional[NativeDriver], float]:
         start = time.perf_counter()
         check_sizes(model)
         handle, info = library(f"native_{type(model).__name__.lower()}", model_source(model) + _DRIVER,
-                               "unforced runs in C", _load, "the CasADi integrator loop")
+                               "unforced runs in C",
+                               functools.partial(store.load_verified, symbols=("pf_run",)),
+                               "the CasADi integrator loop")
         driver = None if handle is None else NativeDriver(handle, model, info)
         _CACHE[key] = driver
         return driver, time.perf_counter() - start

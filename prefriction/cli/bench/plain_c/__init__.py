@@ -43,25 +43,13 @@ def c_available() -> bool:
     return _compiler() is not None
 
 
-def _load(lib: Path, key: str) -> tuple[Optional[ctypes.CDLL], str]:
-    """The verified library loaded with ctypes (the cache's checks), or None and what is wrong."""
-    problem = store.verify(lib, key)
-    if problem:
-        return None, "" if problem == "missing" else problem
-    try:
-        dll = ctypes.CDLL(str(lib))
-        dll.dahl_reversals
-    except (OSError, AttributeError) as exc:
-        return None, f"{lib} could not be loaded ({exc})"
-    return dll, ""
-
-
 @functools.lru_cache(maxsize=1)
 def _library() -> ctypes.CDLL:
     """The compiled reference, built once per machine into the compiled-code cache (its checks apply)."""
     if _compiler() is None:
         raise RuntimeError("the plain-C reference needs a C compiler ($CC or gcc) on the PATH")
-    dll, info = library("plain_c_dahl_rk54", SOURCE.read_text(), "the plain-C reference", _load,
+    dll, info = library("plain_c_dahl_rk54", SOURCE.read_text(), "the plain-C reference",
+                        functools.partial(store.load_verified, symbols=("dahl_reversals",)),
                         "no plain-C row", cflags=("-O2", "-shared", "-fPIC"))
     if dll is None:
         raise RuntimeError(f"the plain-C reference could not be compiled: {info.reason}")
