@@ -13,7 +13,6 @@ and ``memset``/``memcpy`` are replaced by local loops so that the code needs ``<
 from __future__ import annotations
 
 import re
-from typing import TYPE_CHECKING
 
 import casadi as ca
 import numpy as np
@@ -21,8 +20,8 @@ import numpy as np
 from prefriction.simulation.loops.native_loop import loop_source
 from prefriction.simulation.native.forced import FHEAD
 
-if TYPE_CHECKING:
-    from .plant import _Period
+from .period import Period
+
 
 __all__ = ["CAP", "plant_body", "run_width"]
 
@@ -126,7 +125,7 @@ int NAME_step(NAME_state* s, double u) {{
 """
 
 
-def run_width(per: "_Period") -> int:
+def run_width(per: Period) -> int:
     """Entries of the native run state (forced.c ``st[]``) of the period's model."""
     return FHEAD + per.model.n_states + per.model.n_flags
 
@@ -135,7 +134,7 @@ def _numbers(values: np.ndarray) -> str:
     return ", ".join(repr(float(v)) for v in np.atleast_1d(values)) or "0.0"
 
 
-def plant_body(per: "_Period", initial: ca.Function, cfg: np.ndarray, name: str) -> str:
+def plant_body(per: Period, initial: ca.Function, cfg: np.ndarray, name: str) -> str:
     """The C source (after ``#include "<name>.h"``) of the exported plant of ``per``: the native
     loop with ``initial`` (``(x0, v0) -> (w, [x, v, F])``) generated in as ``pf_initial``."""
     init = ca.Function("pf_initial", initial.sx_in(), initial.call(initial.sx_in()), initial.name_in(),

@@ -18,7 +18,6 @@ not happen).
 
 from __future__ import annotations
 
-import math
 from typing import Any, Optional
 
 import casadi as ca
@@ -27,21 +26,13 @@ import numpy as np
 from prefriction._safe_files import output_dir
 from prefriction._validation import check_positive
 from prefriction.models import Oscillator
-from prefriction.signals import Constant
-from prefriction.simulation.loops.compiled_loop import NSTOP, LoopLayout, LoopSpec, _step
-from prefriction.simulation.plant import Layout, PlantSpec
-from prefriction.simulation.loops.records import plant_state
-from prefriction.simulation.simulate import _CAL
-from prefriction.units import Scales
 
 from ._codegen import check_name, check_sample_time, comment_text, write_export
 from .native_plant import CAP, plant_body, run_width
+from .period import Period
 from .source import CSource
 
 __all__ = ["plant_function", "plant_initial_state", "plant_source"]
-
-_K = 2  # the plant's register length: the sampled loop's
-
 
 def _system(system: Any) -> Oscillator:
     if not isinstance(system, Oscillator):
@@ -50,62 +41,6 @@ def _system(system: Any) -> Oscillator:
         raise ValueError("system must have no input force (system.u = None): the exported plant takes the force u "
                          "as its input at each sample")
     return system
-
-
-class _Period:
-    """The loop's period Function for a system, with its constants (parameters, sample time)."""
-
-    def __init__(self, system: Oscillator, Ts: float, rtol: float, force_scale: float) -> None:
-        model, sc = system.friction, Scales.of(system)
-        self.model, self.sc, self.Ts = model, sc, Ts
-        plant = PlantSpec.of(model, Constant(0.0), None, fb="none", n_c=0, energy=False, K=_K, n_out=1,
-                             method="erk", compact=True)
-        self.spec = spec = LoopSpec(plant, 0, 1)
-        self.LL = LL = LoopLayout(spec)
-        L = Layout(plant)
-        self.step = _step(spec, LL)
-        par = np.zeros(LL.npar)
-        P0 = par[LL.p_plant]
-        P0[L.param["eps"]] = eps = rtol * _CAL * math.sqrt(L.n_active / L.nx)
-        P0[L.param["snap"]] = rtol
-        P0[L.param["tunit"]], P0[L.param["xunit"]], P0[L.param["Fc"]] = sc.t, sc.x, sc.F
-        P0[L.q] = model.runtime_params_for(sc)
-        par[LL.param["D"]] = 0.0
-        par[LL.param["umax"]] = 0.0     # the loop's own controller is off: the force comes in as u
-        par[LL.param["Ts"]] = Ts
-        par[LL.param["force_scale"]] = force_scale / sc.F
-        par[LL.p_delay.start] = 1.0     # the measurement of this sample (no delay; unused: no controller)
-        self.par = par
-        self.q = model.runtime_params_for(sc)
-        # the native driver's numbers (forced.c cfg[]): the sampled loop's (loops/runner.py)
-        self.cfg = np.array([rtol * _CAL, eps, rtol, sc.t, 1.0 / sc.F, par[LL.param["force_scale"]], 0.0, 1.0, 0.0])
-
-    def function(self) -> ca.Function:
-        """``(w, u, k) -> (w_next, y)``, ``y = [x, v, F, reversals, complete]`` at ``t_{k+1}`` (SI)."""
-        LL, sc, model = self.LL, self.sc, self.model
-        S, u, k = ca.MX.sym("w", LL.nS), ca.MX.sym("u"), ca.MX.sym("k")
-        Ts_n = self.Ts / sc.t
-        parts: list[Any] = [0.0] * LL.nw  # no reference, noise, input slope: zero
-        for key, val in (("t0", k * Ts_n), ("t1", (k + 1.0) * Ts_n), ("active", 1.0), ("da", u)):
-            parts[LL.inp[key]] = val
-        S1, rec = self.step(S, ca.vertcat(*parts), ca.DM(self.par))
-        n_new = rec[LL.rec["n_new"]]
-        y = ca.vertcat(*self.outputs(S1), n_new + rec[LL.rec["lr"]], n_new < NSTOP - 0.5)
-        return ca.Function("period", [S, u, k], [S1, y], ["w", "u", "k"], ["w_next", "y"])
-
-    def outputs(self, S: Any) -> list[Any]:
-        """Position [m], velocity [m/s] and friction force [N] of the loop state ``S``."""
-        ix, sc, model = self.LL.state, self.sc, self.model
-        z = [S[ix[f"z{i}"]] for i in range(model.n_states)]
-        m = [S[ix[f"m{i}"]] for i in range(model.n_flags)]
-        v = S[ix["v"]]
-        F = model.force(z, m, v, S[ix["s"]], [self.q[i] for i in range(len(self.q))])
-        return [S[ix["x"]] * sc.x, v * sc.v, F * sc.F]
-
-    def initial(self, x0: float, v0: float, F0: float) -> np.ndarray:
-        """The loop state at ``t = 0`` (as the sampled loop starts it, the force at ``t = 0`` unknown:
-        a mass at rest starts at rest and leaves it when the first force moves it)."""
-        return plant_state(self.model, self.sc, self.LL, x0, v0, F0, 0.0)[0]
 
 
 def plant_function(system: Oscillator, Ts: float, *, rtol: float = 1e-8,
@@ -170,14 +105,14 @@ def plant_initial_state(system: Oscillator, Ts: float, x0: float = 0.0, v0: floa
     return _period(system, Ts, rtol, force_scale).initial(float(x0), float(v0), float(F0))
 
 
-def _period(system: Any, Ts: Any, rtol: Any, force_scale: Any) -> _Period:
+def _period(system: Any, Ts: Any, rtol: Any, force_scale: Any) -> Period:
     system = _system(system)
     Ts = check_sample_time(Ts)
     rtol = check_positive("rtol", rtol)
     if not rtol < 1.0:
         raise ValueError(f"rtol must be in (0, 1), got {rtol!r}")
     scale = system.friction.Fc if force_scale is None else check_positive("force_scale", force_scale)
-    return _Period(system, Ts, rtol, scale)
+    return Period(system, Ts, rtol, scale)
 
 
 _HEADER = """\
@@ -332,7 +267,7 @@ def plant_source(system: Oscillator, name: str, directory: Any, *, Ts: float, F0
     return CSource(name, h_path, c_path, "plant", what, fun, n, system, options, digest)
 
 
-def _initial_function(per: _Period, F0: float) -> ca.Function:
+def _initial_function(per: Period, F0: float) -> ca.Function:
     """``(x0, v0) -> (w, [x, v, F])``: the loop state at ``t = 0`` (the direction from the sign of
     ``v0``, else opposing ``F0``; at rest if ``v0 = 0``)."""
     x0, v0 = ca.SX.sym("x0"), ca.SX.sym("v0")

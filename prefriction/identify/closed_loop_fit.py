@@ -38,6 +38,7 @@ from prefriction._validation import check_count, check_positive
 from prefriction.identify.data import Motion
 from prefriction.identify.digital_loop import DigitalLoop
 from prefriction.identify.hac import sandwich
+from prefriction.identify.options import check_solver
 from prefriction.identify.result import FitResult
 from prefriction.identify.statistics import ConvergenceWarning, IdentifiabilityWarning, at_bounds, gauss_newton
 from prefriction.models.base import FrictionModel
@@ -256,9 +257,7 @@ def fit_closed_loop(model: FrictionModel, data: Motion, loop: DigitalLoop, refer
         raise TypeError(f"model must be a prefriction.FrictionModel, got {type(model).__name__}")
     if not isinstance(data, Motion):
         raise TypeError(f"data must be prefriction.identify.Motion, got {type(data).__name__}")
-    from prefriction.identify.inverse import _check_solver
-
-    _check_solver(max_iter, tol, identifiability_limit)
+    check_solver(max_iter, tol, identifiability_limit)
     if not isinstance(loop, DigitalLoop):
         raise TypeError(f"loop must be a DigitalLoop (the known controller), got {type(loop).__name__}")
     r = _series("reference", reference, data.t.size, "m")

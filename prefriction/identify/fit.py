@@ -10,6 +10,7 @@ import numpy as np
 from prefriction._validation import check_bool, check_count, check_finite, check_positive
 from prefriction.errors import SolverError
 from prefriction.identify.data import ForceDisplacement, ForceVelocity, Motion
+from prefriction.identify.options import check_solver
 from prefriction.identify.parameters import ParameterSpace, name_list
 from prefriction.identify.result import FitResult
 from prefriction.identify.validation import model_name
@@ -18,13 +19,6 @@ from prefriction.identify.statistics import (BoundWarning, ConvergenceWarning, I
 from prefriction.models.base import FrictionModel
 
 __all__ = ["fit"]
-
-TOL_RANGE = (1e-14, 1e-6)
-"""Allowed solver tolerances: a looser one stops the solver before the estimates settle within a
-fraction of their standard errors (``fit(tol=10)`` stopped at gamma 1.21 for a truth of 1.5)."""
-MAX_ITER = 100_000
-"""Most solver iterations ``max_iter`` may ask for."""
-
 
 def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequence[str] | None = None,
         fixed: Sequence[str] | None = None, bounds: dict[str, tuple[float, float]] | None = None,
@@ -183,12 +177,7 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
         substeps = check_count("substeps", substeps, 1)
         if substeps > 64:
             raise ValueError(f"substeps must be an integer in [1, 64], got {substeps}")
-    max_iter = check_count("max_iter", max_iter, 1, MAX_ITER, "solver iterations")
-    tol = check_positive("tol", tol)
-    if not TOL_RANGE[0] <= tol <= TOL_RANGE[1]:
-        raise ValueError(f"tol must be in [{TOL_RANGE[0]:g}, {TOL_RANGE[1]:g}], got {tol!r}: a looser tolerance "
-                         f"stops the solver before the estimates settle, a tighter one is below rounding")
-    limit = check_positive("identifiability_limit", identifiability_limit)
+    max_iter, tol, limit = check_solver(max_iter, tol, identifiability_limit)
     offset = check_bool("offset", offset)
     if structures not in ("both", "given"):
         raise ValueError(f"structures must be 'both' or 'given', got {structures!r}")

@@ -35,6 +35,7 @@ import numpy as np
 
 from prefriction.identify.data import ForceDisplacement, Motion
 from prefriction.identify.hac import sandwich
+from prefriction.identify.options import check_solver
 from prefriction.identify.derivatives import Derivatives, derivatives
 from prefriction.identify.result import FitResult
 from prefriction.identify.static_map import StaticFriction
@@ -73,17 +74,6 @@ def applied(data: Motion, delay: float) -> Motion:
     k = np.arange(len(data)) - delay
     u = np.interp(k, np.arange(len(data)), data.u)   # held at u[0] before the record
     return Motion(data.t, data.x, u, data.mass, hold=data.hold)
-
-
-def _check_solver(max_iter: Any, tol: Any, limit: Any) -> None:
-    """The solver options' ranges, as :func:`prefriction.identify.fit` checks them."""
-    from prefriction._validation import check_count, check_positive
-    from prefriction.identify.fit import MAX_ITER, TOL_RANGE
-
-    check_count("max_iter", max_iter, 1, MAX_ITER, "solver iterations")
-    if not TOL_RANGE[0] <= check_positive("tol", tol) <= TOL_RANGE[1]:
-        raise ValueError(f"tol must be in [{TOL_RANGE[0]:g}, {TOL_RANGE[1]:g}], got {tol!r}")
-    check_positive("identifiability_limit", limit)
 
 
 def static_inverse(data: Motion, deriv: Derivatives | None = None, *, directional: bool = False,
@@ -220,7 +210,7 @@ def fit_inverse(model: FrictionModel | StaticFriction, data: Motion, *, offset: 
     from scipy.optimize import least_squares
 
     _check(model, data)
-    _check_solver(max_iter, tol, identifiability_limit)
+    check_solver(max_iter, tol, identifiability_limit)
     data = applied(data, delay)
     d = derivatives(data.t, data.x) if deriv is None else deriv
     notes = [d.summary()] + ([f"force delayed by {delay:g} sample(s)"] if delay else [])
