@@ -20,7 +20,7 @@ from scipy.signal import savgol_filter
 from prefriction.identify.data import Motion
 from prefriction.models.base import FrictionModel
 
-__all__ = ["Start", "StaticStart", "derivatives", "start_values", "static_start", "stiffness_from_reversals"]
+__all__ = ["Start", "StaticStart", "data_start", "derivatives", "start_values", "static_start", "stiffness_from_reversals"]
 
 _RESOLVED = 8
 """Fewest samples in the first third of a reversal transient for a stiffness estimate."""
@@ -55,8 +55,9 @@ def static_start(data: Motion) -> StaticStart | None:
     -------
     StaticStart or None
         ``None`` for a free decay (``u = 0``: the force balance has no scale), when too few
-        samples slide, or when the estimates are not physical (a mass or ``Fc`` not positive, a
-        negative viscous coefficient: the record does not excite the balance enough).
+        samples slide, or when the estimates are not physical (a mass or ``Fc`` not positive: the
+        record does not excite the balance enough). A negative viscous coefficient (a stage
+        without viscous friction, and noise) is refitted without the viscous column: ``b = 0``.
     """
     if data.free_decay:
         return None
@@ -74,11 +75,16 @@ def static_start(data: Motion) -> StaticStart | None:
         rhs = rhs - data.mass * a
     M = np.column_stack(cols)[moving]
     coef, *_ = np.linalg.lstsq(M, rhs[moving], rcond=None)  # no offset column in one direction: 0
+    if not coef[-2] >= 0.0:  # a stage without viscous friction: noise makes b < 0; b = 0 is its estimate
+        col = len(cols) - 2
+        M[:, col] = 0.0
+        coef, *_ = np.linalg.lstsq(M, rhs[moving], rcond=None)
+        coef[col] = 0.0
     if data.mass is None:
         mass, coef = float(coef[0]), coef[1:]
     else:
         mass = None
-    if (mass is not None and not mass > 0.0) or not coef[0] > 0.0 or not coef[1] >= 0.0:
+    if (mass is not None and not mass > 0.0) or not coef[0] > 0.0:
         return None  # a record that does not excite the balance (e.g. one short move): no physical fit
     return StaticStart(mass, float(coef[0]), float(coef[1]), float(coef[2]))
 
@@ -95,11 +101,17 @@ class Start:
         Start offset [N].
     steps : tuple of str
         One line per step of the start pipeline: what was set, and from what.
+    static : StaticStart or None
+        The static least-squares estimates (:func:`static_start`).
+    stiffness : float or None
+        The pre-sliding stiffness [N/m] from the reversal transients (:func:`stiffness_from_reversals`).
     """
 
     mass: float | None
     offset: float
     steps: tuple[str, ...]
+    static: StaticStart | None = None
+    stiffness: float | None = None
 
 
 def start_values(model: FrictionModel, data: Motion, mass0: float | None, offset0: float | None,
@@ -160,7 +172,62 @@ def start_values(model: FrictionModel, data: Motion, mass0: float | None, offset
     if k is not None:
         checks.append(f"stiffness {model.sigma:.4g} N/m (rough check from {k[1]} reversal transients: {k[0]:.4g} N/m)")
     steps.append("friction parameters as given by the start model" + (": " + ", ".join(checks) if checks else ""))
-    return Start(mass0, float(offset0 or 0.0), tuple(steps))
+    return Start(mass0, float(offset0 or 0.0), tuple(steps), fit, None if k is None else k[0])
+
+
+_STIFFNESS = ("sigma", "sigma0")
+_VISCOUS = ("b", "sigma2")
+
+
+def data_start(model: FrictionModel, free: list[str], start: Start) -> tuple[FrictionModel, float | None, float,
+                                                                              str] | None:
+    """A second start from the data alone, for a fit that failed from the user's start: every free
+    Coulomb force at the static estimate (a free ``Fs`` moved with it, keeping the start's
+    ``Fs / Fc``), a free viscous coefficient at the static one (if positive), a free stiffness at
+    the one from the reversal transients (if any), the mass and the offset at the static ones.
+
+    Returns
+    -------
+    tuple or None
+        ``(model, mass0, offset0, line)``, ``line`` saying what was set; ``None`` without static
+        estimates or when nothing would change.
+    """
+    from prefriction.identify.parameters import _build, _entries
+
+    fit = start.static
+    if fit is None:
+        return None
+    entries = [e for e in _entries(model) if e.field not in ("mass", "offset")]
+    values = {e.name: e.value for e in entries}
+    said = []
+    for e in entries:
+        base = e.name.rsplit(".", 1)[-1]
+        if e.name not in free:
+            continue
+        if base == "Fc":
+            values[e.name] = fit.Fc
+        elif base == "Fs":
+            values[e.name] = e.value * fit.Fc / float(model.Fc)
+        elif base in _VISCOUS and fit.b > 0.0:
+            values[e.name] = fit.b
+        elif base in _STIFFNESS and start.stiffness is not None:
+            values[e.name] = start.stiffness
+        else:
+            continue
+        said.append(f"{e.name} {values[e.name]:.4g}")
+    mass0 = start.mass if fit.mass is None or "mass" not in free else fit.mass
+    offset0 = fit.offset if "offset" in free else start.offset
+    if mass0 != start.mass:
+        said.append(f"mass {mass0:.4g} kg")
+    if "offset" in free:
+        said.append(f"offset {offset0:.4g} N")
+    if not said:
+        return None
+    try:
+        new = _build(model, entries, values)
+    except ValueError:
+        return None
+    return new, mass0, offset0, "static least squares and reversal transients: " + ", ".join(said)
 
 
 def _check(value: float | None, unit: str) -> str:
