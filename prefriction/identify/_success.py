@@ -27,7 +27,8 @@ from prefriction.models.dahl import Dahl
 from prefriction.models.lugre import LuGre
 from prefriction.models.viscous import Viscous
 
-__all__ = ["GRID", "STAGES", "Stage", "SuccessRow", "stage_record", "start_model", "success_table", "table_text"]
+__all__ = ["GRID", "STAGES", "Stage", "SuccessRow", "coverage_text", "pooled_text", "stage_record", "start_model",
+           "success_table", "table_text"]
 
 TOLERANCE = 0.05
 """Largest relative error of every estimate for a fit to count as a success."""

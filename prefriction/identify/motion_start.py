@@ -24,6 +24,9 @@ __all__ = ["Start", "StaticStart", "data_start", "derivatives", "start_values", 
 
 _RESOLVED = 8
 """Fewest samples in the first third of a reversal transient for a stiffness estimate."""
+_SECANT = 2.0 / (3.0 * np.log(1.5))
+"""Secant slope of the first third of a reversal transient in units of the stiffness (exponential
+approach from the opposite sliding level: Dahl with ``gamma = 1``, LuGre at low speed)."""
 _WINDOW = 21
 """Samples of the Savitzky-Golay window (cubic) of the velocity and acceleration estimates."""
 
@@ -105,6 +108,8 @@ class Start:
         The static least-squares estimates (:func:`static_start`).
     stiffness : float or None
         The pre-sliding stiffness [N/m] from the reversal transients (:func:`stiffness_from_reversals`).
+    transients : int
+        The number of reversal transients it comes from (the second start uses it from 2 on).
     """
 
     mass: float | None
@@ -112,6 +117,7 @@ class Start:
     steps: tuple[str, ...]
     static: StaticStart | None = None
     stiffness: float | None = None
+    transients: int = 0
 
 
 def start_values(model: FrictionModel, data: Motion, mass0: float | None, offset0: float | None,
@@ -168,11 +174,17 @@ def start_values(model: FrictionModel, data: Motion, mass0: float | None, offset
             if b is None:
                 b = sum(getattr(m, "b", 0.0) for m in getattr(model, "models", ()))
             checks.append(f"viscous {b:.4g} N s/m (static: {fit.b:.4g} N s/m)")
-    k = stiffness_from_reversals(data, mass0 if data.mass is None else data.mass, offset0 or 0.0)
+    if data.mass is not None:
+        m_data, off_data = data.mass, (fit.offset if fit is not None else offset0 or 0.0)
+    elif fit is not None:  # the check and the second start (data_start) from the data alone
+        m_data, off_data = fit.mass, fit.offset
+    else:
+        m_data, off_data = mass0, offset0 or 0.0
+    k = stiffness_from_reversals(data, m_data, off_data)
     if k is not None:
         checks.append(f"stiffness {model.sigma:.4g} N/m (rough check from {k[1]} reversal transients: {k[0]:.4g} N/m)")
     steps.append("friction parameters as given by the start model" + (": " + ", ".join(checks) if checks else ""))
-    return Start(mass0, float(offset0 or 0.0), tuple(steps), fit, None if k is None else k[0])
+    return Start(mass0, float(offset0 or 0.0), tuple(steps), fit, None if k is None else k[0], 0 if k is None else k[1])
 
 
 _STIFFNESS = ("sigma", "sigma0")
@@ -184,7 +196,8 @@ def data_start(model: FrictionModel, free: list[str], start: Start) -> tuple[Fri
     """A second start from the data alone, for a fit that failed from the user's start: every free
     Coulomb force at the static estimate (a free ``Fs`` moved with it, keeping the start's
     ``Fs / Fc``), a free viscous coefficient at the static one (if positive), a free stiffness at
-    the one from the reversal transients (if any), the mass and the offset at the static ones.
+    the one from the reversal transients (if two or more resolve it), the mass and the offset at
+    the static ones.
 
     Returns
     -------
@@ -210,7 +223,7 @@ def data_start(model: FrictionModel, free: list[str], start: Start) -> tuple[Fri
             values[e.name] = e.value * fit.Fc / float(model.Fc)
         elif base in _VISCOUS and fit.b > 0.0:
             values[e.name] = fit.b
-        elif base in _STIFFNESS and start.stiffness is not None:
+        elif base in _STIFFNESS and start.stiffness is not None and start.transients >= 2:
             values[e.name] = start.stiffness
         else:
             continue
@@ -239,9 +252,12 @@ def stiffness_from_reversals(data: Motion, mass: float, offset: float) -> tuple[
     record, and the number of transients used.
 
     After a reversal the friction force ``F = u - m a - F_off`` (``a`` from the smoothed
-    positions) moves from one sliding level to the other; its slope against the position over
-    the first third of that change is the pre-sliding stiffness (``dF/dx = sigma`` at a reversal
-    of Dahl (3.2) and LuGre). The median over the reversals is returned; ``None`` for a free
+    positions) moves from one sliding level to the other; its secant slope against the position
+    over the first third of that change, divided by :data:`_SECANT`, is the pre-sliding
+    stiffness: from the sliding level ``-s Fc`` the gap ``w = 1 - s F / Fc`` of Dahl (3.2) with
+    ``gamma = 1`` (and of LuGre at low speed) decays as ``dw/dx = -sigma w / Fc`` from 2 to
+    ``4/3`` over the first third, a secant slope of ``2 sigma / (3 ln 1.5) = 1.64 sigma``
+    (``dF/dx = sigma`` holds only from ``F = 0``). The median over the reversals is returned; ``None`` for a free
     decay or when no transient spans :data:`_RESOLVED` samples (at 1 kHz a stage's transient
     lasts a few samples and the smoothing spans it: the slope came out 50 times too stiff).
     """
@@ -264,7 +280,7 @@ def stiffness_from_reversals(data: Motion, mass: float, offset: float) -> tuple[
         near = np.abs(Fs - Fs[0]) <= span / 3.0
         if np.count_nonzero(near) < _RESOLVED or np.ptp(xseg[near]) <= 0.0:
             continue
-        slope = np.polyfit(xseg[near], Fs[near], 1)[0] * s
+        slope = np.polyfit(xseg[near], Fs[near], 1)[0] * s / _SECANT
         if slope > 0.0:
             slopes.append(slope)
     if not slopes:
