@@ -27,7 +27,7 @@ from prefriction.models.dahl import Dahl
 from prefriction.models.lugre import LuGre
 from prefriction.models.viscous import Viscous
 
-__all__ = ["GRID", "STAGES", "Stage", "SuccessRow", "coverage_text", "pooled_text", "stage_record", "start_model",
+__all__ = ["GRID", "STAGES", "Stage", "SuccessRow", "coverage_text", "pooled_text", "row_from_dict", "stage_record", "start_model",
            "success_table", "table_text"]
 
 TOLERANCE = 0.05
@@ -469,6 +469,11 @@ def coverage_text(rows: list[SuccessRow], key=lambda r: r.label) -> str:
     return "\n".join(lines)
 
 
+def row_from_dict(d: dict) -> SuccessRow:
+    """A :class:`SuccessRow` from ``dataclasses.asdict`` of one, read back from JSON."""
+    return SuccessRow(**{k: (tuple(map(tuple, v)) if k == "spread" else v) for k, v in d.items()})
+
+
 def _rate(ok: int, n: int) -> str:
     return f"{ok}/{n} ({ok / n:.0%})" if n else "-"
 
@@ -495,8 +500,7 @@ def main(argv: list[str] | None = None) -> None:
     args = ap.parse_args(argv)
     if args.report:
         with open(args.report, encoding="utf-8") as fh:
-            rows = [SuccessRow(**{k: (tuple(map(tuple, v)) if k == "spread" else v) for k, v in json.loads(line).items()})
-                    for line in fh if line.strip()]
+            rows = [row_from_dict(json.loads(line)) for line in fh if line.strip()]
     else:
         stages = GRID if args.grid else STAGES
         if args.stages:

@@ -263,6 +263,7 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
                               offset0=offset_start)
 
     space = space_of(model, start.mass, start.offset)
+    first_steps = start.steps
     try:
         sol, error = fit_motion(model, data, space, n_sub=substeps, max_iter=max_iter, tol=tol,
                                 reversals=reversals), None
@@ -289,9 +290,9 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
                 if keep:
                     sol, space, error = sol2, space2, None
     if sol is None:
-        advice = _route_advice(data)
-        if advice:
-            raise SolverError(f"{error}; {advice}") from error
+        extra = "".join(f"; {x}" for x in (_route_advice(data), *start.steps[len(first_steps):]) if x)
+        if extra:
+            raise SolverError(f"{error}{extra}") from error
         raise error
     message = sol.message
     if not sol.success:
