@@ -118,7 +118,7 @@ def test_harness_sample_lands_within_5_percent():
     assert rows[0].successes == 3, table_text(rows)
     assert max(s for s, _ in rows[0].spread) <= np.log(2.0) and rows[0].returned == 3
     assert "| Dahl | 3/3 (100%)" in pooled_text(rows)
-    assert set(rows[0].held) == {"sigma", "Fc", "mass"} and "| Dahl | 3 |" in coverage_text(rows)
+    assert set(rows[0].held) == {"sigma", "Fc", "mass"} and "| Dahl | 1 | 3 |" in coverage_text(rows)
 
 
 def test_second_start_from_the_data_is_within_a_factor_two():

@@ -18,6 +18,9 @@ each 95 % interval holds the true value:
   1 kHz; :func:`prefriction.identify.synthetic_loop.closed_loop_record`, scipy LSODA between the
   samples) read by a 50 nm encoder after 100 nm of noise, a :class:`Motion` fit with the mass
   free (started at the values of ``tests/test_identify_closed_loop.py``);
+- ``user-stage-dahl-closed``, ``user-stage-dahl-open``: the 2.5 kg / 5 kHz / 10 nm stage of
+  :data:`prefriction.identify._success.GRID` (Dahl + viscous + offset, PID loop or a two-tone
+  force), a :class:`Motion` fit with the mass free from 1.3 times the truth;
 - ``dahl-decay``: the free decay of the Dahl oscillator (2.1) (:func:`prefriction.identify.synthetic.dahl_free_decay`:
   DOP853 between the exact reversals), positions with Gaussian noise, a :class:`Motion` fit.
 
@@ -124,6 +127,26 @@ def _closed_loop(rng: np.random.Generator, n: int) -> tuple:
                                                                         "offset": True}
 
 
+def _stage(index: int) -> Callable:
+    """A stage of :data:`prefriction.identify._success.GRID`: a scipy record (LSODA per sample,
+    the encoder rounding after noise of a third of a step), a :class:`Motion` fit with the mass
+    free from every free parameter 1.3 times the truth (the offset: the truth plus ``0.3 Fc``)."""
+    def make(rng: np.random.Generator, n: int) -> tuple:
+        from prefriction.identify._success import GRID, stage_record
+        from prefriction.identify.parameters import _build, _entries
+
+        stage = GRID[index]
+        truth = stage.truth()
+        model = stage.model()
+        entries = [e for e in _entries(model) if e.field not in ("mass", "offset")]
+        start = _build(model, entries, {e.name: e.value * (1.3 if e.name in stage.free else 1.0) for e in entries})
+        kw = {"fixed": [e.name for e in entries if e.name not in stage.free], "mass0": 1.3 * stage.mass}
+        if stage.fit_offset:
+            kw.update(offset=True, offset0=stage.offset + 0.3 * stage.friction.Fc)
+        return stage_record(stage, n, rng), start, truth, kw
+    return make
+
+
 CASES: dict[str, tuple[Callable, int]] = {
     "dahl-clean": (_dahl(False), 1200),
     "dahl-encoder": (_dahl(True), 1200),
@@ -131,6 +154,8 @@ CASES: dict[str, tuple[Callable, int]] = {
     "maxwell-encoder": (_maxwell, 401),
     "dahl-decay": (_decay, 400),
     "closed-loop-encoder": (_closed_loop, 800),
+    "user-stage-dahl-closed": (_stage(8), 1000),
+    "user-stage-dahl-open": (_stage(9), 1000),
 }
 """Case name: (record maker, samples)."""
 

@@ -450,22 +450,26 @@ def pooled_text(rows: list[SuccessRow], key=lambda r: r.label) -> str:
 
 def coverage_text(rows: list[SuccessRow], key=lambda r: r.label) -> str:
     """How often the 95 % intervals of the fits of :func:`success_table` hold the truth, per
-    parameter, pooled over the stages with the same ``key`` and over all start distances."""
-    groups: dict = {}
+    parameter, pooled over the stages with the same ``key``. The fits of one stage share its
+    record (they differ only in the start), so each record counts once: its weight is spread
+    evenly over its fits that returned estimates."""
+    records: dict = {}
     for r in rows:
-        groups.setdefault(key(r), []).append(r)
-    lines = ["| model | fits with estimates | coverage per parameter | pooled |", "|---|---:|---|---:|"]
-    for name, rs in groups.items():
-        held: dict = {}
-        for r in rs:
-            for p, h in r.held.items():
-                held.setdefault(p, [0, 0])
-                held[p][0] += h
-                held[p][1] += r.returned
-        n = sum(r.returned for r in rs)
-        per = ", ".join(f"{p} {h / max(m, 1):.0%}" for p, (h, m) in held.items())
-        tot = sum(h for h, _ in held.values()) / max(sum(m for _, m in held.values()), 1)
-        lines.append(f"| {name} | {n} | {per} | {tot:.0%} |")
+        rec = records.setdefault(r.stage, {"key": key(r), "held": {}, "returned": 0})
+        rec["returned"] += r.returned
+        for p, h in r.held.items():
+            rec["held"][p] = rec["held"].get(p, 0) + h
+    groups: dict = {}
+    for rec in records.values():
+        if rec["returned"]:
+            groups.setdefault(rec["key"], []).append(rec)
+    lines = ["| model | records | fits with estimates | coverage per parameter (records weighted equally) | pooled |",
+             "|---|---:|---:|---|---:|"]
+    for name, recs in groups.items():
+        per = {p: float(np.mean([rec["held"][p] / rec["returned"] for rec in recs])) for p in recs[0]["held"]}
+        text = ", ".join(f"{p} {v:.0%}" for p, v in per.items())
+        fits = sum(rec["returned"] for rec in recs)
+        lines.append(f"| {name} | {len(recs)} | {fits} | {text} | {float(np.mean(list(per.values()))):.0%} |")
     return "\n".join(lines)
 
 
