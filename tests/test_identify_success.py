@@ -198,12 +198,12 @@ def test_gms_tribometer_fit_returns_a_valid_model():
 def test_success_rate_over_the_grid_sample():
     """A larger seeded sample of the grid: one stage per model (Dahl+b+offset open 0.3 kg / 10 kHz
     / 1 nm, Dahl closed-loop PID 2.5 kg / 5 kHz / 10 nm, LuGre+b+offset closed-loop PID 2.5 kg,
-    LuGre+b+offset closed-loop PID 95.1 kg / 1 kHz / 50 nm), three starts each within a factor 2:
-    at least 90 % of the fits land within 5 % of every true value of the scipy records, and at
+    LuGre+b+offset closed-loop PID 95.1 kg / 1 kHz / 50 nm), two starts each within a factor 2:
+    at most one of the eight fits misses 5 % of any true value of the scipy records, and at
     least 80 % of their 95 % intervals hold it."""
-    rows = success_table((GRID[1], GRID[10], GRID[12], GRID[20]), (2.0,), fits=3, samples=1000, seed=0)
+    rows = success_table((GRID[1], GRID[10], GRID[12], GRID[20]), (2.0,), fits=2, samples=1000, seed=0)
     ok, n = sum(r.successes for r in rows), sum(r.fits for r in rows)
-    assert ok >= 0.9 * n, table_text(rows)
+    assert ok >= n - 1, table_text(rows)
     held = sum(sum(r.held.values()) for r in rows)
     total = sum(len(r.held) * r.returned for r in rows)
     assert held >= 0.8 * total, coverage_text(rows)
