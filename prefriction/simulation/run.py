@@ -264,7 +264,7 @@ def drive(run: Run, t_end: float, n_target: float, times: Optional[np.ndarray], 
     if run.fb is not None and run.fb.sampled:
         return sampled_loop(run, xc0, t_end, n_target)
     if run.native_forced is not None:
-        samples = SampleBuffer(0, len(times) if times is not None else 1024) if want_dense else []
+        samples = SampleBuffer(len(xc0), len(times) if times is not None else 1024) if want_dense else []
         run_forced(run, t_end, n_target, times, samples if want_dense else None)
         return samples, []
     if want_dense:
