@@ -30,6 +30,7 @@ from prefriction.models.base import FrictionModel
 from prefriction.models.sizes import check_sizes
 from prefriction.simulation.compiled import CompileInfo, jit_available, library
 from prefriction.simulation.native.advance import BLOCK
+from prefriction.simulation.native.controller import controller_numbers
 from prefriction.simulation import library_store as store
 from prefriction.simulation.native.library import _DRIVER
 from prefriction.simulation.native.model_code import model_source
@@ -172,9 +173,7 @@ def run_forced(run: "Run", t_end: float, n_target: float, times: Optional[np.nda
                     1.0 / sc.x])
     fb_args: tuple = ()
     if drv.nc:
-        from prefriction.simulation.native.closed import controller_numbers
-
-        fb_args = controller_numbers(run, state, _pieces(run, run.spec.r_sig, t_end)[1])
+        fb_args = controller_numbers(run, state, FHEAD + drv.nz + drv.nm, _pieces(run, run.spec.r_sig, t_end)[1])
     cnt = np.zeros(3, np.int64)
     n_all = len(run.rev)
     code = 1
