@@ -49,7 +49,8 @@
 #define PF_EPS_REST 3.0
 #define PF_EPS_START 1e-13
 
-enum { PF_F_REVERSALS = 0, PF_F_T_END = 1, PF_F_DIED_OUT = 2, PF_F_NONFINITE = 3, PF_F_STEP_UNDERFLOW = 5 };
+enum { PF_F_REVERSALS = 0, PF_F_T_END = 1, PF_F_DIED_OUT = 2, PF_F_NONFINITE = 3, PF_F_STEP_UNDERFLOW = 5,
+       PF_F_STIFF = 6 };
 
 typedef struct {
   pf_ctx c;
@@ -273,7 +274,8 @@ static double pf_branch_energy(pf_fctx* f, const double* Y) {
  * cnt[0] reversals written, cnt[1] samples written, cnt[2] accepted steps (added to). */
 static int pf_forced_run(const double* q, const double* th, const double* brk, long nbrk, const double* pcs,
                          const double* cfg, double* st, double t_end, long n_max, double* rev, const double* td,
-                         long nd, double* out, long* cnt, const double* fbp, const double* thr, const double* pcr) {
+                         long nd, double* out, long* cnt, const double* fbp, const double* thr, const double* pcr,
+                         int stiff_ok) {
   pf_fctx f;
   pf_step P;
   double Y[PF_NF], Y0[PF_NF], Ys[PF_NF], f0[PF_NF], e[PF_NF], U[7][PF_NF], g0[PF_NEA], g1[PF_NEA], sc[PF_NF];
@@ -283,7 +285,8 @@ static int pf_forced_run(const double* q, const double* th, const double* brk, l
   const int n_act = PF_NY + PF_FORCED + dense + PF_NC;
   double t = st[0], ne = st[4], Amax = st[8], h = st[9], Eb = st[11], t_last = st[12], t_prev = st[13];
   double err, err_prev = 1.0, fac, F0, F_end, Fmax = 0.0, vs = 0.0;
-  long n = cnt[0], jd = cnt[1], *steps = cnt + 2;
+  long n = cnt[0], jd = cnt[1], *steps = cnt + 2, branch_steps = 0, stiff = 0, nonstiff = 0;
+  double y6[PF_NF];
   int i, j, rejected = 0, fsal = 0, nonfinite = 0, rest = st[5] > 0.5, leaving = 0, code = PF_F_T_END;
   memset(&f, 0, sizeof f);
   memset(&P, 0, sizeof P);
@@ -422,7 +425,7 @@ static int pf_forced_run(const double* q, const double* th, const double* brk, l
         for (i = 0; i < PF_NM; ++i) f.c.m[i] = mn[i];
         Y[PF_IW] = 0.0;
         ne = 0.0;
-        t_prev = t_last; t_last = t;
+        t_prev = t_last; t_last = t; branch_steps = 0;
         Eb = pf_branch_energy(&f, Y);
       }
       Y[1] = 0.0;
@@ -456,6 +459,7 @@ static int pf_forced_run(const double* q, const double* th, const double* brk, l
         for (l = 0; l < j; ++l) acc += pf_A[j][l] * U[l][i];
         Ys[i] = acc;
       }
+      if (j == 5) memcpy(y6, Ys, sizeof y6);
       pf_ff(&f, t + cst[j] * h, Ys, U[j]);
       for (i = 0; i < PF_NF; ++i) U[j][i] *= h;
     }
@@ -475,7 +479,20 @@ static int pf_forced_run(const double* q, const double* th, const double* brk, l
     }
     F_end = f.F_last; /* the last stage is the step's end */
     ++*steps;
+    ++branch_steps;
     nonfinite = 0;
+    if (stiff_ok) { /* 15 stiff steps (no 6 non-stiff ones between) long after the last reversal: driver.c */
+      double num = 0.0, den = 0.0;
+      for (i = 0; i < PF_NY; ++i) {
+        double a = (U[6][i] - U[5][i]) / sc[i], b = (Ys[i] - y6[i]) / sc[i];
+        num += a * a;
+        den += b * b;
+      }
+      if (den > 0.0 && num > 3.25 * 3.25 * den) {
+        nonstiff = 0;
+        if (++stiff >= 15 && branch_steps > PF_STIFF_STEPS) { code = PF_F_STIFF; break; }
+      } else if (++nonstiff >= 6) stiff = 0;
+    }
     P.U = (const double (*)[PF_NF])U;
     P.y0 = Y0;
     P.off = PF_FORCED ? PF_EPS_START * A : 0.0;
@@ -562,7 +579,7 @@ static int pf_forced_run(const double* q, const double* th, const double* brk, l
         Y[PF_IW] = 0.0;
         f.c.s = -f.c.s;
         ne = 0.0;
-        t_prev = t_last; t_last = t;
+        t_prev = t_last; t_last = t; branch_steps = 0;
         Eb = pf_branch_energy(&f, Y);
         Fmax = 0.0;
       }
@@ -663,7 +680,14 @@ static int pf_forced_run(const double* q, const double* th, const double* brk, l
 int pf_forced(const double* q, const double* th, const double* brk, long nbrk, const double* pcs,
               const double* cfg, double* st, double t_end, long n_max, double* rev, const double* td, long nd,
               double* out, long* cnt) {
-  return pf_forced_run(q, th, brk, nbrk, pcs, cfg, st, t_end, n_max, rev, td, nd, out, cnt, 0, 0, 0);
+  return pf_forced_run(q, th, brk, nbrk, pcs, cfg, st, t_end, n_max, rev, td, nd, out, cnt, 0, 0, 0, 0);
+}
+
+/* pf_forced that stops with PF_F_STIFF on a stiff stretch (the caller continues on an implicit method) */
+int pf_forced_stiff(const double* q, const double* th, const double* brk, long nbrk, const double* pcs,
+                    const double* cfg, double* st, double t_end, long n_max, double* rev, const double* td, long nd,
+                    double* out, long* cnt) {
+  return pf_forced_run(q, th, brk, nbrk, pcs, cfg, st, t_end, n_max, rev, td, nd, out, cnt, 0, 0, 0, 1);
 }
 
 #if PF_NC
@@ -673,6 +697,6 @@ int pf_forced(const double* q, const double* th, const double* brk, long nbrk, c
 int pf_forced_fb(const double* q, const double* th, const double* brk, long nbrk, const double* pcs,
                  const double* cfg, double* st, double t_end, long n_max, double* rev, const double* td, long nd,
                  double* out, long* cnt, const double* fbp, const double* thr, const double* pcr) {
-  return pf_forced_run(q, th, brk, nbrk, pcs, cfg, st, t_end, n_max, rev, td, nd, out, cnt, fbp, thr, pcr);
+  return pf_forced_run(q, th, brk, nbrk, pcs, cfg, st, t_end, n_max, rev, td, nd, out, cnt, fbp, thr, pcr, 0);
 }
 #endif

@@ -29,11 +29,12 @@ import numpy as np
 from prefriction.models.base import FrictionModel
 from prefriction.models.sizes import check_sizes
 from prefriction.simulation.compiled import CompileInfo, jit_available, library
-from prefriction.simulation.native.advance import BLOCK
+from prefriction.simulation.native.advance import BLOCK, STIFF
 from prefriction.simulation.native.controller import controller_numbers
 from prefriction.simulation import library_store as store
 from prefriction.simulation.native.library import _DRIVER
 from prefriction.simulation.native.model_code import model_source
+from prefriction.simulation.stiff_forced import advance_stiff_forced
 
 if TYPE_CHECKING:
     from prefriction.simulation.dense import SampleBuffer
@@ -70,10 +71,13 @@ class ForcedDriver:
         self.u_sig = u_sig  # the structure's input (the zero input of an unforced closed loop)
         self.n_piece = 0 if u_sig is None else u_sig.n_piece
         self.linear = u_sig is not None and u_sig.key == ("PiecewiseLinear",)
+        args = [_D, _D, _D, ctypes.c_long, _D, _D, _D, ctypes.c_double, ctypes.c_long, _D, _D, ctypes.c_long, _D, _L]
         self.call = lib.pf_forced_fb if n_c else lib.pf_forced
         self.call.restype = ctypes.c_int
-        self.call.argtypes = [_D, _D, _D, ctypes.c_long, _D, _D, _D, ctypes.c_double, ctypes.c_long, _D,
-                              _D, ctypes.c_long, _D, _L] + ([_D, _D, _D] if n_c else [])
+        self.call.argtypes = args + ([_D, _D, _D] if n_c else [])
+        self.call_stiff = lib.pf_forced_stiff  # stops on a stiff stretch (code 6: stiff_forced.py goes on)
+        self.call_stiff.restype = ctypes.c_int
+        self.call_stiff.argtypes = args
 
 
 def input_function(u_sig: Any, name: str = "pf_input") -> ca.Function:
@@ -104,7 +108,7 @@ def forced_driver(model: FrictionModel, u_sig: Any, r_sig: Any = None,
         check_sizes(model)
         extra = () if u_sig is None else (input_function(u_sig),)
         head = f"#define PF_FORCED {int(u_sig is not None)}\n#define PF_NPC {0 if u_sig is None else u_sig.n_piece}\n"
-        symbols: tuple[str, ...] = ("pf_run", "pf_forced")
+        symbols: tuple[str, ...] = ("pf_run", "pf_forced", "pf_forced_stiff")
         name = f"native_{type(model).__name__.lower()}_{'forced' if u_sig is not None else 'dense'}"
         if n_c:
             extra += (input_function(r_sig, "pf_ref"),)
@@ -176,6 +180,8 @@ def run_forced(run: "Run", t_end: float, n_target: float, times: Optional[np.nda
         fb_args = controller_numbers(run, state, FHEAD + drv.nz + drv.nm, _pieces(run, run.spec.r_sig, t_end)[1])
     cnt = np.zeros(3, np.int64)
     n_all = len(run.rev)
+    # the stiff switch: open-loop runs without dense output (simulation/stiff_forced.py)
+    entry = drv.call_stiff if buf is None and not drv.nc and run.system.forced else drv.call
     code = 1
 
     def call(t_stop: float, td: np.ndarray) -> int:
@@ -189,8 +195,8 @@ def run_forced(run: "Run", t_end: float, n_target: float, times: Optional[np.nda
                 return 0
             rev = np.empty(5 * want)
             cnt[0] = 0
-            c = drv.call(q, th, brk, nbrk, pcs, cfg, state, t_stop, want, rev, td if nd else np.zeros(1), nd,
-                         out, cnt, *fb_args)
+            c = entry(q, th, brk, nbrk, pcs, cfg, state, t_stop, want, rev, td if nd else np.zeros(1), nd,
+                      out, cnt, *fb_args)
             run.calls += 1
             k = int(cnt[0])
             if k:
@@ -240,5 +246,10 @@ def run_forced(run: "Run", t_end: float, n_target: float, times: Optional[np.nda
     if "Eb" in st:
         st["Eb"] = float(state[11])
     run.A_max = A_max
-    if code > 1:
+    if code == STIFF:  # the rest of the run on the implicit method (docs/simulator.md#stiff)
+        run.note = (f"switched to the implicit Radau method at t = {t * sc.t:.9g} s after {len(run.rev)} "
+                    f"reversal{'' if len(run.rev) == 1 else 's'}: the explicit Runge-Kutta step was held by stability "
+                    f"(h |lambda| > 3.25 on 15 steps, more than 20,000 steps after the last reversal), the problem is stiff")
+        advance_stiff_forced(run, t_end, n_target)
+    elif code > 1:
         raise run._failure(_WHY.get(code, f"the native driver stopped (code {code})"))
