@@ -25,8 +25,8 @@ as for any one-step method.
 
 This module validates the arguments and assembles the result: the plant (its layout and
 driver) is built in :mod:`prefriction.simulation.build`, run by
-:func:`~prefriction.simulation.run.drive` in :mod:`prefriction.simulation.run`, the reversal table
-:mod:`prefriction.simulation.lazy_table`, the compiled integrator and its buffers
+:func:`~prefriction.simulation.drive.drive` in :mod:`prefriction.simulation.drive`, the
+reversal table :mod:`prefriction.simulation.lazy_table`, the compiled integrator and its buffers
 :mod:`prefriction.simulation.integrator`, the force scale of forced runs
 :mod:`prefriction.simulation.force_scale`.
 """
@@ -41,9 +41,10 @@ import numpy as np
 
 from prefriction.signals import Constant, compiled_form
 from prefriction.simulation.feedback import LinearFeedback
-from prefriction.simulation.dense import N_DENSE, samples_si
+from prefriction.simulation.drive import drive
+from prefriction.simulation.samples import N_DENSE, samples_si
 from prefriction.simulation.rest import initial_direction
-from prefriction.simulation.run import RAMP_ROUNDOFF, Run, check_ramps, drive
+from prefriction.simulation.run import RAMP_ROUNDOFF, Run, check_ramps
 from prefriction.simulation.plant import PlantSpec
 from prefriction.simulation.force_scale import MAX_AMPLITUDE, MIN_AMPLITUDE, applied_force_scale, check_amplitude
 from prefriction.simulation.budget import check_input_budget

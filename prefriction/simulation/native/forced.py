@@ -33,10 +33,10 @@ from prefriction.simulation.native.advance import BLOCK
 from prefriction.simulation import library_store as store
 from prefriction.simulation.native.library import _DRIVER
 from prefriction.simulation.native.model_code import model_source
+from prefriction.simulation.samples import DENSE_STEP, SampleBuffer
 
 if TYPE_CHECKING:
-    from prefriction.simulation.dense import SampleBuffer
-    from prefriction.simulation.run import Run
+    from prefriction.simulation.run_state import RunState
 
 __all__ = ["FORCED_SOURCE", "ForcedDriver", "SAMPLE_BLOCK", "forced_driver", "input_function", "linear_pieces",
            "run_forced"]
@@ -116,7 +116,7 @@ def linear_pieces(sig: Any, ta: np.ndarray, tb: np.ndarray) -> tuple[np.ndarray,
     return u1 - slope * (q1 - ta), slope
 
 
-def _pieces(run: "Run", drv: ForcedDriver, t_end: float) -> tuple[np.ndarray, np.ndarray]:
+def _pieces(run: "RunState", drv: ForcedDriver, t_end: float) -> tuple[np.ndarray, np.ndarray]:
     """The break times (normalised, below ``t_end``) and the per-interval numbers, one row per
     interval ``[b_{k-1}, b_k]`` (``b_{-1} = 0``, the last row to ``t_end``)."""
     sig, sc = run.spec.u_sig, run.sc
@@ -134,13 +134,11 @@ def _pieces(run: "Run", drv: ForcedDriver, t_end: float) -> tuple[np.ndarray, np
     return np.ascontiguousarray(brk, dtype=float), np.ascontiguousarray(table.ravel())
 
 
-def run_forced(run: "Run", t_end: float, n_target: float, times: Optional[np.ndarray],
-               buf: Optional["SampleBuffer"]) -> None:
+def run_forced(run: "RunState", t_end: float, n_target: float, times: Optional[np.ndarray],
+               buf: Optional[SampleBuffer]) -> None:
     """The whole run of ``run`` on its forced driver up to the normalised ``t_end`` or
     ``n_target`` reversals, samples at the normalised ``times`` into ``buf`` (``times`` None
-    and ``buf`` given: every :data:`~prefriction.simulation.dense.DENSE_STEP`)."""
-    from prefriction.simulation.dense import DENSE_STEP
-
+    and ``buf`` given: every :data:`~prefriction.simulation.samples.DENSE_STEP`)."""
     drv, st, model, sc = run.native_forced, run.st, run.model, run.sc
     state = np.empty(drv.width)
     state[:FHEAD] = (st["t"], st["x"], st["v"], st["s"], st.get("ne", 0), st["rest"], st["W"], st["Ef"],
