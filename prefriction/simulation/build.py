@@ -13,6 +13,7 @@ from __future__ import annotations
 from typing import Optional
 
 from prefriction.models.base import FrictionModel
+from prefriction.models.sizes import check_sizes
 from prefriction.simulation.feedback import LinearFeedback
 from prefriction.simulation.integrator import integrator
 from prefriction.simulation.native.forced import forced_driver
@@ -27,7 +28,9 @@ def build_plant(model: FrictionModel, spec: PlantSpec, fb: Optional[LinearFeedba
                 native: bool = True) -> BuiltPlant:
     """Build (or reuse) the plant of ``spec`` for the friction ``model``, on the native drivers
     where they apply (``native`` and ``jit``, no controller ``fb`` for the forced one), else on
-    CasADi's integrator (compiled if ``jit``)."""
+    CasADi's integrator (compiled if ``jit``). The model's sizes are checked first, once per
+    structure (:func:`~prefriction.models.sizes.check_sizes`), for every driver alike."""
+    check_sizes(model)
     L = Layout(spec)  # the same for any number of outputs per call
     drv, setup = native_driver(model) if spec.stops_at_reversal and jit and native else (None, 0.0)
     drv_forced = None

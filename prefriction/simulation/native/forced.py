@@ -27,7 +27,6 @@ import casadi as ca
 import numpy as np
 
 from prefriction.models.base import FrictionModel
-from prefriction.models.sizes import check_sizes
 from prefriction.simulation.compiled import CompileInfo, jit_available, library
 from prefriction.simulation.native.advance import BLOCK
 from prefriction.simulation import library_store as store
@@ -93,7 +92,6 @@ def forced_driver(model: FrictionModel, u_sig: Any) -> tuple[Optional[ForcedDriv
         if key in _CACHE:
             return _CACHE[key], 0.0
         start = time.perf_counter()
-        check_sizes(model)
         extra = () if u_sig is None else (input_function(u_sig),)
         head = f"#define PF_FORCED {int(u_sig is not None)}\n#define PF_NPC {0 if u_sig is None else u_sig.n_piece}\n"
         source = head + model_source(model, extra) + _DRIVER + FORCED_SOURCE
