@@ -152,17 +152,15 @@ def _estimate(run: "Run", buf: SampleBuffer, t_end: float, n_target: float) -> f
     return est
 
 
-def dense_loop(run: "Run", times: Optional[np.ndarray], t_end: float, n_target: float) -> SampleBuffer:
-    """Samples at the normalised ``times`` (every ``DENSE_STEP`` if None), integrating up to the
-    normalised time ``t_end`` or ``n_target`` reversals."""
-    buf = SampleBuffer(len(run.st["xc"]))
+def dense_loop(run: "Run", times: Optional[np.ndarray], t_end: float, n_target: float, buf: SampleBuffer) -> None:
+    """Samples at the normalised ``times`` (every ``DENSE_STEP`` if None) into ``buf``,
+    integrating up to the normalised time ``t_end`` or ``n_target`` reversals."""
     if times is not None:
-        buf.reserve(len(times))  # the user's array bounds the count
         for k in range(0, len(times), _BLOCK):
             if dense(run, times[k:k + _BLOCK], t_end, n_target, buf):
-                return buf
+                return
         run.advance(t_end, n_target)
-        return buf
+        return
     k0 = 0  # index of the next sample: t~ = k DENSE_STEP
     while True:
         block = DENSE_STEP * np.arange(k0, k0 + _BLOCK, dtype=float)
@@ -170,13 +168,13 @@ def dense_loop(run: "Run", times: Optional[np.ndarray], t_end: float, n_target: 
         if block.size and block[-1] < t_end < block[-1] + DENSE_STEP:
             block = np.append(block, t_end)  # the last sample is at t_end
         if block.size == 0:
-            return buf
+            return
         if len(buf) + block.size > buf.capacity:  # grow to the estimated final count (2 % margin),
             # at most doubling: an estimate made early (gross sliding) may be far off
             est = 1.02 * _estimate(run, buf, t_end, n_target) + 2 * N_DENSE
             buf.reserve(max(len(buf) + block.size, int(min(est, 2 * buf.capacity))))
         if dense(run, block, t_end, n_target, buf):
-            return buf
+            return
         k0 += _BLOCK
 
 

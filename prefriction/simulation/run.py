@@ -3,8 +3,7 @@
 :class:`Run` drives the integrator calls of a run (:meth:`Run.advance`); the run's state and
 its bookkeeping are in :mod:`prefriction.simulation.run_state`, the conversion of the state to
 and from a call's buffers in :mod:`prefriction.simulation.state_io`, the rests decided between
-calls in :mod:`prefriction.simulation.rest`. :func:`check_ramps` holds the input's ramps
-against the run's error level before the run; :mod:`prefriction.simulation.drive` runs it on
+calls in :mod:`prefriction.simulation.rest`; :mod:`prefriction.simulation.drive` runs it on
 its path.
 """
 
@@ -17,17 +16,11 @@ import numpy as np
 from prefriction.simulation.compact import advance_compact
 from prefriction.simulation.integrator import INTEGRATOR_FAILED, BufferedIntegrator
 from prefriction.simulation.native.advance import advance_native
-from prefriction.simulation.native.forced import linear_pieces
 from prefriction.simulation.plant import Layout
 from prefriction.simulation.rest import Rest
 from prefriction.simulation.state_io import StateIO
 from prefriction.errors import SolverError
 
-RAMP_ROUNDOFF = 0.3
-"""Largest force error from the round-off of the time in a ramp of the input force, in units of
-the run's error level ``eps`` times the force scale (:func:`prefriction.simulate` refuses
-steeper ramps: they started spurious reversal pairs at a rest, or NaN in CasADi's event
-transition)."""
 _MIN_CALL = 1e-9  # relative length of a call below which a failed call is not made shorter (Run._shorten)
 
 
@@ -180,35 +173,3 @@ class Run(StateIO, Rest):
             return math.inf
         k = np.searchsorted(b, t * (1 + 1e-15) + 1e-300, side="right")
         return float(b[k]) if k < b.size else math.inf
-
-
-def check_ramps(run: Run, t_end: float, rtol: float) -> None:
-    """ValueError if a piece of a piecewise-linear input force is so steep that the round-off of
-    its time makes a force error above :data:`RAMP_ROUNDOFF` of the run's error level.
-
-    The plant evaluates a piece as ``a + b (t - t_k)`` from the normalised time ``t``, which
-    carries a round-off of about ``2^-53 t``; a slope ``b`` turns it into a force error
-    ``2^-53 |b| t``. Near a rest the net force is compared with the error level ``eps`` times the
-    force scale (:data:`prefriction.simulation.plant.EPS_REST`): a larger error started the mass
-    backwards (a spurious reversal pair), or made CasADi's event transition return NaN.
-    """
-    sig, sc = run.spec.u_sig, run.sc
-    if sig is None or sig.key != ("PiecewiseLinear",):
-        return
-    level = run.eps * max(run.force_scale, 1e-300)  # error level of the net force (normalised)
-    t = np.concatenate(([0.0], run.breaks[run.breaks < t_end], [t_end]))
-    _, slopes = linear_pieces(sig, t[:-1] * sc.t, t[1:] * sc.t)  # vectorised: one pass over the pieces
-    slopes = np.abs(slopes) * (sc.t / sc.F)  # normalised
-    errs = slopes * t[1:] * 2.0 ** -53
-    for k in np.flatnonzero(errs > RAMP_ROUNDOFF * level)[:1]:
-        ta, tb, slope, err = float(t[k]), float(t[k + 1]), float(slopes[k]), float(errs[k])
-        if err > RAMP_ROUNDOFF * level:
-            rise = abs(slope) * (tb - ta) * sc.F
-            shortest = rise / sc.F * tb * 2.0 ** -53 / (RAMP_ROUNDOFF * level) * sc.t
-            raise ValueError(
-                f"system.u ramps by {rise:.3g} N over {(tb - ta) * sc.t:.3g} s (from t = {ta * sc.t:.12g} s): at rtol = "
-                f"{rtol:g} that is too steep to simulate, because the round-off of the time there (2^-53 t) makes a "
-                f"force error of {err * sc.F:.3g} N, more than RAMP_ROUNDOFF = {RAMP_ROUNDOFF:g} times the error "
-                f"level of the net force ({level * sc.F:.3g} N) at which a resting mass starts to move. Spread the "
-                f"ramp over at least {shortest:.3g} s, loosen rtol, or drop one of its two samples (a jump)"
-            )

@@ -27,6 +27,7 @@ import casadi as ca
 import numpy as np
 
 from prefriction.models.base import FrictionModel
+from prefriction.signals.compiled import linear_pieces
 from prefriction.simulation.compiled import CompileInfo, jit_available, library
 from prefriction.simulation.native.advance import BLOCK
 from prefriction.simulation import library_store as store
@@ -37,8 +38,7 @@ from prefriction.simulation.samples import DENSE_STEP, SampleBuffer
 if TYPE_CHECKING:
     from prefriction.simulation.run_state import RunState
 
-__all__ = ["FORCED_SOURCE", "ForcedDriver", "SAMPLE_BLOCK", "forced_driver", "input_function", "linear_pieces",
-           "run_forced"]
+__all__ = ["FORCED_SOURCE", "ForcedDriver", "SAMPLE_BLOCK", "forced_driver", "input_function", "run_forced"]
 
 FHEAD = 14  # run-state entries before z and m (forced.c: st[])
 SAMPLE_BLOCK = 1 << 14  # requested times per C call (4 x 128 kB of output)
@@ -102,16 +102,6 @@ def forced_driver(model: FrictionModel, u_sig: Any) -> tuple[Optional[ForcedDriv
         driver = None if handle is None else ForcedDriver(handle, model, u_sig, info)
         _CACHE[key] = driver
         return driver, time.perf_counter() - start
-
-
-def linear_pieces(sig: Any, ta: np.ndarray, tb: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Value at ``ta`` and slope of a piecewise-linear signal (the simulator's compiled form,
-    ``key == ("PiecewiseLinear",)``) on each interval ``[ta, tb]`` [s] (no break inside), in one
-    vectorised pass: the line through the quarter points (exact for a linear piece)."""
-    q1, q3 = ta + 0.25 * (tb - ta), ta + 0.75 * (tb - ta)
-    u1, u3 = np.asarray(sig.base(q1), dtype=float), np.asarray(sig.base(q3), dtype=float)
-    slope = (u3 - u1) / (q3 - q1)
-    return u1 - slope * (q1 - ta), slope
 
 
 def _pieces(run: "RunState", drv: ForcedDriver, t_end: float) -> tuple[np.ndarray, np.ndarray]:
