@@ -58,9 +58,15 @@ def stored_energy(F: np.ndarray, direction: np.ndarray, *, friction: FrictionMod
 def initial_stored_energy(F0: float, v0: float, s0: int, *, friction: FrictionModel, scales: Scales) -> float:
     """Stored energy [J] of the state whose friction force at the velocity ``v0`` [m/s] is ``F0``
     [N] on a branch of direction ``s0``: the model's :meth:`~prefriction.FrictionModel.initial_state`
-    of the rest force ``f`` for which the force at ``v0`` is ``F0`` (``f = F0`` at rest), by
-    ``brentq`` over ``|f|`` up to the model's largest hysteretic force; ``ValueError`` if no
-    such state exists."""
+    of the rest force ``f`` for which the force at ``v0`` is ``F0`` (``f = F0`` at rest).
+
+    While the bristle slides, the force at a given speed need not grow with the deflection (the
+    elasto-plastic ``alpha`` rises from 0 to 1 past breakaway), so several states can have the
+    force ``F0``; the one of least deflection is taken (that of a run started at the rest force
+    0, as :func:`prefriction.simulate` starts by default). The roots are bracketed on 256
+    intervals of ``|f|`` up to the model's largest hysteretic force and refined by ``brentq``;
+    ``ValueError`` if there is none.
+    """
     from scipy.optimize import brentq
 
     f_max = friction.max_hysteretic_force / friction.Fc
@@ -73,10 +79,14 @@ def initial_stored_energy(F0: float, v0: float, s0: int, *, friction: FrictionMo
             z, m = friction.initial_state(f, s0)
             return float(friction.force(z, m, vn, s0, q)) - target
 
-        lo, hi = gap(-f_max), gap(f_max)
-        if not (math.isfinite(lo) and math.isfinite(hi) and lo * hi <= 0.0):
+        grid = np.linspace(-f_max, f_max, 257)
+        g = np.array([gap(f) for f in grid.tolist()])
+        roots = grid[g == 0.0].tolist()
+        for k in np.flatnonzero(np.sign(g[:-1]) * np.sign(g[1:]) < 0).tolist():
+            roots.append(brentq(gap, grid[k], grid[k + 1], xtol=1e-15, rtol=4 * np.finfo(float).eps))
+        if not roots:
             raise ValueError(
                 f"no state of {type(friction).__name__} has the friction force F[0] = {F0!r} N at the velocity "
                 f"v[0] = {v0!r} m/s: F[0] must be the model's force at t[0] with that velocity")
-        target = brentq(gap, -f_max, f_max, xtol=1e-15, rtol=4 * np.finfo(float).eps)
+        target = min(roots, key=abs)
     return float(stored_energy(np.array([target * friction.Fc]), np.array([float(s0)]), friction=friction)[0])
