@@ -30,7 +30,7 @@ from prefriction.simulation.plant import EPS_REST, EPS_START, EPS_TOUCH, event_c
 from prefriction.simulation.stiff import _BAND, _MIN_RTOL, _event, _scales, stiff_functions
 
 if TYPE_CHECKING:
-    from prefriction.simulation.run import Run
+    from prefriction.simulation.run_state import RunState
 
 __all__ = ["advance_stiff_forced"]
 
@@ -48,7 +48,7 @@ def _rhs(model: Any, u: Callable[[float], float], t: float, y: np.ndarray, m: li
 class _Input:
     """The input force ``u~(t~)`` of ``run`` (normalised) and its break times."""
 
-    def __init__(self, run: "Run") -> None:
+    def __init__(self, run: "RunState") -> None:
         sig, sc = run.system.u, run.sc
         self.breaks = run.breaks
         self.u = lambda t: float(sig(t * sc.t)) / sc.F
@@ -71,7 +71,7 @@ def _rest_exit(inp: _Input, F: float, thr: float, t: float, t_end: float) -> flo
     return t_end
 
 
-def advance_stiff_forced(run: "Run", t_end: float, n_target: float) -> None:
+def advance_stiff_forced(run: "RunState", t_end: float, n_target: float) -> None:
     """Continue the forced open-loop ``run`` (state ``run.st``, normalised) with Radau to the
     normalised time ``t_end`` or ``n_target`` reversals, appending reversals ``(t, x, F, W)`` and
     their half-cycles' event counts as the native driver does."""
@@ -161,7 +161,7 @@ def advance_stiff_forced(run: "Run", t_end: float, n_target: float) -> None:
               W=float(y[-1]), F=float(model.force(z, m, v, s, ql)))
 
 
-def _reverse(run: "Run", model: Any, y: np.ndarray, m: list, s: float, t: float, ne: int, ql: list,
+def _reverse(run: "RunState", model: Any, y: np.ndarray, m: list, s: float, t: float, ne: int, ql: list,
              F: float | None = None) -> float:
     """Record the reversal at ``t`` (the force ``F``, by default the force after the model's reset,
     as forced.c; the input's work ``y[-1]``), start the branch of direction ``-s`` in ``y`` and

@@ -9,24 +9,30 @@ the normalised units of the CasADi plant (:mod:`prefriction.simulation.plant`, m
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 if TYPE_CHECKING:
-    from prefriction.simulation.run import Run
+    from prefriction.simulation.run_state import RunState
 
 __all__ = ["controller_numbers"]
 
 
-def controller_numbers(run: "Run", state: np.ndarray, k: int,
+def controller_numbers(run: "RunState", state: np.ndarray, k: int,
                        pcr: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Write the controller states and the clip's mode of ``run`` into the driver's run state
     ``state`` from entry ``k`` on and return the arguments ``fbp, thr, pcr`` of ``pf_forced_fb``
     (``pcr``: the reference's per-interval numbers, rows as the input's)."""
     fb, sc, nc = run.fb, run.sc, run.spec.n_c
     state[k:k + nc] = np.asarray(run.st["xc"], dtype=float)
-    state[k + nc] = run._clip_mode()
+    st = run.st
+    if fb.u_max is None:  # the force limit's mode now: 0 inside, +-1 clipped at +-u_max
+        state[k + nc] = 0.0
+    else:
+        w = float(fb.output(st["xc"], float(fb.reference(st["t"] * sc.t)) - st["x"] * sc.x))
+        state[k + nc] = 0.0 if abs(w) <= fb.u_max else math.copysign(1.0, w)
     Cn = fb.C[0] / sc.F
     xs = np.where(Cn != 0.0, 1.0 / np.where(Cn == 0.0, 1.0, np.abs(Cn)), 1.0)
     umax = 1e300 if fb.u_max is None else fb.u_max / sc.F
