@@ -17,6 +17,13 @@
  * integration is broken at every break time. Dense output: the states at the requested times,
  * from the step's dense output, written into arrays.
  *
+ * A continuous controller (PF_NC > 0 states, pf_forced_fb, native/closed.py): its states join the
+ * integrated state after E_f, its force is added to the input, the reference is pf_ref (PF_NRPC
+ * per-interval numbers, rows as the input's); at rest the plant's rates are zero and the controller
+ * integrates on, the end of the rest and the force limit's switches are events of the steps.
+ * pf_forced_stiff stops with PF_F_STIFF where the step is held by stability (the test of
+ * driver.c), for stiff_forced.py to go on with Radau.
+ *
  * This file follows driver.c (pf_ctx, the tableau, the model's Functions) and needs PF_FORCED
  * (1: an input signal, with pf_input, PF_NPC per-interval numbers; 0: unforced dense runs).
  *
