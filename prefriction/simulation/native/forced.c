@@ -32,10 +32,10 @@
  *   since the last reversal), 7 E_f (friction work since t = 0), 8 largest amplitude so far,
  *   9 the step size to try next (0: none yet), 10 index of the current piece, 11 branch energy
  *   v^2/2 + potential - W, 12 time of the last reversal, 13 of the one before (NaN if none),
- *   14.. z, then m.
+ *   14.. z, then m (with a controller: then xc and the force limit's mode 0, +-1).
  * cfg[]: 0 eps (error control), 1 eps of the thresholds, 2 snap, 3 time unit [s], 4 1/Fc [1/N],
  *   5 force scale, 6 dense (E_f error-controlled), 7 piecewise-linear input (1/0), 8 energy
- *   correction at model events (1/0).
+ *   correction at model events (1/0), 9 (with a controller) 1 / the position unit [1/m].
  */
 
 #ifndef PF_NC
