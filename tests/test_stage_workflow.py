@@ -1,7 +1,8 @@
 """examples/stage_workflow.py end to end (--quick): every step's numbers against the true stage.
 
-The record comes from the script's scipy generator (independent of the simulator); the fit is
-held to the true parameters, the compensated loop to the PID alone, the exported C loop to the
+The record comes from the script's scipy generator (independent of the simulator); the fit (the
+closed-loop output error; a CSV without the reference: force against displacement) is held to
+the true parameters, the compensated loop to the PID alone, the exported C loop to the
 Python loop, the optimal move to its target."""
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ def test_every_step_of_the_chain(tmp_path):
     w = _script()
     out = w.main(tmp_path, quick=True)
     fit, val = out["fit"], out["validation"]
+    assert "closed-loop output error" in fit.summary()           # the route for a record under feedback
     assert fit.model.sigma == pytest.approx(w.SIGMA, rel=0.05)
     assert fit.model.Fc == pytest.approx(w.FC, rel=0.03)
     assert fit.estimate("offset") == pytest.approx(w.OFFSET, abs=0.03)
