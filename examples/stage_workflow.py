@@ -8,12 +8,13 @@ Every step writes a figure into ``OUTDIR``:
 1. ``1_record.png``: a closed-loop record (reference, encoder position, commanded force). By default
    synthetic, from an independent scipy integration of the stage (LSODA per sample interval,
    restarted at every velocity reversal; :func:`synthetic_record`); or a user's CSV with the
-   columns ``t, x, u`` [s, m, N] (a header line, comma-separated), a positioning loop's record.
+   columns ``t, x, u[, r]`` [s, m, N, m] (a header line, comma-separated), a positioning loop's
+   record (with the reference ``r``, set ``RECORD_PID`` to the loop's controller).
 2. ``2_fit.png``, ``2_validation.png``: a Dahl model and the offset fitted to the first 60 % of
    the record by the closed-loop output error (:func:`prefriction.identify.fit_closed_loop`: the
    model simulated in the record's loop) and validated on the held-out 40 % (the fitted stage in
-   the same loop: its controller force against the recorded one). A user's CSV (no reference, no
-   controller) is fitted as force against displacement instead (a slow record).
+   the same loop: its controller force against the recorded one). A user's CSV without the
+   reference is fitted as force against displacement instead (a slow record).
 3. ``3_compensation.png``: the PID designed on the fitted stage, alone, with the fitted model's
    feedforward and with a friction observer of the fitted model, tracking back-and-forth moves in
    the *true* stage's sampled loop, with the encoder step, measurement noise and the fitted
@@ -128,13 +129,15 @@ def synthetic_record(seconds: float, seed: int = 1) -> Record:
 
 
 def read_record(path: Path) -> Record:
-    """A user's record from a CSV file with a header and the columns ``t, x, u`` [s, m, N]."""
+    """A user's record from a CSV file with a header and the columns ``t, x, u[, r]`` [s, m, N, m]
+    (``r``: the reference, when known)."""
     data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
-    if data.shape[1] < 3 or len(data) < 200:
-        raise ValueError(f"{path}: expected the columns t, x, u [s, m, N] and at least 200 rows, got "
+    if data.shape[1] not in (3, 4) or len(data) < 200:
+        raise ValueError(f"{path}: expected the columns t, x, u [s, m, N] (and r [m]) and at least 200 rows, got "
                          f"{data.shape[1]} columns and {len(data)} rows")
     t, x, u = data[:, 0], data[:, 1], data[:, 2]
-    return Record(t - t[0], np.full_like(t, np.nan), x, u)
+    r = data[:, 3] if data.shape[1] == 4 else np.full_like(t, np.nan)
+    return Record(t - t[0], r, x, u)
 
 
 def plot_record(rec: Record, outdir: Path) -> Path:
@@ -167,26 +170,28 @@ class Identified:
     stage: pf.Oscillator
 
 
-def record_loop() -> identify.DigitalLoop:
+def record_loop(dt: float = TS) -> identify.DigitalLoop:
     """The record's controller as the closed-loop fit simulates it: the digital PID of
-    :func:`synthetic_record`, ``C(z) = kp + ki Ts z / (z - 1) + kd (z - 1) / (Ts z)``."""
+    :func:`synthetic_record` with the gains ``RECORD_PID`` at the sample time ``dt`` [s],
+    ``C(z) = kp + ki dt z / (z - 1) + kd (z - 1) / (dt z)``. For a record of your own loop, set
+    ``RECORD_PID`` to its gains, or return its law here (any python-control system)."""
     kp, ki, kd = RECORD_PID
-    z = control.tf([1.0, 0.0], [1.0], TS)
-    return identify.DigitalLoop.from_controller(kp + ki * TS * z / (z - 1.0) + kd * (z - 1.0) / (TS * z), TS)
+    z = control.tf([1.0, 0.0], [1.0], dt)
+    return identify.DigitalLoop.from_controller(kp + ki * dt * z / (z - 1.0) + kd * (z - 1.0) / (dt * z), dt)
 
 
 def identify_stage(rec: Record, mass: float = MASS) -> Identified:
     """Fit a Dahl model and a force offset to the first 60 % of a closed-loop record, score it on
     the rest.
 
-    A record with its reference (the synthetic one): the closed-loop output error
+    A record with its reference (the synthetic one, or a CSV with the column ``r``): the closed-loop output error
     (:func:`prefriction.identify.fit_closed_loop`): the model simulated inside the record's loop
     (:func:`record_loop`) fitted to the measured positions and forces, the route for a record
     taken under feedback (an open-loop :class:`prefriction.identify.Motion` replay of a stiff
     loop's force drifts away from the positions). The held-out 40 %: the fitted stage in the
     same loop, run over the whole reference, its controller force against the recorded one.
-    A user's CSV without the reference and controller: a slow record's force is the friction
-    plus the offset (:class:`prefriction.identify.ForceDisplacement`), scored on held-out data.
+    A CSV without the reference: a slow record's force is the friction plus the offset
+    (:class:`prefriction.identify.ForceDisplacement`), scored on held-out data.
 
     The start values are an engineer's guesses (half the stiffness, 2/3 of the Coulomb force);
     ``gamma`` is held at 1, the structure the friction observer, the optimal move and the
@@ -200,7 +205,7 @@ def identify_stage(rec: Record, mass: float = MASS) -> Identified:
         held_out = identify.ForceDisplacement(rec.t[split:], rec.x[split:], rec.u[split:])
         fit = identify.fit(start, part, fixed=["gamma"], offset=True)
         return Identified(fit, fit.validate(held_out), pf.Oscillator(fit.model, mass=mass))
-    loop = record_loop()
+    loop = record_loop(float(rec.t[1] - rec.t[0]))
     part = identify.Motion(rec.t[:split], rec.x[:split], rec.u[:split], mass=mass)
     fit = identify.fit_closed_loop(start, part, loop, rec.r[:split], fixed=["gamma"])
     _, force = identify.simulate_closed_loop(fit.model, loop, rec.t, rec.r, mass=mass, offset=fit.estimate("offset"))
