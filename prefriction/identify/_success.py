@@ -344,7 +344,7 @@ class _Fit:
 
 def _one_fit(stage: Stage, data: Motion, start: FrictionModel, m0: float, off0: float | None) -> _Fit:
     """Fit ``data`` from one start; errors, interval hits and the realised start distance."""
-    from prefriction import identify
+    from prefriction.identify.fit import fit
     from prefriction.identify.parameters import _entries
 
     truth = stage.truth()
@@ -359,7 +359,7 @@ def _one_fit(stage: Stage, data: Motion, start: FrictionModel, m0: float, off0: 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
-            res = identify.fit(start, data, fixed=fixed, mass0=m0, **kw)
+            res = fit(start, data, fixed=fixed, mass0=m0, **kw)
             est = {n: res.estimate(n) for n in truth}
             for n, v in truth.items():
                 lo, hi = res.interval(n)
