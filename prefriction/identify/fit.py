@@ -330,8 +330,10 @@ def _finish(space: ParameterSpace, values: dict, est: np.ndarray, stats: Any, re
         warnings.warn(f"the data cannot identify {name}: {why}; its interval is meaningless. Fix it (fixed=[{name!r}]) "
                       f"or record data that excite it (docs/identify.md#identifiability)",
                       IdentifiabilityWarning, stacklevel=level)
-    low, high, flags = at_bounds(space.free, est, stats.low, stats.high, space.scale, *space.limits(values),
-                                 space.why_low, space.why_high)
+    lower, upper = space.limits(values)
+    floor = {hi: max(float(stats.low[space.free.index(lo)]), lower[lo]) for hi, lo in space.excess.items()}
+    low, high, flags = at_bounds(space.free, est, stats.low, stats.high, space.scale, lower, upper,
+                                 space.why_low, space.why_high, floor)
     for name, value, flag in zip(space.free, est, flags):
         if flag.startswith("on its"):
             todo = "fit the other structure (structures='both')" if "structure" in flag else "widen the bound"

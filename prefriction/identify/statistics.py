@@ -266,11 +266,18 @@ class ConvergenceWarning(UserWarning):
 
 def at_bounds(names: list[str], estimates: np.ndarray, low: np.ndarray, high: np.ndarray, scale: np.ndarray,
               lower: dict[str, float], upper: dict[str, float], why_low: dict[str, str],
-              why_high: dict[str, str]) -> tuple[np.ndarray, np.ndarray, tuple[str, ...]]:
+              why_high: dict[str, str], floor: dict[str, float] | None = None
+              ) -> tuple[np.ndarray, np.ndarray, tuple[str, ...]]:
     """Intervals cut to the allowed range and a note per parameter on a bound or cut.
 
     An estimate within ``1e-6`` of its scale (or of the bound) of a bound is on it. Its interval is
     one-sided: it starts at the bound. An interval that reaches past a bound is cut there.
+
+    A lower bound that is another parameter's estimate (LuGre's ``Fs >= Fc``) is itself uncertain:
+    the true values obey the relation, so the true ``Fs`` is at least the true ``Fc``, which lies
+    anywhere in ``Fc``'s interval. ``floor`` gives such a parameter's cut (the lower end of its
+    partner's interval): cutting at the partner's estimate would exclude a true ``Fs = Fc`` whenever
+    ``Fc`` is overestimated, about half the fits of a model on the relation.
 
     Parameters
     ----------
@@ -280,6 +287,9 @@ def at_bounds(names: list[str], estimates: np.ndarray, low: np.ndarray, high: np
         Estimates, 95 % interval ends and scales (physical units).
     lower, upper : dict
         The allowed range of each name.
+    floor : dict, optional
+        Per name, where to cut the interval's lower end instead of ``lower`` (at most ``lower``):
+        the lower end of the interval of the partner whose estimate is the bound.
     why_low, why_high : dict
         What each end of the range is (``"the declared range"``, ``"the user bound"``, a structure
         boundary).
@@ -300,7 +310,8 @@ def at_bounds(names: list[str], estimates: np.ndarray, low: np.ndarray, high: np
             cut = a if low[i] < a else b
             which = why_low[n] if low[i] < a else why_high[n]
             note = f"interval cut at {cut:.6g} ({which})"
-        lo_out[i], hi_out[i] = max(low[i], a), min(high[i], b)
+        cut_low = min(a, floor[n]) if floor and n in floor and np.isfinite(floor[n]) else a
+        lo_out[i], hi_out[i] = max(low[i], cut_low), min(high[i], b)
         notes.append(note)
     return lo_out, hi_out, tuple(notes)
 
