@@ -176,6 +176,11 @@ def test_free_Fs_and_Fc_keep_Fs_at_or_above_Fc():
     assert res.estimate("Fc") == pytest.approx(1.0, rel=0.01)
     assert res.estimate("Fs") == pytest.approx(1.0, rel=0.01)
     assert np.all(np.isfinite(res.stderr))
+    # the true Fs is at least the true Fc, which may be anywhere in Fc's interval: Fs's interval
+    # reaches down to that interval's lower end, not just to the estimate of Fc
+    assert res.interval("Fs")[0] <= res.interval("Fc")[0] + 1e-12
+    if "on its lower bound" in res.flags[res.names.index("Fs")]:
+        assert res.interval("Fs")[0] == pytest.approx(res.interval("Fc")[0], rel=1e-12)
 
 
 @pytest.mark.slow

@@ -21,6 +21,9 @@ each 95 % interval holds the true value:
 - ``user-stage-dahl-closed``, ``user-stage-dahl-open``: the 2.5 kg / 5 kHz / 10 nm stage of
   :data:`prefriction.identify._success.GRID` (Dahl + viscous + offset, PID loop or a two-tone
   force), a :class:`Motion` fit with the mass free from 1.3 times the truth;
+  ``user-stage-dahl-bare-open``, ``user-stage-lugre-bare-open``: the same stage in open loop
+  with Dahl or LuGre (``Fs = Fc``: the fitted excess ``Fs - Fc`` on its bound 0) and neither a
+  viscous term nor an offset;
 - ``dahl-decay``: the free decay of the Dahl oscillator (2.1) (:func:`prefriction.identify.synthetic.dahl_free_decay`:
   DOP853 between the exact reversals), positions with Gaussian noise, a :class:`Motion` fit.
 
@@ -156,6 +159,8 @@ CASES: dict[str, tuple[Callable, int]] = {
     "closed-loop-encoder": (_closed_loop, 800),
     "user-stage-dahl-closed": (_stage(8), 1000),
     "user-stage-dahl-open": (_stage(9), 1000),
+    "user-stage-dahl-bare-open": (_stage(11), 1000),
+    "user-stage-lugre-bare-open": (_stage(15), 1000),
 }
 """Case name: (record maker, samples)."""
 
