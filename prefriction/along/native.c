@@ -7,8 +7,9 @@
  * The motion (docs/along.md#motion, as prefriction.along.motion.Motion): interval k, samples k to
  * k + 1, has the velocity (x[k+1] - x[k]) / (t[k+1] - t[k]) and the direction of its displacement;
  * an interval without displacement keeps the previous direction (the first moving interval's, s0,
- * before it); the velocity at a sample is the velocity of the interval that ends there (of the
- * first interval at the first sample) or the user's samples vu. */
+ * before it); the velocity at a sample, for the rate-dependent part of the force, is the velocity
+ * of the interval that ends there (of the first interval at the first sample) or the user's
+ * samples vu. */
 
 /* the direction of the first interval with a displacement (+1 if none moves) */
 double pf_first_direction(const double* x, long n) {
@@ -29,43 +30,51 @@ int pf_check(const double* t, const double* x, const double* vu, long n) {
   return ok;
 }
 
-/* n samples t, x (and vu, or NULL) from the state X[0..PF_NX) (row 0 of X, n x PF_NX), direction s0
- * before the first moving interval; F[0] and ev[0] are the caller's. Writes X, F, ev and the
- * velocity at every sample va [m/s]; the reversal samples into rv, their count returned. iv, it:
- * 1 / velocity and 1 / time unit; uF: the force unit. */
+/* n samples t, x (and vu, or NULL) from the state X0[0..PF_NX), direction s0 before the first
+ * moving interval. Writes the force at every sample after the first into F (F[0] is the caller's),
+ * the reversal samples into rv (their count returned), the number of model events along the motion
+ * into out[0] and into out[1] a sum that is NaN if a force is not finite (0 otherwise). The states
+ * X (n x PF_NX, row 0 the caller's) and the event counts ev (ev[0] the caller's) are written only
+ * if given (not NULL); without X the state is kept in two local rows and the pass writes only F.
+ * iv, it: 1 / velocity and 1 / time unit; uF: the force unit. */
 long pf_along(const double* t, const double* x, const double* vu, const double* q, long n, double s0, double iv,
-              double it, double uF, double* X, double* F, long long* ev, double* va, long long* rv) {
+              double it, double uF, const double* X0, double* X, double* F, long long* ev,
+              long long* rv, double* out) {
   const casadi_real* arg[PF_SZ_ARG + 1];
   casadi_real* res[PF_SZ_RES + 1];
   casadi_int iw[PF_SZ_IW];
   casadi_real w[PF_SZ_W];
-  double vn, dtn, ve, Fk, ek, s = s0, sp = s0, vi;
+  double row[2][PF_NX];
+  double vn, dtn, ve, Fk, ek, s = s0, sp = s0, vi, events = 0.0, nonfinite = 0.0;
+  const double* xin = X0;
   long k, nr = 0;
   arg[1] = &vn; arg[2] = &dtn; arg[3] = &sp; arg[4] = &s; arg[5] = &ve; arg[6] = q;
   res[1] = &Fk; res[2] = &ek;
   for (k = 0; k + 1 < n; ++k) {
     double dt = t[k + 1] - t[k], dx = x[k + 1] - x[k];
+    double* xout = X ? X + (k + 1) * PF_NX : row[k & 1];
     vi = dx / dt;
     sp = s;
     if (dx != 0.0) s = dx > 0.0 ? 1.0 : -1.0;
-    if (k == 0) {
-      sp = s;
-      va[0] = vu ? vu[0] : vi;
-    }
-    va[k + 1] = vu ? vu[k + 1] : vi;
+    if (k == 0) sp = s;
     vn = vi * iv;
     dtn = dt * it;
-    ve = va[k + 1] * iv;
-    arg[0] = X + k * PF_NX;
-    res[0] = X + (k + 1) * PF_NX;
+    ve = (vu ? vu[k + 1] : vi) * iv;
+    arg[0] = xin;
+    res[0] = xout;
     if (s != sp) {
       rv[nr++] = k;
       pf_step(arg, res, iw, w, 0);
     } else {
       pf_plain(arg, res, iw, w, 0);
     }
+    xin = xout;
     F[k + 1] = uF * Fk;
-    ev[k + 1] = (long long)(ek + 0.5);
+    nonfinite += Fk - Fk;
+    events += ek;
+    if (ev) ev[k + 1] = (long long)(ek + 0.5);
   }
+  out[0] = events;
+  out[1] = nonfinite;
   return nr;
 }

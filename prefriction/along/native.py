@@ -3,8 +3,10 @@
 :func:`along_driver` builds (once per model structure and sub-step count) a library of the
 model's interval step (:func:`prefriction.along.step.counted_interval_function`, generated with
 CasADi's code generator) and ``native.c``; :func:`run_native` runs every interval in one call,
-reading the motion's arrays and writing the states, forces and event counts into the arrays
-of the result (no per-block assembly; ``docs/along.md``).
+reading the motion's arrays and writing the forces into the result's array (no per-block
+assembly; ``docs/along.md``). The states and event counts per sample are written only when
+asked for: :class:`~prefriction.along.result.AlongResult` asks on first access, by running the
+same deterministic pass again.
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ import os
 import tempfile
 import threading
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Hashable, Optional
+from typing import TYPE_CHECKING, Any, Hashable, NamedTuple, Optional
 
 import casadi as ca
 import numpy as np
@@ -29,12 +31,12 @@ from prefriction.simulation import library_store as store
 if TYPE_CHECKING:
     from prefriction.along.engine import Units
 
-__all__ = ["along_driver", "fast_samples", "first_direction", "run_native"]
+__all__ = ["NativePass", "along_driver", "fast_samples", "first_direction", "run_native"]
 
 _SOURCE = (Path(__file__).parent / "native.c").read_text()
 _D = np.ctypeslib.ndpointer(dtype=np.float64, flags="C_CONTIGUOUS")
 _L = np.ctypeslib.ndpointer(dtype=np.int64, flags="C_CONTIGUOUS")
-_CFLAGS = ("-O3", "-shared", "-fPIC")
+_CFLAGS = ("-O3", "-fno-semantic-interposition", "-shared", "-fPIC")
 """The pass is small and runs per sample: -O3 makes it 1.5x as fast as the simulator's -O1 (Maxwell-slip(3),
 1e6 samples: 23 ms against 34 ms; -O2 28 ms), for a compile time of well under a second."""
 _CACHE: dict = {}
@@ -75,7 +77,8 @@ def along_driver(model: FrictionModel, substeps: Optional[int]) -> Optional[ctyp
             if handle is not None:
                 handle.pf_along.restype = ctypes.c_long
                 handle.pf_along.argtypes = [_D, _D, ctypes.c_void_p, _D, ctypes.c_long, ctypes.c_double,
-                                            ctypes.c_double, ctypes.c_double, ctypes.c_double, _D, _D, _L, _D, _L]
+                                            ctypes.c_double, ctypes.c_double, ctypes.c_double, _D, ctypes.c_void_p,
+                                            _D, ctypes.c_void_p, _L, _D]
                 handle.pf_first_direction.restype = ctypes.c_double
                 handle.pf_first_direction.argtypes = [_D, ctypes.c_long]
                 handle.pf_check.restype = ctypes.c_int
@@ -103,25 +106,42 @@ def fast_samples(lib: ctypes.CDLL, t: Any, x: Any, v: Any) -> Optional[tuple[np.
         return None
     if not lib.pf_check(t, x, None if v is None else v.ctypes.data, t.size):
         return None
-    return t.copy(), x.copy(), v  # the result's own t and x (v: read into the result's velocities)
+    return t.copy(), x.copy(), v  # the result's own t and x (v: copied by the caller)
+
+
+class NativePass(NamedTuple):
+    """What one C pass wrote: forces [N], reversal samples, the number of model events and
+    whether every force is finite; the states ``n x nx`` and event counts per sample only if
+    asked for (else None)."""
+
+    F: np.ndarray
+    reversals: np.ndarray
+    n_events: int
+    finite: bool
+    X: Optional[np.ndarray]
+    events: Optional[np.ndarray]
 
 
 def run_native(lib: ctypes.CDLL, X0: np.ndarray, F_first: float, t: np.ndarray, x: np.ndarray,
-               v: Optional[np.ndarray], s0: float, q: np.ndarray,
-               U: "Units") -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """States ``n x nx``, forces [N], event counts and velocities [m/s] at every sample of the
-    motion ``t, x`` (checked, float, contiguous; ``v`` the user's velocities or None), and the
-    reversal samples, in one C pass (the motion's intervals computed there, ``docs/along.md#motion``)."""
+               v: Optional[np.ndarray], s0: float, q: np.ndarray, U: "Units", states: bool = False) -> NativePass:
+    """Forces [N] at every sample of the motion ``t, x`` (checked, float, contiguous; ``v`` the
+    user's velocities or None), the reversal samples and the number of model events in one C pass
+    (the motion's intervals computed there, ``docs/along.md#motion``); ``states``: the states and
+    event counts per sample written too (else the pass keeps only the current state)."""
     n = t.size
     nx = X0.size
-    X = np.empty((n, nx))
-    X[0] = X0
+    X0 = np.ascontiguousarray(X0, dtype=float)
     F = np.empty(n)
     F[0] = U.F * F_first
-    ev = np.empty(n, dtype=np.int64)
-    ev[0] = 0
-    va = np.empty(n)
+    X = ev = None
+    if states:
+        X = np.empty((n, nx))
+        X[0] = X0
+        ev = np.empty(n, dtype=np.int64)
+        ev[0] = 0
     rv = np.empty(max(n - 1, 1), dtype=np.int64)  # pages written only as reversals come
+    out = np.zeros(2)
     k = lib.pf_along(t, x, None if v is None else v.ctypes.data, np.ascontiguousarray(q, dtype=float), n, s0,
-                     1.0 / U.v, 1.0 / U.t, U.F, X, F, ev, va, rv)
-    return X, F, ev, va, rv[:k].copy()
+                     1.0 / U.v, 1.0 / U.t, U.F, X0, None if X is None else X.ctypes.data, F,
+                     None if ev is None else ev.ctypes.data, rv, out)
+    return NativePass(F, rv[:k].copy(), int(out[0]), bool(np.isfinite(out[1])) and bool(np.isfinite(F[0])), X, ev)
