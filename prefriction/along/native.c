@@ -1,8 +1,8 @@
 /* friction_along in one C pass: the motion's intervals and the model's interval step over every
  * sample, writing into the caller's arrays (docs/along.md). The step is generated from
- * prefriction.along.step.counted_interval_function twice: pf_step with the reversal at the
- * interval's start, pf_plain without (the intervals that keep their direction, most of them).
- * Needs PF_NX (states and flags).
+ * prefriction.along.step.counted_interval_function twice (prefriction.along.native): pf_step_in
+ * with the reversal at the interval's start, pf_plain_in without (the intervals that keep their
+ * direction, most of them). Needs PF_NX (states and flags) and PF_NQ (run-time numbers).
  *
  * The motion (docs/along.md#motion, as prefriction.along.motion.Motion): interval k, samples k to
  * k + 1, has the velocity (x[k+1] - x[k]) / (t[k+1] - t[k]) and the direction of its displacement;
@@ -40,19 +40,13 @@ int pf_check(const double* t, const double* x, const double* vu, long n) {
 long pf_along(const double* t, const double* x, const double* vu, const double* q, long n, double s0, double iv,
               double it, double uF, const double* X0, double* X, double* F, long long* ev,
               long long* rv, double* out) {
-  const casadi_real* arg[PF_SZ_ARG + 1];
-  casadi_real* res[PF_SZ_RES + 1];
-  casadi_int iw[PF_SZ_IW];
-  casadi_real w[PF_SZ_W];
-  double row[2][PF_NX];
+  double xs[PF_NX], xn[PF_NX], qs[PF_NQ + 1]; /* local copies: held in registers across the samples */
   double vn, dtn, ve, Fk, ek, s = s0, sp = s0, vi, events = 0.0, nonfinite = 0.0;
-  const double* xin = X0;
   long k, nr = 0;
-  arg[1] = &vn; arg[2] = &dtn; arg[3] = &sp; arg[4] = &s; arg[5] = &ve; arg[6] = q;
-  res[1] = &Fk; res[2] = &ek;
+  PF_COPY_X(xs, X0);
+  PF_COPY_Q(qs, q);
   for (k = 0; k + 1 < n; ++k) {
     double dt = t[k + 1] - t[k], dx = x[k + 1] - x[k];
-    double* xout = X ? X + (k + 1) * PF_NX : row[k & 1];
     vi = dx / dt;
     sp = s;
     if (dx != 0.0) s = dx > 0.0 ? 1.0 : -1.0;
@@ -60,15 +54,14 @@ long pf_along(const double* t, const double* x, const double* vu, const double* 
     vn = vi * iv;
     dtn = dt * it;
     ve = (vu ? vu[k + 1] : vi) * iv;
-    arg[0] = xin;
-    res[0] = xout;
     if (s != sp) {
       rv[nr++] = k;
-      pf_step(arg, res, iw, w, 0);
+      pf_step_in(xs, vn, dtn, sp, s, ve, qs, xn, &Fk, &ek);
     } else {
-      pf_plain(arg, res, iw, w, 0);
+      pf_plain_in(xs, vn, dtn, sp, s, ve, qs, xn, &Fk, &ek);
     }
-    xin = xout;
+    PF_COPY_X(xs, xn);
+    if (X) PF_COPY_X(X + (k + 1) * PF_NX, xn);
     F[k + 1] = uF * Fk;
     nonfinite += Fk - Fk;
     events += ek;

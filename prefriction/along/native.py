@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING, Any, Hashable, NamedTuple, Optional
 import casadi as ca
 import numpy as np
 
+from prefriction.along.emit import straight_line
 from prefriction.along.motion import MAX_SAMPLES
 from prefriction.along.step import counted_interval_function
 from prefriction.models.base import FrictionModel
@@ -36,24 +37,53 @@ __all__ = ["NativePass", "along_driver", "fast_samples", "first_direction", "run
 _SOURCE = (Path(__file__).parent / "native.c").read_text()
 _D = np.ctypeslib.ndpointer(dtype=np.float64, flags="C_CONTIGUOUS")
 _L = np.ctypeslib.ndpointer(dtype=np.int64, flags="C_CONTIGUOUS")
-_CFLAGS = ("-O3", "-fno-semantic-interposition", "-shared", "-fPIC")
+_CFLAGS = ("-O3", "-shared", "-fPIC")
 """The pass is small and runs per sample: -O3 makes it 1.5x as fast as the simulator's -O1 (Maxwell-slip(3),
 1e6 samples: 23 ms against 34 ms; -O2 28 ms), for a compile time of well under a second."""
 _CACHE: dict = {}
 _LOCK = threading.Lock()
 
 
+_SIGNATURE = ("(const double* X, double vn, double dtn, double sp, double s, double ve, const double* q, "
+              "double* Xn, double* F, double* e)")
+_INLINE = "#ifdef __GNUC__\n#define PF_INLINE static inline __attribute__((always_inline))\n#else\n" \
+          "#define PF_INLINE static inline\n#endif\n"
+
+
 def _source(funs: list[ca.Function], nx: int) -> str:
-    """C source: the steps ``funs`` (``pf_step``, ``pf_plain``) generated, their work sizes, then ``native.c``."""
+    """C source: the steps ``funs`` (``pf_step``, ``pf_plain``) as inline functions on scalars
+    (:func:`prefriction.along.emit.straight_line`; CasADi's code generator for an operation
+    without a straight-line form), then ``native.c``."""
+    nq = funs[0].nnz_in(6)
+    head = (f"#include <math.h>\n#define PF_NX {nx}\n#define PF_NQ {nq}\n" + _INLINE
+            + "".join(f"#define PF_COPY_{what}(d, s) do {{{''.join(f' (d)[{i}] = (s)[{i}];' for i in range(n))} }} while (0)\n"
+                      for what, n in (("X", nx), ("Q", nq))))  # written out: the compiler keeps the copies in registers
+    inputs = [lambda j: f"X[{j}]", lambda j: "vn", lambda j: "dtn", lambda j: "sp", lambda j: "s", lambda j: "ve",
+              lambda j: f"q[{j}]"]
+    outputs = [lambda j: f"Xn[{j}]", lambda j: "*F", lambda j: "*e"]
+    try:
+        bodies = [straight_line(fun, inputs, outputs, "v") for fun in funs]
+    except NotImplementedError:
+        return head + _generated(funs) + _SOURCE
+    return head + "".join(f"PF_INLINE void {fun.name()}_in{_SIGNATURE} {{\n{body}\n}}\n"
+                          for fun, body in zip(funs, bodies)) + _SOURCE
+
+
+def _generated(funs: list[ca.Function]) -> str:
+    """The steps by CasADi's code generator, each called from an inline function of the pass's signature."""
     with tempfile.TemporaryDirectory(prefix="prefriction-") as tmp:
         cg = ca.CodeGenerator("pf_along.c", {"with_header": False})
         for fun in funs:
             cg.add(fun)
         cg.generate(tmp + os.sep)
         code = (Path(tmp) / "pf_along.c").read_text()
-    head = {"PF_NX": nx, "PF_SZ_ARG": max(f.sz_arg() for f in funs), "PF_SZ_RES": max(f.sz_res() for f in funs),
-            "PF_SZ_IW": max(f.sz_iw() for f in funs) + 1, "PF_SZ_W": max(f.sz_w() for f in funs) + 1}
-    return "".join(f"#define {k} {v}\n" for k, v in head.items()) + code + _SOURCE
+    for fun in funs:
+        code += (f"PF_INLINE void {fun.name()}_in{_SIGNATURE} {{\n"
+                 f"  const casadi_real* arg[{fun.sz_arg() + 1}] = {{X, &vn, &dtn, &sp, &s, &ve, q}};\n"
+                 f"  casadi_real* res[{fun.sz_res() + 1}] = {{Xn, F, e}};\n"
+                 f"  casadi_int iw[{fun.sz_iw() + 1}];\n  casadi_real w[{fun.sz_w() + 1}];\n"
+                 f"  {fun.name()}(arg, res, iw, w, 0);\n}}\n")
+    return code
 
 
 def along_driver(model: FrictionModel, substeps: Optional[int]) -> Optional[ctypes.CDLL]:
@@ -68,7 +98,7 @@ def along_driver(model: FrictionModel, substeps: Optional[int]) -> Optional[ctyp
             funs = []
             for name, reversal in (("pf_step", True), ("pf_plain", False)):
                 fun = counted_interval_function(model, n_sub, reversal=reversal)
-                funs.append(ca.Function(name, fun.sx_in(), fun.call(fun.sx_in())))
+                funs.append(ca.Function(name, fun.sx_in(), [ca.densify(out) for out in fun.call(fun.sx_in())]))
             handle, _ = library(f"along_native_{type(model).__name__.lower()}",
                                 _source(funs, model.n_states + model.n_flags), "friction_along in C",
                                 functools.partial(store.load_verified,

@@ -67,11 +67,17 @@ class AlongResult:
         self._lock = threading.Lock()
 
     def _get(self, key: str) -> object:
-        """The value ``key`` (``"v"`` or ``"detail"``), made once on first access (thread-safe)."""
+        """The value ``key`` (``"v"``, or ``"detail"``: states, flags, events), made once on first
+        access (thread-safe)."""
         with self._lock:
             if key not in self._made:
                 maker = self._makers[key]
-                self._made[key] = maker() if callable(maker) else maker
+                made = maker() if callable(maker) else maker
+                if key == "detail":
+                    X, ev = made
+                    nz = self.model.n_states
+                    made = (X[:, :nz], X[:, nz:], ev)
+                self._made[key] = made
             return self._made[key]
 
     @property
@@ -80,9 +86,7 @@ class AlongResult:
         return self._get("v")  # type: ignore[return-value]
 
     def _split(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        X, ev = self._get("detail")  # type: ignore[misc]
-        nz = self.model.n_states
-        return X[:, :nz], X[:, nz:], ev
+        return self._get("detail")  # type: ignore[return-value]
 
     @property
     def states(self) -> np.ndarray:

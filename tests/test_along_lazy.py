@@ -1,0 +1,103 @@
+"""friction_along's states made on first access: the C pass writes only the forces, and the
+states, flags and events per sample come from the same pass run again. Checked against the
+Maxwell-slip stop operator (closed form, written here) and against the CasADi block path, which
+computes them with the run."""
+
+from __future__ import annotations
+
+import threading
+
+import numpy as np
+import pytest
+
+import prefriction as pf
+import prefriction.along.run as along_run
+from prefriction.simulation.compiled import jit_available
+
+pytestmark = pytest.mark.skipif(not jit_available(), reason="the C pass needs a C compiler")
+
+K, W = np.array([6e4, 3e4, 1e4]), np.array([0.3, 0.4, 0.3])
+
+
+def _motion() -> tuple[np.ndarray, np.ndarray]:
+    """Reversals of several sizes, a pause, uneven sample times: 600 samples."""
+    rng = np.random.default_rng(11)
+    t = np.cumsum(rng.uniform(0.5e-3, 1.5e-3, 600))
+    x = 2.5e-5 * np.sin(2 * np.pi * 2.3 * t) + 6e-6 * np.sin(2 * np.pi * 13.0 * t)
+    x[300:330] = x[300]
+    return t, x
+
+
+def _stop_operator(x: np.ndarray) -> np.ndarray:
+    """Element forces [N] from the relaxed state, ``n x 3``: element i carries ``k_i (x - a_i)``
+    clipped to ``+-W_i``, its anchor ``a_i`` dragged along while it slips."""
+    a = np.full(K.size, x[0])
+    out = np.empty((x.size, K.size))
+    for j, xj in enumerate(x):
+        out[j] = np.clip(K * (xj - a), -W, W)
+        a = xj - out[j] / K
+    return out
+
+
+def test_states_on_access_match_closed_form_and_eager_path(monkeypatch: pytest.MonkeyPatch) -> None:
+    t, x = _motion()
+    model = pf.MaxwellSlip(K, W)
+    lazy = pf.friction_along(model, t, x)
+    Fi = _stop_operator(x)
+    np.testing.assert_allclose(lazy.F, Fi.sum(axis=1), rtol=0, atol=1e-12 * W.sum())
+    # z_i = k_i d_i / Fc; the retrace guard is zero on every branch
+    np.testing.assert_allclose(lazy.states[:, :3], Fi / W.sum(), rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(lazy.states[:, 3], 0.0)
+    slipping = np.abs(Fi) >= W * (1.0 - 1e-9)  # an element slips exactly while it sits on its limit
+    np.testing.assert_array_equal(lazy.flags, slipping.astype(float))
+    rev = np.zeros(t.size, dtype=bool)
+    rev[lazy.reversals + 1] = True  # the interval into sample k + 1 starts with a reversal (flags cleared)
+    kept = slipping[:-1] & ~rev[1:, None]
+    started = (slipping[1:] & ~kept).sum(axis=1)
+    np.testing.assert_array_equal(lazy.events, np.concatenate(([0], started)))
+    assert lazy.n_events == int(started.sum()) > 0
+    v = np.diff(x) / np.diff(t)
+    np.testing.assert_array_equal(lazy.v, np.concatenate((v[:1], v)))
+
+    monkeypatch.setattr(along_run, "along_driver", lambda model, substeps: None)
+    eager = pf.friction_along(model, t, x)  # the CasADi block path: states with the run
+    np.testing.assert_allclose(lazy.F, eager.F, rtol=0, atol=1e-13 * W.sum())
+    np.testing.assert_allclose(lazy.states, eager.states, rtol=0, atol=1e-13)
+    np.testing.assert_array_equal(lazy.flags, eager.flags)
+    np.testing.assert_array_equal(lazy.events, eager.events)
+    np.testing.assert_array_equal(lazy.v, eager.v)
+    assert lazy.n_events == eager.n_events
+
+
+def test_states_made_once_from_the_result_motion() -> None:
+    """Threads asking at once get one array; the motion the states follow cannot be changed."""
+    t, x = _motion()
+    res = pf.friction_along(pf.MaxwellSlip(K, W) + pf.Viscous(1.5), t, x, v=np.cos(t))
+    got: list[np.ndarray] = []
+    threads = [threading.Thread(target=lambda: got.append(res.states)) for _ in range(4)]
+    for th in threads:
+        th.start()
+    for th in threads:
+        th.join()
+    assert all(a is got[0] for a in got) and got[0].shape[0] == t.size and res.states is got[0]
+    with pytest.raises(ValueError):
+        res.x[0] = 1.0
+    np.testing.assert_array_equal(res.v, np.cos(t))
+
+
+def test_generated_step_without_straight_line_form(monkeypatch: pytest.MonkeyPatch) -> None:
+    """An operation without a straight-line C form: the pass calls CasADi's generated step
+    instead, with the same forces and states (closed form)."""
+    import prefriction.along.native as native
+
+    def refuse(*args: object, **kwargs: object) -> str:
+        raise NotImplementedError("test")
+
+    monkeypatch.setattr(native, "straight_line", refuse)
+    monkeypatch.setattr(native, "_CACHE", {})
+    t, x = _motion()
+    res = pf.friction_along(pf.MaxwellSlip(K, W), t, x)
+    assert native._CACHE and all(lib is not None for lib in native._CACHE.values())  # the C pass ran
+    Fi = _stop_operator(x)
+    np.testing.assert_allclose(res.F, Fi.sum(axis=1), rtol=0, atol=1e-12 * W.sum())
+    np.testing.assert_allclose(res.states[:, :3], Fi / W.sum(), rtol=0, atol=1e-12)
