@@ -20,11 +20,16 @@ double pf_first_direction(const double* x, long n) {
 }
 
 /* 1 if t, x and vu (or NULL) are finite and t strictly increases, else 0 (the caller then finds
- * the first bad entry and names it) */
-int pf_check(const double* t, const double* x, const double* vu, long n) {
+ * the first bad entry and names it); t and x copied into tc and xc on the way (the result's own) */
+int pf_check(const double* t, const double* x, const double* vu, long n, double* tc, double* xc) {
   long k;
   int ok = 1;
-  for (k = 0; k < n; ++k) ok &= isfinite(t[k]) && isfinite(x[k]) && (k == 0 || t[k] > t[k - 1]);
+  for (k = 0; k < n; ++k) {
+    double tk = t[k], xk = x[k];
+    ok &= isfinite(tk) && isfinite(xk) && (k == 0 || tk > t[k - 1]);
+    tc[k] = tk;
+    xc[k] = xk;
+  }
   if (vu)
     for (k = 0; k < n; ++k) ok &= isfinite(vu[k]) != 0;
   return ok;

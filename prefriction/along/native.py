@@ -112,7 +112,7 @@ def along_driver(model: FrictionModel, substeps: Optional[int]) -> Optional[ctyp
                 handle.pf_first_direction.restype = ctypes.c_double
                 handle.pf_first_direction.argtypes = [_D, ctypes.c_long]
                 handle.pf_check.restype = ctypes.c_int
-                handle.pf_check.argtypes = [_D, _D, ctypes.c_void_p, ctypes.c_long]
+                handle.pf_check.argtypes = [_D, _D, ctypes.c_void_p, ctypes.c_long, _D, _D]
             _CACHE[key] = handle
         return _CACHE[key]
 
@@ -123,10 +123,10 @@ def first_direction(lib: ctypes.CDLL, x: np.ndarray) -> float:
 
 
 def fast_samples(lib: ctypes.CDLL, t: Any, x: Any, v: Any) -> Optional[tuple[np.ndarray, np.ndarray, Optional[np.ndarray]]]:
-    """``t, x, v`` as they are if they are 1-D float64 arrays of one length, 2 to
-    :data:`~prefriction.along.motion.MAX_SAMPLES` samples, finite, ``t`` strictly increasing
-    (checked in one C pass; ``t`` and ``x`` copied for the result); else None (:meth:`Motion.of` then checks them and names
-    what is wrong)."""
+    """Copies of ``t`` and ``x`` (the result's own) and ``v`` if they are 1-D float64 arrays of one
+    length, 2 to :data:`~prefriction.along.motion.MAX_SAMPLES` samples, finite, ``t`` strictly
+    increasing (checked in the C pass that copies them); else None (:meth:`Motion.of` then checks
+    them and names what is wrong)."""
     given = [t, x] if v is None else [t, x, v]
     for a in given:
         if not (isinstance(a, np.ndarray) and a.dtype == np.float64 and a.ndim == 1 and a.flags.c_contiguous
@@ -134,9 +134,10 @@ def fast_samples(lib: ctypes.CDLL, t: Any, x: Any, v: Any) -> Optional[tuple[np.
             return None
     if not 2 <= t.size <= MAX_SAMPLES:
         return None
-    if not lib.pf_check(t, x, None if v is None else v.ctypes.data, t.size):
+    tc, xc = np.empty(t.size), np.empty(t.size)  # the result's own t and x (v: copied by the caller)
+    if not lib.pf_check(t, x, None if v is None else v.ctypes.data, t.size, tc, xc):
         return None
-    return t.copy(), x.copy(), v  # the result's own t and x (v: copied by the caller)
+    return tc, xc, v
 
 
 class NativePass(NamedTuple):

@@ -103,8 +103,8 @@ def friction_along(model: FrictionModel, t: Any, x: Any, *, F0: float = 0.0, v: 
     motion = Motion.of(t, x, v) if fast is None else None  # checks and names what is wrong
     if fast is not None:
         t_arr, x_arr, v_arr = fast
-    else:  # the result's own copies (Motion.of may keep the caller's arrays)
-        t_arr, x_arr, v_arr = motion.t.copy(), motion.x.copy(), None if v is None else motion.v_at
+    else:  # Motion.of's arrays are its own
+        t_arr, x_arr, v_arr = motion.t, motion.x, None if v is None else motion.v_at
     v_arr = None if v_arr is None else v_arr.copy()  # the result's own
     k = model.n_states + model.n_flags  # the states of every sample (made on first access), three times at the peak
     check_memory(f"friction_along of {type(model).__name__} ({k} states and flags per sample)", t_arr.size,
