@@ -65,6 +65,7 @@ def straight_line(fun: ca.Function, inputs: Sequence[Callable[[int], str]],
     work: dict[int, str] = {}  # work slot -> the name of the value it holds now
     define: dict[str, tuple[int, list[str]]] = {}  # name -> (operation, operand names)
     lines: list[str] = []
+    ints: set[str] = set()
     for k in range(fun.n_instructions()):
         op, ins, outs = fun.instruction_id(k), fun.instruction_input(k), fun.instruction_output(k)
         if op == ca.OP_OUTPUT:
@@ -85,7 +86,10 @@ def straight_line(fun: ca.Function, inputs: Sequence[Callable[[int], str]],
             expr = expr or _BINARY[op](a, b)
         else:
             raise NotImplementedError(f"CasADi operation {op} has no straight-line C form here")
-        kind = "int" if op in _LOGICAL else "double"  # a truth value stays an int (no conversion on the path)
+        # truth values and their sums (event counts) stay ints: no conversions on the path
+        kind = "int" if op in _LOGICAL or (op == ca.OP_ADD and ints.issuperset(define[name][1])) else "double"
+        if kind == "int":
+            ints.add(name)
         lines.append(f"  const {kind} {name} = {expr};")
         work[outs[0]] = name
     return "\n".join(lines)

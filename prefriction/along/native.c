@@ -41,12 +41,14 @@ int pf_check(const double* t, const double* x, const double* vu, long n, double*
  * into out[0] and into out[1] a sum that is NaN if a force is not finite (0 otherwise). The states
  * X (n x PF_NX, row 0 the caller's) and the event counts ev (ev[0] the caller's) are written only
  * if given (not NULL); without X the state is kept in two local rows and the pass writes only F.
- * iv, it: 1 / velocity and 1 / time unit; uF: the force unit. */
+ * iv, it, ix: 1 / velocity, time and length unit; uF: the force unit. The step takes the normalised
+ * displacement dxn and duration dtn of the interval (its velocity is dxn / dtn, symbolically: a
+ * rate-independent step sees the displacement alone, with no division). */
 long pf_along(const double* t, const double* x, const double* vu, const double* q, long n, double s0, double iv,
-              double it, double uF, const double* X0, double* X, double* F, long long* ev,
+              double it, double ix, double uF, const double* X0, double* X, double* F, long long* ev,
               long long* rv, double* out) {
   double xs[PF_NX], xn[PF_NX], qs[PF_NQ + 1]; /* local copies: held in registers across the samples */
-  double vn, dtn, ve, Fk, ek, s = s0, sp = s0, vi, events = 0.0, nonfinite = 0.0;
+  double dxn, dtn, ve, Fk, ek, s = s0, sp = s0, vi, events = 0.0, nonfinite = 0.0;
   long k, nr = 0;
   PF_COPY_X(xs, X0);
   PF_COPY_Q(qs, q);
@@ -56,14 +58,14 @@ long pf_along(const double* t, const double* x, const double* vu, const double* 
     sp = s;
     if (dx != 0.0) s = dx > 0.0 ? 1.0 : -1.0;
     if (k == 0) sp = s;
-    vn = vi * iv;
+    dxn = dx * ix;
     dtn = dt * it;
     ve = (vu ? vu[k + 1] : vi) * iv;
     if (s != sp) {
       rv[nr++] = k;
-      pf_step_in(xs, vn, dtn, sp, s, ve, qs, xn, &Fk, &ek);
+      pf_step_in(xs, dxn, dtn, sp, s, ve, qs, xn, &Fk, &ek);
     } else {
-      pf_plain_in(xs, vn, dtn, sp, s, ve, qs, xn, &Fk, &ek);
+      pf_plain_in(xs, dxn, dtn, sp, s, ve, qs, xn, &Fk, &ek);
     }
     PF_COPY_X(xs, xn);
     if (X) PF_COPY_X(X + (k + 1) * PF_NX, xn);

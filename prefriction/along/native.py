@@ -44,7 +44,7 @@ _CACHE: dict = {}
 _LOCK = threading.Lock()
 
 
-_SIGNATURE = ("(const double* X, double vn, double dtn, double sp, double s, double ve, const double* q, "
+_SIGNATURE = ("(const double* X, double dxn, double dtn, double sp, double s, double ve, const double* q, "
               "double* Xn, double* F, double* e)")
 _INLINE = "#ifdef __GNUC__\n#define PF_INLINE static inline __attribute__((always_inline))\n#else\n" \
           "#define PF_INLINE static inline\n#endif\n"
@@ -58,7 +58,7 @@ def _source(funs: list[ca.Function], nx: int) -> str:
     head = (f"#include <math.h>\n#define PF_NX {nx}\n#define PF_NQ {nq}\n" + _INLINE
             + "".join(f"#define PF_COPY_{what}(d, s) do {{{''.join(f' (d)[{i}] = (s)[{i}];' for i in range(n))} }} while (0)\n"
                       for what, n in (("X", nx), ("Q", nq))))  # written out: the compiler keeps the copies in registers
-    inputs = [lambda j: f"X[{j}]", lambda j: "vn", lambda j: "dtn", lambda j: "sp", lambda j: "s", lambda j: "ve",
+    inputs = [lambda j: f"X[{j}]", lambda j: "dxn", lambda j: "dtn", lambda j: "sp", lambda j: "s", lambda j: "ve",
               lambda j: f"q[{j}]"]
     outputs = [lambda j: f"Xn[{j}]", lambda j: "*F", lambda j: "*e"]
     try:
@@ -79,7 +79,7 @@ def _generated(funs: list[ca.Function]) -> str:
         code = (Path(tmp) / "pf_along.c").read_text()
     for fun in funs:
         code += (f"PF_INLINE void {fun.name()}_in{_SIGNATURE} {{\n"
-                 f"  const casadi_real* arg[{fun.sz_arg() + 1}] = {{X, &vn, &dtn, &sp, &s, &ve, q}};\n"
+                 f"  const casadi_real* arg[{fun.sz_arg() + 1}] = {{X, &dxn, &dtn, &sp, &s, &ve, q}};\n"
                  f"  casadi_real* res[{fun.sz_res() + 1}] = {{Xn, F, e}};\n"
                  f"  casadi_int iw[{fun.sz_iw() + 1}];\n  casadi_real w[{fun.sz_w() + 1}];\n"
                  f"  {fun.name()}(arg, res, iw, w, 0);\n}}\n")
@@ -98,7 +98,10 @@ def along_driver(model: FrictionModel, substeps: Optional[int]) -> Optional[ctyp
             funs = []
             for name, reversal in (("pf_step", True), ("pf_plain", False)):
                 fun = counted_interval_function(model, n_sub, reversal=reversal)
-                funs.append(ca.Function(name, fun.sx_in(), [ca.densify(out) for out in fun.call(fun.sx_in())]))
+                ins = fun.sx_in()
+                dxn = ca.SX.sym("dxn")  # the displacement in: v = dxn / dt, so that v dt is dxn exactly
+                outs = fun.call([ins[0], dxn / ins[2], *ins[2:]])
+                funs.append(ca.Function(name, [ins[0], dxn, *ins[2:]], [ca.densify(out) for out in outs]))
             handle, _ = library(f"along_native_{type(model).__name__.lower()}",
                                 _source(funs, model.n_states + model.n_flags), "friction_along in C",
                                 functools.partial(store.load_verified,
@@ -107,8 +110,8 @@ def along_driver(model: FrictionModel, substeps: Optional[int]) -> Optional[ctyp
             if handle is not None:
                 handle.pf_along.restype = ctypes.c_long
                 handle.pf_along.argtypes = [_D, _D, ctypes.c_void_p, _D, ctypes.c_long, ctypes.c_double,
-                                            ctypes.c_double, ctypes.c_double, ctypes.c_double, _D, ctypes.c_void_p,
-                                            _D, ctypes.c_void_p, _L, _D]
+                                            ctypes.c_double, ctypes.c_double, ctypes.c_double, ctypes.c_double, _D,
+                                            ctypes.c_void_p, _D, ctypes.c_void_p, _L, _D]
                 handle.pf_first_direction.restype = ctypes.c_double
                 handle.pf_first_direction.argtypes = [_D, ctypes.c_long]
                 handle.pf_check.restype = ctypes.c_int
@@ -173,6 +176,6 @@ def run_native(lib: ctypes.CDLL, X0: np.ndarray, F_first: float, t: np.ndarray, 
     rv = np.empty(max(n - 1, 1), dtype=np.int64)  # pages written only as reversals come
     out = np.zeros(2)
     k = lib.pf_along(t, x, None if v is None else v.ctypes.data, np.ascontiguousarray(q, dtype=float), n, s0,
-                     1.0 / U.v, 1.0 / U.t, U.F, X0, None if X is None else X.ctypes.data, F,
+                     1.0 / U.v, 1.0 / U.t, 1.0 / (U.v * U.t), U.F, X0, None if X is None else X.ctypes.data, F,
                      None if ev is None else ev.ctypes.data, rv, out)
     return NativePass(F, rv[:k].copy(), int(out[0]), bool(np.isfinite(out[1])) and bool(np.isfinite(F[0])), X, ev)
