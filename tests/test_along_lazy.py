@@ -101,3 +101,22 @@ def test_generated_step_without_straight_line_form(monkeypatch: pytest.MonkeyPat
     Fi = _stop_operator(x)
     np.testing.assert_allclose(res.F, Fi.sum(axis=1), rtol=0, atol=1e-12 * W.sum())
     np.testing.assert_allclose(res.states[:, :3], Fi / W.sum(), rtol=0, atol=1e-12)
+
+
+def test_pass_with_states_computes_the_same_forces() -> None:
+    """The pass run again for the states gives the forces of the run bit for bit (docs/along.md)."""
+    from prefriction.along import native
+    from prefriction.along.engine import Units
+    from prefriction.along.run import initial_state
+
+    t, x = _motion()
+    for model in (pf.MaxwellSlip(K, W), pf.Dahl(1e5, 1.0) + pf.Viscous(2.0)):
+        lib = native.along_driver(model, None)
+        _F0, X0 = initial_state(model, 0.0, 1.0)
+        q = model.runtime_params()
+        plain = native.run_native(lib, X0, 0.0, t, x, None, 1.0, q, Units.of(model))
+        full = native.run_native(lib, X0, 0.0, t, x, None, 1.0, q, Units.of(model), states=True)
+        np.testing.assert_array_equal(plain.F, full.F)
+        assert plain.X is None and full.X is not None and full.X.shape == (t.size, X0.size)
+        assert plain.n_events == full.n_events == int(full.events.sum())
+        np.testing.assert_array_equal(plain.reversals, full.reversals)

@@ -37,9 +37,11 @@ __all__ = ["NativePass", "along_driver", "fast_samples", "first_direction", "run
 _SOURCE = (Path(__file__).parent / "native.c").read_text()
 _D = np.ctypeslib.ndpointer(dtype=np.float64, flags="C_CONTIGUOUS")
 _L = np.ctypeslib.ndpointer(dtype=np.int64, flags="C_CONTIGUOUS")
-_CFLAGS = ("-O3", "-shared", "-fPIC")
-"""The pass is small and runs per sample: -O3 makes it 1.5x as fast as the simulator's -O1 (Maxwell-slip(3),
-1e6 samples: 23 ms against 34 ms; -O2 28 ms), for a compile time of well under a second."""
+_CFLAGS = ("-O3", "-ffp-contract=off", "-shared", "-fPIC")
+"""-O3: the pass is small and runs per sample (Maxwell-slip(3), 1e6 samples, with the step on CasADi's
+buffers: 23 ms at -O3, 28 ms at -O2, 34 ms at the simulator's -O1), for a compile time of well
+under a second; -ffp-contract=off: no fused multiply-adds, so the pass that writes the states
+computes the same forces, bit for bit, as the one that does not."""
 _CACHE: dict = {}
 _LOCK = threading.Lock()
 

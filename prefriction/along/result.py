@@ -21,7 +21,7 @@ class AlongResult:
 
     The force, the reversals and the number of events come with the run. The velocities, the
     states, the flags and the events per sample are made on first access (the states by the
-    same deterministic pass run again with its states written, ``docs/along.md#states``), so a
+    same deterministic pass run again with its states written, ``docs/along.md#states-on-access``), so a
     run that needs only the force does not pay for them. ``t`` and ``x`` are read-only.
 
     Attributes
