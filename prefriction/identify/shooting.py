@@ -51,9 +51,6 @@ WINDOW = 2_000
 its estimates, so it needs few iterations and its cost stays linear in the samples."""
 LONG = 5_000
 """Records of at least this many samples report each iteration on stderr (long work)."""
-_FLAG_ROUNDS = 3
-"""Most re-solves after which the flags at the nodes still differ from those the segments before
-them end with (an event that moved across a node during the solve)."""
 _NODE_WINDOW = 7
 """Samples of the Savitzky-Golay window of the node start values (short: coarse records)."""
 _MAPPED: dict[Any, tuple[ca.Function, ca.Function]] = {}
@@ -143,16 +140,6 @@ class _Problem:
                          m0=np.zeros((model.n_flags, lay.J)))
         self.first_flags: list[float] = [0.0] * model.n_flags
 
-    def flag_defects(self, w: np.ndarray) -> int:
-        """Nodes whose flags (inputs, like the direction) differ from the end flags of the segment
-        before them at ``w``; each such node takes those flags (their next evaluation agrees)."""
-        if not self.args["m0"].size:
-            return 0
-        Me = np.asarray(self._call(self.plain, w)["Me"])[:, :-1]
-        bad = np.any(np.abs(Me - self.args["m0"][:, 1:]) > 0.5, axis=0)
-        self.args["m0"][:, 1:] = np.round(Me)
-        return int(np.count_nonzero(bad))
-
     def carry_states(self, w: np.ndarray, single: ca.Function) -> np.ndarray:
         """``w`` with every node's model state after the first replaced by the end state of the
         segment before it (simulated from the start values): states consistent with the history."""
@@ -169,8 +156,6 @@ class _Problem:
             ye = np.asarray(out["Ye"]).ravel()
             if np.all(np.isfinite(ye)):
                 nodes[2:, j + 1] = np.clip(ye[2:], -STATE_CAP, STATE_CAP)
-                if a["m0"].size:
-                    a["m0"][:, j + 1] = np.round(np.asarray(out["Me"]).ravel())
         w[self.nth:] = nodes.T.ravel()
         return w
 
@@ -384,11 +369,6 @@ def _solve_record(model: FrictionModel, data: Motion, space: ParameterSpace, the
 
     out = solve(prob.full_eval, prob.plain_eval, w0, lo, hi, max_iter=max_iter, tol=tol, gtol=GTOL,
                 weight=weight, restart=restart, progress=progress)
-    for _round in range(_FLAG_ROUNDS):  # the flags at the nodes are those the segments before them end with
-        if not prob.flag_defects(out.w):
-            break
-        out = solve(prob.full_eval, prob.plain_eval, out.w, lo, hi, max_iter=max_iter, tol=tol, gtol=GTOL,
-                    weight=10.0, restart=restart, progress=progress)
     w = out.w
     r, _g, res = prob.residuals(w)
     Jred = prob.reduced_jacobian(w)
