@@ -99,7 +99,7 @@ def step_function(model: FrictionModel, n_sub: int) -> ca.Function:
     return ca.Function("motion_step", [y, u0, u1, dt, pp], [ca.vertcat(*yl, *fl, s)])
 
 
-MAX_EVENTS = 1
+MAX_EVENTS = 4
 """Most in-branch events located inside one sub-step (on its part before a reversal); a further
 one fires at the start of the next sub-step (its indicator is then negative)."""
 
