@@ -55,8 +55,8 @@ def p_of_force(f: Any, gamma: Any) -> Any:
     """Branch distance ``p = (1 - (1 - f)^e) / e`` of the branch force ``f`` for gamma < 1
     (inverse of :func:`force_of_p`; ``1 / e`` at saturation ``f >= 1``)."""
     e = 1.0 - gamma
-    if _sym(f, gamma):
-        return -ca.expm1(e * ca.log1p(-ca.fmin(f, 1.0))) / e
+    if _sym(f, gamma):  # if_else: log1p(-1) = -inf would make the derivative at saturation inf * 0
+        return ca.if_else(f < 1.0, -ca.expm1(e * ca.log1p(-f)) / e, 1.0 / e)
     if f >= 1.0:
         return 1.0 / e
     return -math.expm1(e * math.log1p(-f)) / e
