@@ -142,12 +142,17 @@ def _start(name: str, f: float) -> pf.FrictionModel:
 
 @pytest.mark.parametrize("factor", [1.5, 2.0])
 def test_dahl_gamma_below_one_with_offset_fits_from_far_starts(factor):
-    """Dahl gamma = 0.6 (saturation events) + offset, every parameter ``factor`` off: within 1 %
-    of the truth on a clean record; on a noisy one the 95 % intervals hold the truth."""
+    """Dahl gamma = 0.6 (saturation events) + offset, every parameter ``factor`` off (gamma
+    0.9 and 0.3): within 1 % of the truth on a clean record."""
     res, truth, _sec = _fit("dahl", factor, 300, 0.0)
     assert res.success, res.message
     np.testing.assert_allclose(res.estimates, truth, rtol=0.01)
-    res, truth, _sec = _fit("dahl", factor, 300, 0.01, seed=int(10 * factor))
+
+
+def test_dahl_gamma_below_one_intervals_hold_the_truth():
+    """The same fit from 1.5x on a record with position noise (1 % of Fc / sigma): the 95 %
+    intervals hold every true value."""
+    res, truth, _sec = _fit("dahl", 1.5, 300, 0.01, seed=15)
     assert res.success, res.message
     assert np.all((res.low <= truth) & (truth <= res.high)), (res.names, res.estimates, res.low, res.high)
 
