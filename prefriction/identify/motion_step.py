@@ -14,6 +14,12 @@ e.g. Dahl's log-gap), Runge-Kutta on the new branch for the rest. A velocity lef
 on the old side of zero by the cut does not turn the branch back. No step straddles a reversal
 by more than the error of that prediction, where the velocity and so the rates are small.
 
+A model with in-branch events carries its flags beside the direction. On the part of a
+sub-step before a reversal each event is located at the zero of its indicator (secant from a
+Runge-Kutta trial step, refined by one Newton step on the quadratic through three values), the
+model's ``on_event`` applied there and the rest integrated (:func:`_branch`); the event time is
+a differentiable function of the state and the parameters, so the sensitivities carry its jump.
+
 Forward sensitivities ride along: the carried matrix ``S = dy/dw`` of a segment is propagated
 sample by sample, ``S <- (dy+/dy) S + (dy+/dp) (dp/dw)``, with the small Jacobians of one sample
 built symbolically once. A segment is that step repeated with ``mapaccum`` over ``K`` samples;
@@ -190,8 +196,8 @@ def segment_functions(model: FrictionModel, space: ParameterSpace, K: int, n_sub
     the next node), ``theta`` and ``scale`` (the free
     parameters are ``theta * scale``), ``fixed``, ``mass``,
     ``U0``, ``U1``, ``DT`` (rows of ``K`` samples) and ``scl = [Xs, Vs]``. Outputs: ``X``
-    (``2 x (K + 1)``: position [m] and velocity [m/s] at the node and after each sample) and
-    ``Ye`` (the scaled end state in the coordinates of ``s_to``) and ``Me`` (its flags in those
+    (``2 x (K + 1)``: position [m] and velocity [m/s] at the node and after each sample), ``Ye``
+    (the scaled end state in the coordinates of ``s_to``) and ``Me`` (its flags in those
     coordinates: they ride along like the direction, without derivatives); the sensitive one adds ``dX``
     (``ncol x (K + 1)``: ``dx/dw`` of each position) and ``dYe`` (``ny x ncol``), ``w`` the
     segment's ``[theta, node]``.

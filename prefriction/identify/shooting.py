@@ -433,8 +433,3 @@ def _nuisance(model: FrictionModel, space: ParameterSpace, w: np.ndarray, prob: 
     tau = t[k] + (t[k + 1] - t[k]) * vel[k] / (vel[k] - vel[k + 1])
     return {"initial velocity v0 [m/s]": v0, "initial force F0 [N]": F0, "reversal times [s]": tau}
 
-
-def _without_events(model: FrictionModel) -> str:
-    """The hint for a model that has a form without events (ElastoPlastic's ``crossings=False``)."""
-    return ", or give it with crossings=False (the crossings inside the right-hand side)" \
-        if hasattr(model, "crossings") else ""
