@@ -123,7 +123,13 @@ def _mapped(model: FrictionModel, space: ParameterSpace, K: int, n_sub: int, mas
 
 
 class _Problem:
-    """Residuals, constraints and their sparse Jacobians of one record, layout and parameter set."""
+    """Residuals, constraints and their sparse Jacobians of one record, layout and parameter set.
+
+    A model with flags gets them at each node as inputs, like the direction: at the first node
+    those of its start state, at the others none set, so that the node's state decides (an event
+    indicator not positive fires at once: a saturated Dahl or a slipping Maxwell-slip element sits
+    on its limit). Flags inherited from the segment before would jump with the defects of a
+    multiple-shooting iterate and make the residuals discontinuous."""
 
     def __init__(self, model: FrictionModel, space: ParameterSpace, data: Motion, lay: _Layout, n_sub: int,
                  mass_free: bool, mass: float, xs: float) -> None:
