@@ -15,6 +15,13 @@ fit first matches the data segment by segment and tightens the chain as it goes,
 from the drifting open-loop simulations that trap a fit started far from the optimum. The trust
 region globalises each inner solve; the matrices of multiple shooting are block-sparse, so the
 cost of an iteration grows linearly with the number of samples.
+
+A large problem (beyond :data:`_DENSE`) solves the trust-region steps by LSMR, whose inexact steps
+on these ill-conditioned matrices stall a little above the defect tolerance. Once its defects are
+below :data:`_POLISH_BELOW`, the end phase takes sparse direct Gauss-Newton (SQP) steps of the
+constrained problem itself (:func:`prefriction.identify.kkt.polish`: the KKT system factorised as
+a band plus the parameters' Schur complement, linear in the samples) until the defects meet the
+tolerance and the step is below a thousandth of the estimates' standard errors.
 """
 
 from __future__ import annotations
