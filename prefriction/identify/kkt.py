@@ -234,19 +234,38 @@ def polish(full: Callable, plain: Callable, w: np.ndarray, lower: np.ndarray, up
         merit = 0.5 * float(r @ r) + nu * float(np.abs(g).sum())
         slope = float(r @ Jd) - nu * float(np.abs(g).sum())
         alpha, accepted = 1.0, False
-        for _ in range(_HALVINGS):
+        for half in range(_HALVINGS):
             trial = np.clip(w + alpha * d, lower, upper)
             rt, gt = plain(trial)
-            if np.all(np.isfinite(rt)) and np.all(np.isfinite(gt)):
-                mt = 0.5 * float(rt @ rt) + nu * float(np.abs(gt).sum())
-                if mt <= merit + 1e-4 * alpha * min(slope, 0.0):
-                    accepted = True
-                    break
+            if _accept(rt, gt, nu, merit, 1e-4 * alpha * min(slope, 0.0)):
+                accepted = True
+                break
+            if half == 0 and np.all(np.isfinite(gt)):
+                # second-order correction (Nocedal and Wright 18.3, (18.30)): the full step's
+                # defects removed to first order, against the merit's rejection of a good step
+                # where the constraints curve (the Maratos effect)
+                try:
+                    corr = np.clip(trial + kkt_step(J, A, np.zeros(n), gt, _DAMPING * scale, free, border)[0],
+                                   lower, upper)
+                except np.linalg.LinAlgError:
+                    corr = None
+                if corr is not None:
+                    rc, gc = plain(corr)
+                    if _accept(rc, gc, nu, merit, 1e-4 * min(slope, 0.0)):
+                        trial, accepted = corr, True
+                        break
             alpha *= 0.5
-        last = f"step {k}: |g| = {gmax:.1e}, step {size:.1e} standard errors"
+        last = f"step {k}: |g| = {gmax:.1e}, step {size:.1e} standard errors, length {alpha:.2g}"
         if not accepted:
             return PolishOutcome(w, False, k - 1, f"{last}; no decrease of the merit function along the step")
         w = trial
     r, g = plain(w)
     return PolishOutcome(w, False, steps, f"{last}; {steps} sparse Gauss-Newton steps did not converge "
                                           f"(|g| = {float(np.abs(g).max(initial=0.0)):.1e})")
+
+
+def _accept(r: np.ndarray, g: np.ndarray, nu: float, merit: float, decrease: float) -> bool:
+    """Armijo test of a trial point on the merit ``0.5 |r|^2 + nu |g|_1``."""
+    if not (np.all(np.isfinite(r)) and np.all(np.isfinite(g))):
+        return False
+    return 0.5 * float(r @ r) + nu * float(np.abs(g).sum()) <= merit + decrease
