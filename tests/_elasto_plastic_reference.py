@@ -73,23 +73,27 @@ def _next_region(region: int, which: int) -> int:
 
 
 def oscillator(p: Any, mass: float, v0: float, *, u: Optional[Callable[[float], float]] = None, t_end: float,
-               times: np.ndarray = np.zeros(0), rtol: float = 1e-12) -> dict:
+               times: np.ndarray = np.zeros(0), rtol: float = 1e-12, dissipation: bool = False) -> dict:
     """``m x'' = u(t) - F`` from ``x = 0``, ``z = 0``, speed ``v0`` up to ``t_end``.
 
     Returns the reversal rows ``(t, x, F)`` (F after the reversal, at ``v = 0``), the number of
-    breakaway and first saturation crossings, and ``(x, v, F)`` at ``times``.
+    breakaway and first saturation crossings, and ``(x, v, F)`` at ``times``. With
+    ``dissipation``, the rows carry a fourth column: the energy dissipated since ``t = 0``,
+    integrated as a state from the power ``sigma0 z (v - z') + (sigma1 z' + sigma2 v) v`` (the
+    friction power ``F v`` less the rate of the stored energy ``sigma0 z^2 / 2``).
     """
     uf = u or (lambda t: 0.0)
     s = 1.0 if v0 > 0 else -1.0
-    y = np.array([0.0, v0, 0.0])
+    y = np.array([0.0, v0, 0.0, 0.0] if dissipation else [0.0, v0, 0.0])
     t, region, rows, n_cross = 0.0, ELASTIC, [], [0, 0]
     zs, vs = p.Fc / p.sigma0, p.Fc / math.sqrt(mass * p.sigma0)  # the sizes of x and z, of v
-    atol = 1e-3 * rtol * np.array([zs, max(vs, abs(v0)), zs])
+    atol = 1e-3 * rtol * np.array([zs, max(vs, abs(v0)), zs, p.sigma0 * zs * zs][:y.size])
     dense_t, dense_y, dense_r = [], [], []
     while t < t_end:
         def rhs(tt: float, yy: np.ndarray, region: int = region) -> np.ndarray:
-            F = force(p, region, yy[2], yy[1])
-            return np.array([yy[1], (uf(tt) - F) / mass, zdot(p, region, yy[2], yy[1])])
+            F, zd = force(p, region, yy[2], yy[1]), zdot(p, region, yy[2], yy[1])
+            power = p.sigma0 * yy[2] * (yy[1] - zd) + (p.sigma1 * zd + p.sigma2 * yy[1]) * yy[1]
+            return np.array([yy[1], (uf(tt) - F) / mass, zd, power][:yy.size])
 
         def reversal(_t: float, yy: np.ndarray, s: float = s) -> float:
             return s * yy[1]
@@ -111,11 +115,11 @@ def oscillator(p: Any, mass: float, v0: float, *, u: Optional[Callable[[float], 
         if which == 0:
             s, y[1] = -s, 0.0
             region = region_at_rest(p, y[2], s)
-            rows.append((t, y[0], force(p, region, y[2], 0.0)))
+            rows.append((t, y[0], force(p, region, y[2], 0.0), *y[3:]))
         else:
             n_cross[which - 1] += 1
             region = _next_region(region, which - 1)
-    out = {"reversals": np.array(rows).reshape(-1, 3), "breakaways": n_cross[0], "saturations": n_cross[1]}
+    out = {"reversals": np.array(rows).reshape(-1, y.size), "breakaways": n_cross[0], "saturations": n_cross[1]}
     if dense_t:
         tt, yy = np.concatenate(dense_t), np.vstack(dense_y)
         out["dense"] = np.column_stack([yy[:, 0], yy[:, 1], [force(p, r, z, v) for r, z, v in

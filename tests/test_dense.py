@@ -10,7 +10,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import prefriction as pf
-from prefriction.simulation.dense import DENSE_STEP, SampleBuffer
+from prefriction.simulation.samples import DENSE_STEP, SampleBuffer
 
 SYSTEM = pf.Oscillator(pf.Dahl(1e4, 1.0, 1.0), mass=1.0)
 

@@ -1,5 +1,6 @@
 """ElastoPlastic everywhere a model works: identify.fit (force-displacement data), the positioning
-loop with its compensators, the exported C step and the energy analysis of a reversal table."""
+loop with its compensators, the exported C step and the energy analysis of a reversal table and
+of samples."""
 
 from __future__ import annotations
 
@@ -97,5 +98,26 @@ def test_energy_of_the_reversal_table():
     np.testing.assert_allclose(rep.E_p, ref[:, 2] ** 2 / (2 * TRUE.sigma0), rtol=1e-8)
     assert rep.E_0 == pytest.approx(0.5 * 0.5 * 0.05 ** 2, rel=1e-14)
     assert np.all(rep.E_d > 0) and rep.bound.holds
-    with pytest.raises(TypeError, match="analyze_table"):
-        pf.energy.analyze_samples(res.reversals.t, res.reversals.x, np.zeros(6), res.reversals.F, system=system)
+
+
+def test_energy_of_samples_against_the_dissipation_integrated_from_the_2002_equations():
+    """``analyze_samples`` of samples of the independent reference (forced past breakaway and
+    saturation): the stored energy ``sigma0 z^2 / 2`` at each reversal and the energy dissipated
+    per half-cycle, the integral of ``sigma0 z (v - z') + (sigma1 z' + sigma2 v) v`` carried as a
+    state of the reference's DOP853 integration (rtol 1e-12)."""
+    mass, v0 = 0.5, 1e-3
+    u = lambda tt: 0.3 + 2.0 * math.sin(2 * math.pi * 10 * tt)  # noqa: E731
+    t = np.linspace(0.0, 0.3, 12001)
+    ref = oscillator(TRUE, mass, v0, u=u, t_end=0.3, times=t, dissipation=True)
+    assert ref["breakaways"] >= 5 and ref["saturations"] >= 5
+    x, v, F = ref["dense"].T
+    rep = pf.energy.analyze_samples(t, x, v, F, system=pf.Oscillator(TRUE, mass=mass), u=np.vectorize(u)(t))
+    rows = ref["reversals"]
+    assert len(rep.E_p) == len(rows) == 5
+    np.testing.assert_allclose(rep.t, rows[:, 0], rtol=0, atol=1e-8)
+    E_p = rows[:, 2] ** 2 / (2 * TRUE.sigma0)  # F = sigma0 z at v = 0
+    np.testing.assert_allclose(rep.E_p, E_p, rtol=0, atol=1e-3 * E_p.max())
+    D = np.diff(rows[:, 3], prepend=0.0)  # dissipated in the first excursion, then per half-cycle
+    np.testing.assert_allclose(rep.E_d, D, rtol=0, atol=1e-5 * D.max())
+    assert rep.E_0 == pytest.approx(0.5 * mass * v0 ** 2, rel=1e-12)  # z = 0 at t = 0
+    assert rep.bound.holds and rep.bound.max_E_p <= TRUE.Fs ** 2 / (2 * TRUE.sigma0)

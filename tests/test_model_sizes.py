@@ -39,6 +39,19 @@ def test_a_correct_model_passes() -> None:
     assert len(res.reversals) == 3
 
 
+def test_a_refused_model_is_refused_on_every_call_and_on_every_path() -> None:
+    """Only structures that passed are remembered: the same wrong model is refused again, by the
+    unforced, the forced and the CasADi path alike (the check comes before any driver)."""
+    from prefriction.signals import Sine
+
+    match = r"RateTooLong\.rate\(\) returned 2 entries"
+    for kw in ({}, {"method": "erk"}):
+        with pytest.raises(TypeError, match=match):
+            pf.simulate(pf.Oscillator(RateTooLong(1e4, 1.0)), 1.0, reversals=3, **kw)
+    with pytest.raises(TypeError, match=match):
+        pf.simulate(pf.Oscillator(RateTooLong(1e4, 1.0), u=Sine(0.5, 10.0)), 0.0, t_end=0.1)
+
+
 @dataclass(frozen=True)
 class NoBranchEnergy(ElasticPlastic):
     branch_energy_of_force = pf.FrictionModel.branch_energy_of_force

@@ -22,7 +22,8 @@ from typing import Callable
 import numpy as np
 from scipy.integrate import solve_ivp
 
-import prefriction as pf
+from prefriction.along.run import friction_along
+from prefriction.models import GMS, Dahl, FrictionModel, LuGre, MaxwellSlip, Viscous
 
 __all__ = ["N", "N_REF", "Row", "main", "record", "rows"]
 
@@ -117,20 +118,20 @@ def _lugre_reference(t: np.ndarray, x: np.ndarray, p: tuple) -> np.ndarray:
     return F
 
 
-def _cases() -> list[tuple[str, pf.FrictionModel, Callable[[np.ndarray, np.ndarray], np.ndarray]]]:
+def _cases() -> list[tuple[str, FrictionModel, Callable[[np.ndarray, np.ndarray], np.ndarray]]]:
     k, w = np.array([6e4, 3e4, 1e4]), np.array([0.3, 0.4, 0.3])
     alpha, C, S = np.array([0.2, 0.3, 0.5]), 2e3, (lambda v: 1.0 + 0.5 * math.exp(-(v / 1e-4) ** 2))
     lugre = (1e5, 300.0, 0.5, 1.0, 1.5, 1e-4)
     return [
-        ("Dahl gamma=1", pf.Dahl(1e5, 1.0), lambda t, x: _dahl_reference(t, x, 1e5, 1.0, 1.0)),
-        ("Dahl gamma=0.5", pf.Dahl(1e5, 1.0, 0.5), lambda t, x: _dahl_reference(t, x, 1e5, 1.0, 0.5)),
-        ("MaxwellSlip(3)", pf.MaxwellSlip(k, w),
+        ("Dahl gamma=1", Dahl(1e5, 1.0), lambda t, x: _dahl_reference(t, x, 1e5, 1.0, 1.0)),
+        ("Dahl gamma=0.5", Dahl(1e5, 1.0, 0.5), lambda t, x: _dahl_reference(t, x, 1e5, 1.0, 0.5)),
+        ("MaxwellSlip(3)", MaxwellSlip(k, w),
          lambda t, x: _elements_reference(t, x, k, lambda v: w, lambda v, s, y: 0.0 * y)),
-        ("GMS(3)", pf.GMS(k=k, alpha=alpha, Fc=1.0, Fs=1.5, vs=1e-4, C=C),
+        ("GMS(3)", GMS(k=k, alpha=alpha, Fc=1.0, Fs=1.5, vs=1e-4, C=C),
          lambda t, x: _elements_reference(t, x, k, lambda v: alpha * S(v),
                                           lambda v, s, y: s * C * (1.0 - s * y / (alpha * S(v))))),
-        ("LuGre", pf.LuGre(*lugre), lambda t, x: _lugre_reference(t, x, lugre)),
-        ("Dahl + Viscous", pf.Dahl(1e5, 1.0) + pf.Viscous(3.0),
+        ("LuGre", LuGre(*lugre), lambda t, x: _lugre_reference(t, x, lugre)),
+        ("Dahl + Viscous", Dahl(1e5, 1.0) + Viscous(3.0),
          lambda t, x: _dahl_reference(t, x, 1e5, 1.0, 1.0)
          + 3.0 * np.concatenate(([(x[1] - x[0]) / (t[1] - t[0])], np.diff(x) / np.diff(t)))),
     ]
@@ -144,15 +145,15 @@ def rows(repeats: int = 5, n: int = N, n_ref: int = N_REF) -> list[Row]:
     cases = _cases()
     best = {name: math.inf for name, _m, _r in cases}
     for name, model, _ref in cases:  # build and compile once, outside the timing
-        pf.friction_along(model, t[:10], x[:10])
+        friction_along(model, t[:10], x[:10])
     for _ in range(repeats):  # interleaved rounds, minimum kept
         for name, model, _ref in cases:
             start = time.perf_counter()
-            pf.friction_along(model, t, x)
+            friction_along(model, t, x)
             best[name] = min(best[name], time.perf_counter() - start)
     for name, model, ref in cases:
         print(f"bench --along: scipy reference for {name} ({n_ref} samples)", file=sys.stderr, flush=True)
-        F = pf.friction_along(model, t_ref_rec, x_ref_rec).F
+        F = friction_along(model, t_ref_rec, x_ref_rec).F
         start = time.perf_counter()
         F_ref = ref(t_ref_rec, x_ref_rec)
         t_ref = (time.perf_counter() - start) * n / n_ref

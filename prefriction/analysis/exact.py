@@ -26,7 +26,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from prefriction import dahl
+from prefriction.analysis import dahl
 from prefriction.analysis.branch import (
     branch_distance,
     branch_potential,

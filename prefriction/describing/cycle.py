@@ -194,7 +194,7 @@ def plant_describing_function(system: Oscillator, U: float, omega: float, *, rto
     complex
         ``X1 / U`` [m/N] (python-control's convention, phasors relative to ``sin``).
     """
-    from prefriction import signals
+    from prefriction.signals import Sine
     from prefriction.simulation.simulate import simulate
 
     model = check_oscillator(system, "plant_describing_function")
@@ -208,7 +208,7 @@ def plant_describing_function(system: Oscillator, U: float, omega: float, *, rto
     samples = check_count("samples", samples, minimum=64)
     if max_periods > 1024 or samples > 8192:
         raise ValueError(f"max_periods must be <= 1024 and samples <= 8192, got {max_periods} and {samples}")
-    forced = Oscillator(model, system.mass, u=signals.Sine(U, omega / (2.0 * math.pi)))
+    forced = Oscillator(model, system.mass, u=Sine(U, omega / (2.0 * math.pi)))
     T = 2.0 * math.pi / omega
     theta = 2.0 * math.pi * np.arange(samples) / samples
     while True:

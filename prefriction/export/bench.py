@@ -27,15 +27,15 @@ LOOP_SAMPLES = 100_000
 
 
 def _cases() -> list[tuple[str, object, float | None]]:
-    import prefriction as pf
+    from prefriction.models import GMS, Dahl, LuGre, MaxwellSlip
 
     return [
-        ("Dahl gamma = 1", pf.Dahl(2e5, 1.5, 1.0), None),
-        ("Dahl gamma = 0.5", pf.Dahl(2e5, 1.5, 0.5), None),
-        ("Dahl gamma = 3", pf.Dahl(2e5, 1.5, 3.0), None),
-        ("LuGre", pf.LuGre(2e5, 400.0, 0.5, 1.2, 1.6, 2e-3), TS),
-        ("Maxwell-slip, 3 elements", pf.MaxwellSlip([1e5, 6e4, 3e4], [0.3, 0.5, 0.6]), None),
-        ("GMS, 3 elements", pf.GMS([1e5, 6e4, 3e4], [0.3, 0.3, 0.4], 1.2, 1.6, 2e-3, 50.0), TS),
+        ("Dahl gamma = 1", Dahl(2e5, 1.5, 1.0), None),
+        ("Dahl gamma = 0.5", Dahl(2e5, 1.5, 0.5), None),
+        ("Dahl gamma = 3", Dahl(2e5, 1.5, 3.0), None),
+        ("LuGre", LuGre(2e5, 400.0, 0.5, 1.2, 1.6, 2e-3), TS),
+        ("Maxwell-slip, 3 elements", MaxwellSlip([1e5, 6e4, 3e4], [0.3, 0.5, 0.6]), None),
+        ("GMS, 3 elements", GMS([1e5, 6e4, 3e4], [0.3, 0.3, 0.4], 1.2, 1.6, 2e-3, 50.0), TS),
     ]
 
 
@@ -55,20 +55,21 @@ def _warm(fun, repeats: int) -> float:
 
 
 def _model_rows(repeats: int, d: str) -> tuple[list[str], bool]:
-    import prefriction as pf
-    from prefriction import export
+    from prefriction.along import FrictionStream, friction_along
+    from prefriction.export.model import c_source
+    from prefriction.export.run import run_c
 
     t, x = _motion()
     rows, ok = [], True
     for i, (label, model, Ts) in enumerate(_cases()):
         print(f"bench --export: {label}", file=sys.stderr)
-        src = export.c_source(model, f"m{i}", d, Ts=Ts)
-        run = export.run_c(src, x, rounds=repeats)
-        along = pf.friction_along(model, t, x)
-        t_along = _warm(lambda: pf.friction_along(model, t, x), repeats) / N
+        src = c_source(model, f"m{i}", d, Ts=Ts)
+        run = run_c(src, x, rounds=repeats)
+        along = friction_along(model, t, x)
+        t_along = _warm(lambda: friction_along(model, t, x), repeats) / N
         stream_n = 2000
         def stream() -> None:
-            s = pf.FrictionStream(model, x[0], t0=t[0])
+            s = FrictionStream(model, x[0], t0=t[0])
             for k in range(1, stream_n):
                 s.step(x[k], t[k])
         t_stream = _warm(stream, 1) / (stream_n - 1)
@@ -82,30 +83,34 @@ def _model_rows(repeats: int, d: str) -> tuple[list[str], bool]:
 
 
 def _loop_rows(repeats: int, d: str) -> list[str]:
-    import prefriction as pf
-    from prefriction import controllers, export
+    from prefriction.controllers import Feedforward, PID, simulate_loop
+    from prefriction.export.controller import controller_source
+    from prefriction.export.loop_run import run_loop_c
+    from prefriction.export.plant import plant_source
+    from prefriction.export.plant_run import run_plant_c
+    from prefriction.models import Dahl, LuGre, Oscillator
     from prefriction.signals import Sine
 
     rows = []
-    for label, stage in (("Dahl stage", pf.Oscillator(pf.Dahl(1e5, 1.0, 1.0), mass=0.5)),
-                         ("LuGre stage", pf.Oscillator(pf.LuGre(1e5, 300.0, 0.4, 1.0, 1.3, 1e-3), mass=0.5))):
+    for label, stage in (("Dahl stage", Oscillator(Dahl(1e5, 1.0, 1.0), mass=0.5)),
+                         ("LuGre stage", Oscillator(LuGre(1e5, 300.0, 0.4, 1.0, 1.3, 1e-3), mass=0.5))):
         print(f"bench --export: {label}", file=sys.stderr)
         Ts, n = 1e-4, LOOP_SAMPLES
         ref = Sine(1e-5, 20.0)
         tk = np.arange(n) * Ts
         v = 1e-5 * 2 * np.pi * 20 * np.cos(2 * np.pi * 20 * tk)
-        pid = controllers.PID(kp=4e5, ki=2e7, kd=600.0)
-        ff = controllers.Feedforward(stage.friction)
-        plant = export.plant_source(stage, "stage", d, Ts=Ts)
-        ctl = export.controller_source(pid, "ctl", d, Ts=Ts, compensator=ff, mass=stage.mass)
+        pid = PID(kp=4e5, ki=2e7, kd=600.0)
+        ff = Feedforward(stage.friction)
+        plant = plant_source(stage, "stage", d, Ts=Ts)
+        ctl = controller_source(pid, "ctl", d, Ts=Ts, compensator=ff, mass=stage.mass)
         sim = [None]
 
         def loop() -> None:
-            sim[0] = controllers.simulate_loop(stage, pid, ref, (n - 1) * Ts, Ts=Ts, compensator=ff)
+            sim[0] = simulate_loop(stage, pid, ref, (n - 1) * Ts, Ts=Ts, compensator=ff)
         t_sim = _warm(loop, 1) / n
         res = sim[0]
-        c_loop = export.run_loop_c(ctl, plant, np.asarray(res.reference), v, rounds=repeats)
-        free = export.run_plant_c(plant, np.zeros(2000), rounds=repeats)
+        c_loop = run_loop_c(ctl, plant, np.asarray(res.reference), v, rounds=repeats)
+        free = run_plant_c(plant, np.zeros(2000), rounds=repeats)
         diff = float(np.max(np.abs(c_loop.x - res.x)) / np.max(np.abs(res.x)))
         rows.append(f"{label:12s} {c_loop.ns_per_sample / 1e3:8.2f} {t_sim * 1e6:16.2f} "
                     f"{t_sim * 1e9 / c_loop.ns_per_sample:8.1f}x {free.ns_per_step / 1e3:10.3f} {diff:12.1e}")
@@ -125,9 +130,9 @@ def run(repeats: int = 5) -> str:
     str
         The printed text.
     """
-    from prefriction import export
+    from prefriction.export.run import gcc
 
-    if export.gcc() is None:
+    if gcc() is None:
         return "prefriction bench --export: gcc is not on the PATH; nothing measured\n"
     with tempfile.TemporaryDirectory(prefix="pf-bench-export-") as d:
         rows, ok = _model_rows(repeats, d)

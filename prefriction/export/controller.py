@@ -38,8 +38,8 @@ class _Law:
                  discretization: str) -> None:
         import control
 
-        from prefriction import controllers
         from prefriction.controllers._linear import _sample_time, as_lti
+        from prefriction.controllers._pid import PID
 
         C = as_lti(controller)
         dt = _sample_time(C)
@@ -50,7 +50,7 @@ class _Law:
         self.A, self.B = np.atleast_2d(C.A), np.atleast_2d(C.B)
         self.C, self.D = np.atleast_2d(C.C), float(np.atleast_2d(C.D)[0, 0])
         self.n = self.A.shape[0] if self.A.size else 0
-        pid = isinstance(controller, controllers.PID)
+        pid = isinstance(controller, PID)
         self.u_max = controller.u_max if pid and controller.u_max is not None else None
         self.k_aw = controller.back_calculation_gain() if self.u_max is not None else np.zeros(self.n)
         self.Ts = Ts

@@ -69,8 +69,8 @@ def _encoder(x: np.ndarray, noise: float, quantum: float, rng: np.random.Generat
 
 def _dahl(encoder: bool, declared: bool = True) -> Callable:
     def make(rng: np.random.Generator, n: int) -> tuple:
-        import prefriction as pf
-        from prefriction import identify
+        from prefriction.identify.data import ForceDisplacement
+        from prefriction.models import Dahl
 
         t = np.linspace(0.0, 4.0, n)
         x = 3e-6 * np.sin(np.pi * t + 0.3) - 3e-6 * np.sin(0.3) + 0.2e-6 * t
@@ -78,49 +78,49 @@ def _dahl(encoder: bool, declared: bool = True) -> Callable:
         F = dahl2_force(2e6, 3.0, x) + 0.2 + 0.015 * rng.standard_normal(n)
         if encoder:
             noise = {"x_noise": 3e-9, "quantum": 1e-8} if declared else {}
-            data = identify.ForceDisplacement(t, _encoder(x, 3e-9, 1e-8, rng), F, **noise)
+            data = ForceDisplacement(t, _encoder(x, 3e-9, 1e-8, rng), F, **noise)
         else:
-            data = identify.ForceDisplacement(t, x, F)
-        start = pf.Dahl(sigma=2.6e6, Fc=3.9, gamma=2.0)
+            data = ForceDisplacement(t, x, F)
+        start = Dahl(sigma=2.6e6, Fc=3.9, gamma=2.0)
         return data, start, truth, {"fixed": ["gamma"], "offset": True}
     return make
 
 
 def _maxwell(rng: np.random.Generator, n: int) -> tuple:
-    import prefriction as pf
-    from prefriction import identify
+    from prefriction.identify.data import ForceDisplacement
     from prefriction.identify.synthetic import maxwell_slip_force
+    from prefriction.models import MaxwellSlip
 
     t = np.linspace(0.0, 2.0, n)
     x = 40e-6 * np.sin(2.0 * np.pi * t) * (0.25 + 0.75 * t / 2.0)
-    true = pf.MaxwellSlip([6e4, 2e4], [0.4, 0.6])
+    true = MaxwellSlip([6e4, 2e4], [0.4, 0.6])
     F = maxwell_slip_force(true, x) + 0.003 * rng.standard_normal(n)
-    data = identify.ForceDisplacement(t, _encoder(x, 3e-8, 1e-7, rng), F, x_noise=3e-8, quantum=1e-7)
+    data = ForceDisplacement(t, _encoder(x, 3e-8, 1e-7, rng), F, x_noise=3e-8, quantum=1e-7)
     truth = {"stiffness[0]": 6e4, "stiffness[1]": 2e4, "slip_force[0]": 0.4, "slip_force[1]": 0.6}
-    return data, pf.MaxwellSlip([7.8e4, 2.6e4], [0.52, 0.78]), truth, {}
+    return data, MaxwellSlip([7.8e4, 2.6e4], [0.52, 0.78]), truth, {}
 
 
 def _decay(rng: np.random.Generator, n: int) -> tuple:
-    import prefriction as pf
     from prefriction.identify.synthetic import dahl_free_decay
+    from prefriction.models import Dahl
 
-    true = pf.Dahl(sigma=1.5e4, Fc=1.0, gamma=1.5)
+    true = Dahl(sigma=1.5e4, Fc=1.0, gamma=1.5)
     t = np.linspace(0.0, 0.2, n)
     data = dahl_free_decay(true, 1.0, 0.02, t, 2e-7, rng)
     truth = {"sigma": 1.5e4, "gamma": 1.5}
-    return data, pf.Dahl(sigma=1.9e4, Fc=1.0, gamma=1.9), truth, {"fixed": ["Fc"], "structures": "given"}
+    return data, Dahl(sigma=1.9e4, Fc=1.0, gamma=1.9), truth, {"fixed": ["Fc"], "structures": "given"}
 
 
 def _closed_loop(rng: np.random.Generator, n: int) -> tuple:
-    import prefriction as pf
-    from prefriction import identify
+    from prefriction.identify.data import Motion
     from prefriction.identify.synthetic_loop import ClosedLoop, closed_loop_record
+    from prefriction.models import Dahl, Viscous
 
-    loop = ClosedLoop(pf.Dahl(sigma=1.0e6, Fc=20.39), mass=95.1, b=203.5, offset=-3.16, quantum=5e-8, noise=1e-7)
+    loop = ClosedLoop(Dahl(sigma=1.0e6, Fc=20.39), mass=95.1, b=203.5, offset=-3.16, quantum=5e-8, noise=1e-7)
     rec = closed_loop_record(loop, n, rng)
     truth = {"sigma": 1.0e6, "Fc": 20.39, "b": 203.5, "mass": 95.1, "offset": -3.16}
-    start = pf.Dahl(sigma=8e5, Fc=10.0) + pf.Viscous(b=100.0)
-    return identify.Motion(rec.t, rec.x, rec.u, None), start, truth, {"fixed": ["gamma"], "mass0": 80.0,
+    start = Dahl(sigma=8e5, Fc=10.0) + Viscous(b=100.0)
+    return Motion(rec.t, rec.x, rec.u, None), start, truth, {"fixed": ["gamma"], "mass0": 80.0,
                                                                         "offset": True}
 
 
@@ -173,7 +173,7 @@ def coverage_table(cases: tuple[str, ...] = tuple(CASES), runs: int = 40, seed: 
     -------
     list of CoverageRow
     """
-    from prefriction import identify
+    from prefriction.identify.fit import fit
 
     rows = []
     for c, name in enumerate(cases):
@@ -187,7 +187,7 @@ def coverage_table(cases: tuple[str, ...] = tuple(CASES), runs: int = 40, seed: 
             try:
                 with warnings.catch_warnings():
                     warnings.simplefilter("ignore")
-                    res = identify.fit(start, data, **kw)
+                    res = fit(start, data, **kw)
             except Exception:  # noqa: BLE001 - a failed fit is counted, not raised
                 failures += 1
                 continue

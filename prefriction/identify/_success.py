@@ -231,7 +231,7 @@ def success_table(stages: tuple = STAGES, distances: tuple = (1.25, 1.5, 2.0), *
     list of SuccessRow
         One row per stage and distance.
     """
-    from prefriction import identify
+    from prefriction.identify.fit import fit
     from prefriction.identify.parameters import _entries
 
     rows = []
@@ -250,7 +250,7 @@ def success_table(stages: tuple = STAGES, distances: tuple = (1.25, 1.5, 2.0), *
                 with warnings.catch_warnings():
                     warnings.simplefilter("ignore")
                     try:
-                        res = identify.fit(start, data, fixed=fixed, offset=True, mass0=m0, offset0=off0)
+                        res = fit(start, data, fixed=fixed, offset=True, mass0=m0, offset0=off0)
                         est = {n: res.estimate(n) for n in truth}
                         conv += bool(res.success)
                         msg = "" if res.success else res.message

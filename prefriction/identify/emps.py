@@ -162,8 +162,8 @@ def loop_rmse(result: Any, record: EMPSRecord) -> float:
     stiffness 1e8 N/m (0.2 um of pre-sliding), its direction-dependent levels a symmetric one and
     an offset.
     """
-    import prefriction as pf
     from prefriction.identify.closed_loop_fit import simulate_closed_loop
+    from prefriction.models import Dahl, DirectionalViscous, Viscous
     from prefriction.identify.digital_loop import DigitalLoop
     from prefriction.identify.static_map import StaticFriction
 
@@ -171,8 +171,8 @@ def loop_rmse(result: Any, record: EMPSRecord) -> float:
     model = result.model
     if isinstance(model, StaticFriction):
         fc_neg = model.Fc if model.Fc_neg is None else model.Fc_neg
-        viscous = pf.Viscous(model.b) if model.b_neg is None else pf.DirectionalViscous(model.b, model.b_neg)
-        model, off = pf.Dahl(sigma=1e8, Fc=0.5 * (model.Fc + fc_neg)) + viscous, off + 0.5 * (model.Fc - fc_neg)
+        viscous = Viscous(model.b) if model.b_neg is None else DirectionalViscous(model.b, model.b_neg)
+        model, off = Dahl(sigma=1e8, Fc=0.5 * (model.Fc + fc_neg)) + viscous, off + 0.5 * (model.Fc - fc_neg)
     loop = DigitalLoop.emps(record.kp, record.kv, record.gtau, dt=float(np.mean(np.diff(record.t))))
     x, _ = simulate_closed_loop(model, loop, record.t, record.reference, mass=result.mass, offset=off,
                                 x0=float(record.x[0]), extra=record.extra)
@@ -228,8 +228,8 @@ def benchmark(directory: str | os.PathLike, *, starts: tuple[float, ...] = (1.0,
     """
     import warnings
 
-    import prefriction as pf
     from prefriction.identify.closed_loop_fit import fit_closed_loop
+    from prefriction.models import Dahl, DirectionalViscous, Viscous
     from prefriction.identify.digital_loop import DigitalLoop
     from prefriction.identify.inverse import fit_inverse
     from prefriction.identify.routes import recommend
@@ -253,17 +253,17 @@ def benchmark(directory: str | os.PathLike, *, starts: tuple[float, ...] = (1.0,
                                              offset=False), pulses))
         say(f"{rows[-2].route}: {rows[-2].model}, {rows[-2].seconds:.2f} s")
         for f in starts:
-            model = pf.Dahl(sigma=f * 5e6, Fc=f * P["Fc"]) + pf.Viscous(f * P["b"])
+            model = Dahl(sigma=f * 5e6, Fc=f * P["Fc"]) + Viscous(f * P["b"])
             rows.append(_row("inverse", "Dahl + Viscous", f"{f:g} x", lambda model=model, f=f: fit_inverse(
                 model, data, fixed=["gamma"], mass0=f * P["mass"], offset0=f * P["offset"]), pulses))
             say(f"inverse: Dahl + Viscous from {f:g} x, {rows[-1].seconds:.1f} s")
-        model = pf.Dahl(sigma=5e6, Fc=P["Fc"]) + pf.DirectionalViscous(P["b"], P["b"])
+        model = Dahl(sigma=5e6, Fc=P["Fc"]) + DirectionalViscous(P["b"], P["b"])
         rows.append(_row("inverse", "Dahl + DirectionalViscous", "1 x", lambda: fit_inverse(
             model, data, fixed=["gamma"], mass0=P["mass"], offset0=P["offset"]), pulses))
         if closed_loop:
             loop = DigitalLoop.emps(est.kp, est.kv, est.gtau, dt=float(np.mean(np.diff(est.t))))
             for f in starts:
-                model = pf.Dahl(sigma=f * 5e6, Fc=f * P["Fc"]) + pf.Viscous(f * P["b"])
+                model = Dahl(sigma=f * 5e6, Fc=f * P["Fc"]) + Viscous(f * P["b"])
                 rows.append(_row("closed-loop", "Dahl + Viscous", f"{f:g} x", lambda model=model, f=f: fit_closed_loop(
                     model, data, loop, est.reference, fixed=["gamma"], mass0=f * P["mass"],
                     offset0=f * P["offset"]), pulses))

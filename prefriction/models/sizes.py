@@ -8,11 +8,13 @@ once with CasADi symbols and names the method, its count and the declared one.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Hashable
 
 import casadi as ca
 
 __all__ = ["check_sizes"]
+
+_CHECKED: set = set()  # (class, structure key) of the models that passed: checked once per structure
 
 
 def _count(what: Any) -> int:
@@ -25,7 +27,17 @@ def _count(what: Any) -> int:
 def check_sizes(model: Any) -> None:
     """``TypeError`` naming the method whose output size differs from the model's declared sizes,
     or a rate-independent model without ``branch_energy_of_force`` (every run's reversal table
-    takes its potential energies from it)."""
+    takes its potential energies from it). A structure that passed is not checked again (the
+    class and :meth:`~prefriction.FrictionModel.structure_key` fix every size)."""
+    key: Hashable = (type(model).__module__, type(model).__qualname__, model.structure_key())
+    if key in _CHECKED:
+        return
+    _check(model)
+    _CHECKED.add(key)
+
+
+def _check(model: Any) -> None:
+    """:func:`check_sizes` without the memory of structures that passed."""
     name = type(model).__name__
     from prefriction.models.base import FrictionModel
 

@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 from scipy.special import lambertw
 
-from prefriction import dahl
+from prefriction.analysis import dahl
 from prefriction._validation import check_count, check_finite
 from prefriction.models import check_dahl_oscillator
 

@@ -1,4 +1,5 @@
-"""The form in which the simulator compiles a signal (:func:`compiled_form`)."""
+"""The form in which the simulator compiles a signal (:func:`compiled_form`), and the numbers of
+its piecewise-linear form on many intervals at once (:func:`linear_pieces`)."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ import numpy as np
 
 from prefriction.signals.base import LinearPieces, Signal
 
-__all__ = ["compiled_form"]
+__all__ = ["compiled_form", "linear_pieces"]
 
 
 class _PiecewiseLinear(LinearPieces):
@@ -59,3 +60,13 @@ def compiled_form(sig: Optional[Signal]) -> Optional[Signal]:
     if sig is None or isinstance(sig, _PiecewiseLinear):
         return sig
     return _PiecewiseLinear(sig) if sig.linear_piece(0.0, 0.0) is not None else sig
+
+
+def linear_pieces(sig: Any, ta: np.ndarray, tb: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Value at ``ta`` and slope of a piecewise-linear signal (the simulator's compiled form,
+    ``key == ("PiecewiseLinear",)``) on each interval ``[ta, tb]`` [s] (no break inside), in one
+    vectorised pass: the line through the quarter points (exact for a linear piece)."""
+    q1, q3 = ta + 0.25 * (tb - ta), ta + 0.75 * (tb - ta)
+    u1, u3 = np.asarray(sig.base(q1), dtype=float), np.asarray(sig.base(q3), dtype=float)
+    slope = (u3 - u1) / (q3 - q1)
+    return u1 - slope * (q1 - ta), slope

@@ -10,38 +10,27 @@ and process and reused (numbers and tolerances are run-time inputs).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Any, Optional
+from typing import Optional
 
 from prefriction.models.base import FrictionModel
+from prefriction.models.sizes import check_sizes
 from prefriction.simulation.feedback import LinearFeedback
-from prefriction.simulation.integrator import BufferedIntegrator, integrator
+from prefriction.simulation.integrator import integrator
 from prefriction.simulation.native.forced import forced_driver
 from prefriction.simulation.native.library import native_driver
 from prefriction.simulation.plant import Layout, PlantSpec
+from prefriction.simulation.run_state import BuiltPlant
 
-__all__ = ["BuiltPlant", "build_plant"]
-
-
-@dataclass(frozen=True)
-class BuiltPlant:
-    """The plant of a run: its layout ``L`` and exactly one driver (``f1``: CasADi's integrator;
-    ``native``: the unforced native driver; ``native_forced``: the forced one; the others None),
-    the setup time [s] (0 if reused) and the JIT mode (``"interpreted"``, ``"cached"``, ...)."""
-
-    L: Layout
-    f1: Optional[BufferedIntegrator]
-    native: Any
-    native_forced: Any
-    setup_time: float
-    mode: str
+__all__ = ["build_plant"]
 
 
 def build_plant(model: FrictionModel, spec: PlantSpec, fb: Optional[LinearFeedback], jit: bool,
                 native: bool = True) -> BuiltPlant:
     """Build (or reuse) the plant of ``spec`` for the friction ``model``, on the native drivers
     where they apply (``native`` and ``jit``, no controller ``fb`` for the forced one), else on
-    CasADi's integrator (compiled if ``jit``)."""
+    CasADi's integrator (compiled if ``jit``). The model's sizes are checked first, once per
+    structure (:func:`~prefriction.models.sizes.check_sizes`), for every driver alike."""
+    check_sizes(model)
     L = Layout(spec)  # the same for any number of outputs per call
     drv, setup = native_driver(model) if spec.stops_at_reversal and jit and native else (None, 0.0)
     drv_forced = None

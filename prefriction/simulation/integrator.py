@@ -9,7 +9,6 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
-from prefriction.models.sizes import check_sizes
 from prefriction.simulation.compiled import compiled, jit_available
 from prefriction.simulation.per_thread import PerThread
 from prefriction.simulation.plant import PlantSpec, build_integrator
@@ -54,7 +53,6 @@ def _build(spec: PlantSpec, jit: bool) -> tuple[Any, str, float]:
     """The Function of ``spec`` (compiled or loaded from the cache if ``jit``), its mode and setup time."""
     start = time.perf_counter()
     what = _describe(spec)  # for the compile message
-    check_sizes(spec.model)  # a user model's sizes, once per structure
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", FutureWarning)
         fun = build_integrator(spec)

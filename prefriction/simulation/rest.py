@@ -9,13 +9,8 @@ from __future__ import annotations
 
 from typing import Callable, Optional
 
-import numpy as np
-
-from prefriction.models import Oscillator
-from prefriction.models.base import FrictionModel
-from prefriction.simulation.feedback import LinearFeedback
-from prefriction.simulation.plant import EPS_REST, EPS_TOUCH, PlantSpec
-from prefriction.units import Scales
+from prefriction.simulation.plant import EPS_REST, EPS_TOUCH
+from prefriction.simulation.run_state import RunState
 
 __all__ = ["Rest", "initial_direction"]
 
@@ -45,24 +40,14 @@ def initial_direction(v0: float, acc0: float, F0: float) -> tuple[float, float]:
     return (-1.0 if F0 > 0 else 1.0), 1.0
 
 
-class Rest:
+class Rest(RunState):
     """Net force on the mass and the rest transitions made between calls.
 
-    A mixin of :class:`~prefriction.simulation.run.Run`, which sets the attributes below and
-    provides the amplitude scales ``_scales`` (:class:`~prefriction.simulation.state_io.StateIO`).
+    A part of :class:`~prefriction.simulation.run.Run` on the state of
+    :class:`~prefriction.simulation.run_state.RunState`; the amplitude scales ``_scales`` come
+    from :class:`~prefriction.simulation.state_io.StateIO`.
     """
 
-    system: Oscillator
-    spec: PlantSpec
-    fb: Optional[LinearFeedback]
-    sc: Scales
-    model: FrictionModel
-    q: np.ndarray
-    eps: float
-    snap: float
-    st: dict
-    rev: list
-    rev_events: list
     _scales: Callable[[], dict]
 
     def _net_force(self, state: Optional[dict] = None, t: Optional[float] = None) -> float:

@@ -1,40 +1,26 @@
-"""The integration loop of one :func:`prefriction.simulate` call (normalised units inside).
+"""The CasADi integration loop of one :func:`prefriction.simulate` call (normalised units inside).
 
-:class:`Run` holds the run's state and drives the integrator calls; :func:`drive` runs it on
-its path (sampled controller, forced native driver, dense output or reversals only) once
-:func:`check_ramps` has held the input's ramps against the run's error level. The conversion
-of the state to and from a call's buffers is in :mod:`prefriction.simulation.state_io`, the
-rests decided between calls in :mod:`prefriction.simulation.rest`.
+:class:`Run` drives the integrator calls of a run (:meth:`Run.advance`); the run's state and
+its bookkeeping are in :mod:`prefriction.simulation.run_state`, the conversion of the state to
+and from a call's buffers in :mod:`prefriction.simulation.state_io`, the rests decided between
+calls in :mod:`prefriction.simulation.rest`; :mod:`prefriction.simulation.drive` runs it on
+its path.
 """
 
 from __future__ import annotations
 
 import math
-from typing import Optional, Union
 
 import numpy as np
 
 from prefriction.simulation.compact import advance_compact
-from prefriction.simulation.dense import SampleBuffer, dense_loop
-from prefriction.simulation.build import BuiltPlant
 from prefriction.simulation.integrator import INTEGRATOR_FAILED, BufferedIntegrator
-from prefriction.simulation.feedback import LinearFeedback
 from prefriction.simulation.native.advance import advance_native
-from prefriction.simulation.native.forced import linear_pieces, run_forced
-from prefriction.simulation.plant import Layout, PlantSpec
+from prefriction.simulation.plant import Layout
 from prefriction.simulation.rest import Rest
-from prefriction.simulation.reversal_log import ReversalLog
 from prefriction.simulation.state_io import StateIO
 from prefriction.errors import SolverError
-from prefriction.models import Oscillator
-from prefriction.units import Scales
 
-_DIED_OUT = 1e-20  # normalised speed below which an unforced motion has died out (no reversal comes)
-RAMP_ROUNDOFF = 0.3
-"""Largest force error from the round-off of the time in a ramp of the input force, in units of
-the run's error level ``eps`` times the force scale (:func:`prefriction.simulate` refuses
-steeper ramps: they started spurious reversal pairs at a rest, or NaN in CasADi's event
-transition)."""
 _MIN_CALL = 1e-9  # relative length of a call below which a failed call is not made shorter (Run._shorten)
 
 
@@ -42,39 +28,13 @@ class Run(StateIO, Rest):
     """The integration loop of one :func:`prefriction.simulate` call (normalised units inside).
 
     ``simulate`` builds the ``plant`` (:func:`~prefriction.simulation.build.build_plant`), sets
-    the initial state ``st``, the run constants (``snap``,
-    ``force_scale``, ``breaks``, signal kinds, ``P0``) and then :func:`drive` runs it through
-    :meth:`advance` (or :func:`prefriction.simulation.dense.dense`) and :meth:`sample`; the
-    reversals found are in ``rev``. Packing of the call buffers:
-    :class:`~prefriction.simulation.state_io.StateIO`; rests between calls:
+    the initial state ``st`` and the run constants (``snap``, ``force_scale``, ``breaks``,
+    ``P0``); :func:`~prefriction.simulation.drive.drive` then runs it through :meth:`advance`
+    (or the dense-output loop of :mod:`prefriction.simulation.dense`); the reversals found are
+    in ``rev``. The state: :class:`~prefriction.simulation.run_state.RunState`; packing of the
+    call buffers: :class:`~prefriction.simulation.state_io.StateIO`; rests between calls:
     :class:`~prefriction.simulation.rest.Rest`.
     """
-
-    def __init__(self, system: Oscillator, spec: PlantSpec, fb: Optional[LinearFeedback],
-                 eps: float, plant: BuiltPlant, sc: Optional[Scales] = None) -> None:
-        self.system, self.spec, self.fb = system, spec, fb
-        self.sc = Scales.of(system) if sc is None else sc  # (simulate has them already)
-        self.model = system.friction
-        self.q = self.model.runtime_params_for(self.sc)  # may depend on the mass (units)
-        self.eps = eps  # run-time tolerance: states are scaled by amplitude * eps
-        self.eps_native = eps  # the same for the native drivers' norm over the active states (simulate sets it)
-        # a sampled controller on a plant without a hold control: its force joins the input piece
-        self.hold_in_piece = fb is not None and fb.sampled and spec.fb == "none"
-        self.L, self.f1, self.native, self.native_forced = plant.L, plant.f1, plant.native, plant.native_forced
-        self.setup_time, self.mode = plant.setup_time, plant.mode
-        self.calls = 0
-        self.steps: Optional[int] = 0
-        self.max_chunk = math.inf  # longest next call of advance (finite after a failed call)
-        self.rev = ReversalLog()  # (t~, x~, F~, W~) per reversal
-        self.rev_events: list[int] = []  # model events of the half-cycle ending at each reversal
-        self.st: dict = {}  # current state, normalised (set by simulate)
-        self.snap = 0.0  # reversal-event coincidence tolerance (e.g. Dahl saturation)
-        self.force_scale = 0.0  # size of the applied force / Fc
-        self.A_max = 0.0  # largest amplitude seen (forced)
-        self.breaks = np.zeros(0)  # sample times of sampled signals (normalised)
-        self.S = np.ones(spec.n_c)  # controller state scales (times eps)
-        self.P0 = np.zeros(self.L.np)  # parameters fixed during the run
-        self.note = ""  # a change of method during the run, for the result's message
 
     # --- one call -----------------------------------------------------------------------
     def _call(self, call: BufferedIntegrator, L: Layout, times: list[float], nstop: float) -> tuple[np.ndarray, dict]:
@@ -130,39 +90,6 @@ class Run(StateIO, Rest):
             self.steps += int(call.buf.stats()["n_steps"])
         except (RuntimeError, KeyError):
             self.steps = None
-
-    def _failure(self, why: str) -> SolverError:
-        """The SolverError of a failed call: time, state, reversals so far and what to try."""
-        sc, st = self.sc, self.st
-        if not self.spec.forced and abs(st["v"]) < _DIED_OUT and abs(st["F"]) < _DIED_OUT ** 0.5:
-            n = len(self.rev)
-            return SolverError(
-                f"simulate stopped at t = {st['t'] * sc.t:.9g} s: the motion has died out after {n} "
-                f"reversal{'' if n == 1 else 's'} (v = {st['v'] * sc.v:.3g} m/s, F = {st['F'] * sc.F:.3g} N, "
-                f"x = {st['x'] * sc.x:.6g} m), so it will not reverse again and the requested reversals cannot "
-                f"come ({why}). Give t_end to simulate up to a time instead, or ask for at most {n} "
-                f"reversal{'' if n == 1 else 's'}."
-            )
-        return SolverError(
-            f"simulate failed after t = {st['t'] * sc.t:.9g} s (state there: x = {st['x'] * sc.x:.6g} m, "
-            f"v = {st['v'] * sc.v:.6g} m/s, F = {st['F'] * sc.F:.6g} N, direction {int(st['s']):+d}, "
-            f"{len(self.rev)} reversals so far): {why}. Try a looser rtol, a shorter t_end or fewer "
-            f"reversals" + (", or a smoother input force (samples closer together)." if self.spec.forced else ".")
-        )
-
-    def _record(self, out: dict) -> None:
-        """Append the reversals of the unpacked state ``out`` and their half-cycles' event counts."""
-        self.rev.extend(out["new"])
-        self.rev_events.extend(out["new_events"])
-
-    def _accept(self, out: dict, t: float) -> None:
-        """Take the unpacked state ``out``, at normalised time ``t`` unless the call stopped early."""
-        self._record(out)
-        for k in ("x", "v", "F", "z", "m", "s", "rest", "W", "Ef", "xc", "ne"):
-            self.st[k] = out[k]
-        if "Eb" in out:
-            self.st["Eb"] = out["Eb"]
-        self.st["t"] = t if out["t"] is None else out["t"]
 
     # --- loops --------------------------------------------------------------------------
     def advance(self, t_target: float, n_target: float) -> bool:
@@ -246,88 +173,3 @@ class Run(StateIO, Rest):
             return math.inf
         k = np.searchsorted(b, t * (1 + 1e-15) + 1e-300, side="right")
         return float(b[k]) if k < b.size else math.inf
-
-    def sample(self) -> tuple:
-        """Current state as a sample (t~, x~, v~, F~, E_f~, xc)."""
-        st = self.st
-        return (st["t"], st["x"], st["v"], st["F"], st["Ef"], np.array(st["xc"], dtype=float))
-
-
-def drive(run: Run, t_end: float, n_target: float, times: Optional[np.ndarray], want_dense: bool,
-          xc0: np.ndarray) -> tuple[Union[SampleBuffer, list], list]:
-    """Run ``run`` from its initial state to the normalised time ``t_end`` or ``n_target``
-    reversals on its path: a sampled controller's loop (:func:`sampled_loop`), the forced native
-    driver, dense output at the normalised ``times`` (all of them if None:
-    :func:`~prefriction.simulation.dense.dense_loop`) or :meth:`Run.advance`. Returns the samples
-    (empty without dense output or a sampled controller) and a sampled controller's applied
-    forces [N]."""
-    if run.fb is not None and run.fb.sampled:
-        return sampled_loop(run, xc0, t_end, n_target)
-    if run.native_forced is not None:
-        samples = SampleBuffer(0, len(times) if times is not None else 1024) if want_dense else []
-        run_forced(run, t_end, n_target, times, samples if want_dense else None)
-        return samples, []
-    if want_dense:
-        return dense_loop(run, times, t_end, n_target), []
-    run.advance(t_end, n_target)
-    return [], []
-
-
-def sampled_loop(run: Run, xc0: np.ndarray, t_end: float, n_target: float) -> tuple[SampleBuffer, list]:
-    """Closed loop with a sampled controller: hold its output over each period ``Ts`` up to the
-    normalised time ``t_end`` or ``n_target`` reversals; returns the samples at ``k Ts`` and the
-    total applied force there [N]."""
-    system, feedback, sc = run.system, run.fb, run.sc
-    samples = SampleBuffer(len(xc0))
-    u_hist: list = []
-    Ts = feedback.Ts / sc.t
-    xc = xc0.copy()
-    k = 0
-    while True:
-        tk = min(k * Ts, t_end)
-        t_si = tk * sc.t
-        e = float(feedback.reference(t_si)) - run.st["x"] * sc.x
-        uk = float(feedback.C[0] @ xc + feedback.D[0, 0] * e)
-        run.st["uhold"] = uk
-        run.st["xc"] = xc.copy()
-        samples.append(run.sample())
-        u_hist.append(uk + (float(system.u(t_si)) if system.forced else 0.0))
-        if tk >= t_end * (1 - 1e-12):
-            break
-        xc = feedback.A @ xc + feedback.B[:, 0] * e
-        if run.advance(min((k + 1) * Ts, t_end), n_target):
-            break
-        k += 1
-    return samples, u_hist
-
-
-def check_ramps(run: Run, t_end: float, rtol: float) -> None:
-    """ValueError if a piece of a piecewise-linear input force is so steep that the round-off of
-    its time makes a force error above :data:`RAMP_ROUNDOFF` of the run's error level.
-
-    The plant evaluates a piece as ``a + b (t - t_k)`` from the normalised time ``t``, which
-    carries a round-off of about ``2^-53 t``; a slope ``b`` turns it into a force error
-    ``2^-53 |b| t``. Near a rest the net force is compared with the error level ``eps`` times the
-    force scale (:data:`prefriction.simulation.plant.EPS_REST`): a larger error started the mass
-    backwards (a spurious reversal pair), or made CasADi's event transition return NaN.
-    """
-    sig, sc = run.spec.u_sig, run.sc
-    if sig is None or sig.key != ("PiecewiseLinear",):
-        return
-    level = run.eps * max(run.force_scale, 1e-300)  # error level of the net force (normalised)
-    t = np.concatenate(([0.0], run.breaks[run.breaks < t_end], [t_end]))
-    _, slopes = linear_pieces(sig, t[:-1] * sc.t, t[1:] * sc.t)  # vectorised: one pass over the pieces
-    slopes = np.abs(slopes) * (sc.t / sc.F)  # normalised
-    errs = slopes * t[1:] * 2.0 ** -53
-    for k in np.flatnonzero(errs > RAMP_ROUNDOFF * level)[:1]:
-        ta, tb, slope, err = float(t[k]), float(t[k + 1]), float(slopes[k]), float(errs[k])
-        if err > RAMP_ROUNDOFF * level:
-            rise = abs(slope) * (tb - ta) * sc.F
-            shortest = rise / sc.F * tb * 2.0 ** -53 / (RAMP_ROUNDOFF * level) * sc.t
-            raise ValueError(
-                f"system.u ramps by {rise:.3g} N over {(tb - ta) * sc.t:.3g} s (from t = {ta * sc.t:.12g} s): at rtol = "
-                f"{rtol:g} that is too steep to simulate, because the round-off of the time there (2^-53 t) makes a "
-                f"force error of {err * sc.F:.3g} N, more than RAMP_ROUNDOFF = {RAMP_ROUNDOFF:g} times the error "
-                f"level of the net force ({level * sc.F:.3g} N) at which a resting mass starts to move. Spread the "
-                f"ramp over at least {shortest:.3g} s, loosen rtol, or drop one of its two samples (a jump)"
-            )

@@ -25,8 +25,8 @@ as for any one-step method.
 
 This module validates the arguments and assembles the result: the plant (its layout and
 driver) is built in :mod:`prefriction.simulation.build`, run by
-:func:`~prefriction.simulation.run.drive` in :mod:`prefriction.simulation.run`, the reversal table
-:mod:`prefriction.simulation.lazy_table`, the compiled integrator and its buffers
+:func:`~prefriction.simulation.drive.drive` in :mod:`prefriction.simulation.drive`, the
+reversal table :mod:`prefriction.simulation.lazy_table`, the compiled integrator and its buffers
 :mod:`prefriction.simulation.integrator`, the force scale of forced runs
 :mod:`prefriction.simulation.force_scale`.
 """
@@ -41,9 +41,10 @@ import numpy as np
 
 from prefriction.signals import Constant, compiled_form
 from prefriction.simulation.feedback import LinearFeedback
-from prefriction.simulation.dense import N_DENSE, samples_si
+from prefriction.simulation.drive import RAMP_ROUNDOFF, drive
+from prefriction.simulation.samples import N_DENSE, samples_si
 from prefriction.simulation.rest import initial_direction
-from prefriction.simulation.run import RAMP_ROUNDOFF, Run, check_ramps, drive
+from prefriction.simulation.run import Run
 from prefriction.simulation.plant import PlantSpec
 from prefriction.simulation.force_scale import MAX_AMPLITUDE, MIN_AMPLITUDE, applied_force_scale, check_amplitude
 from prefriction.simulation.budget import check_input_budget
@@ -236,10 +237,10 @@ def simulate(
     xc0 = np.array(feedback.xc0, dtype=float) if feedback is not None else np.zeros(0)
     run.st, s0 = _initial_state(run, x0, v0, F0, xc0, stops=forced or t_end is not None)
     run.breaks = breaks
-    check_ramps(run, t_end_n, rtol)
 
     start = time.perf_counter()
-    samples, u_hist = drive(run, t_end_n, n_target, None if times_si is None else times_si / sc.t, want_dense, xc0)
+    samples, u_hist = drive(run, t_end_n, n_target, None if times_si is None else times_si / sc.t, want_dense, xc0,
+                            rtol)
     if reversals is None and len(run.rev) >= n_target:
         raise ValueError(
             f"t_end = {t_end_si:.6g} s needs more than {MAX_REVERSALS:_} reversals (the reversal table is held in "

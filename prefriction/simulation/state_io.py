@@ -9,44 +9,22 @@ arguments of one call).
 from __future__ import annotations
 
 import math
-from typing import Optional
 
 import numpy as np
 
-from prefriction.models import Oscillator
-from prefriction.models.base import FrictionModel
-from prefriction.simulation.feedback import LinearFeedback
 from prefriction.simulation.integrator import BufferedIntegrator
-from prefriction.simulation.plant import Layout, PlantSpec
-from prefriction.units import Scales
+from prefriction.simulation.plant import Layout
+from prefriction.simulation.run_state import RunState
 
 __all__ = ["StateIO"]
 
 
-class StateIO:
+class StateIO(RunState):
     """Packing and unpacking of the plant's parameter, state and control vectors of a run.
 
-    A mixin of :class:`~prefriction.simulation.run.Run`, which sets the attributes below; the
-    state ``st`` holds the normalised ``t, x, v, F, z, m, s, rest, W, Ef, xc`` (and ``ne``,
-    ``Eb``, ``uhold`` where used).
+    A part of :class:`~prefriction.simulation.run.Run`; the state it converts is that of
+    :class:`~prefriction.simulation.run_state.RunState`.
     """
-
-    system: Oscillator
-    spec: PlantSpec
-    fb: Optional[LinearFeedback]
-    sc: Scales
-    model: FrictionModel
-    q: np.ndarray
-    eps: float
-    L: Layout
-    hold_in_piece: bool
-    rev: list
-    st: dict
-    snap: float
-    force_scale: float
-    A_max: float
-    S: np.ndarray
-    P0: np.ndarray
 
     def _scales(self) -> dict:
         """Amplitude scales of the next call (normalised units): the state and, if forced, the

@@ -24,6 +24,7 @@ from prefriction.simulation.plant import EPS_DIED, event_count
 
 if TYPE_CHECKING:
     from prefriction.models.base import FrictionModel
+    from prefriction.simulation.run_state import RunState
 
 __all__ = ["StiffFunctions", "advance_stiff", "stiff_functions"]
 
@@ -81,9 +82,8 @@ def _event(fun: Callable[[float, np.ndarray], float]) -> Callable[[float, np.nda
     return fun
 
 
-def advance_stiff(run: Any, t_target: float, n_target: float) -> bool:
-    """Continue ``run`` (the :class:`~prefriction.simulation.run.Run`, which imports this module
-    through the native driver's; state ``run.st``, normalised) with Radau to the normalised time
+def advance_stiff(run: "RunState", t_target: float, n_target: float) -> bool:
+    """Continue ``run`` (the state of a :class:`~prefriction.simulation.run.Run`: ``run.st``, normalised) with Radau to the normalised time
     ``t_target`` or ``n_target`` reversals (True if the latter), appending reversals and their
     half-cycles' event counts as the native driver does."""
     model, st = run.model, run.st

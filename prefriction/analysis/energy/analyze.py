@@ -9,13 +9,16 @@ import numpy as np
 
 from prefriction.analysis.energy.balance import bound_check, branch_energy, dissipation, series
 from prefriction.analysis.energy.checks import ROUNDING, check_flag, check_method, check_samples, check_system
+from prefriction.analysis.energy.lugre import lugre_bound
 from prefriction.analysis.energy.lugre_report import LuGreEnergyReport, analyze_lugre_samples
 from prefriction.analysis.energy.report import EnergyReport, _rel_residual
 from prefriction.analysis.energy.sampled_energy import kinetic_energy
 from prefriction.analysis.energy.sampled_reversals import SampledReversals, find_reversals
+from prefriction.analysis.energy.stored_energy import initial_stored_energy, reversal_forces, stored_energy
 from prefriction.analysis.energy.work import input_work, split_integrals
-from prefriction.models import ElastoPlastic, LuGre, Oscillator
+from prefriction.models import LuGre, Oscillator
 from prefriction.simulation.result import SimulationResult
+from prefriction.units import Scales
 
 Report = Union[EnergyReport, LuGreEnergyReport]
 
@@ -61,7 +64,11 @@ def analyze_samples(
     A :class:`prefriction.LuGre` model gives a :class:`LuGreEnergyReport`: the stored bristle
     energy at the reversals and the viscous and hysteretic dissipation per half-cycle, apart
     (docs/mathematics.md#lugre-energy); ``F[0]`` must then be the friction force at ``t[0]``
-    with the initial velocity.
+    with the initial velocity. A :class:`prefriction.ElastoPlastic` model gives an
+    :class:`EnergyReport` with the stored bristle energy at the reversals from the model's
+    branch energy (:mod:`prefriction.analysis.energy.stored_energy`), the forces there
+    extrapolated in time along the incoming branch; ``F[0]`` is its force at ``t[0]`` with the
+    initial velocity.
 
     Detects the reversals (:func:`find_reversals`), evaluates the potential energy at each
     (:func:`branch_energy`, (3.9) for ``gamma = 1``), the dissipation per half-cycle (2.10)
@@ -79,7 +86,7 @@ def analyze_samples(
     v : array_like
         Velocities [m/s], length N.
     F : array_like
-        Friction forces [N], length N, ``|F| <= Fc``.
+        Friction forces [N], length N, ``|F| <= Fc`` (rate-independent models).
     system : Oscillator
         The oscillator that produced the samples (mass, friction model, input ``u``).
     u : array_like, optional
@@ -104,15 +111,10 @@ def analyze_samples(
         Invalid arrays (see :func:`find_reversals`; ``u`` is checked like them), no reversal in
         the samples, ``|F| > Fc``, or ``zoh`` without ``u``.
     TypeError
-        ``system`` is not an Oscillator, its model is rate-dependent other than LuGre (a GMS
-        with ``Fs > Fc`` or damping), or ``zoh`` is not a bool.
+        ``system`` is not an Oscillator, its model is rate-dependent other than LuGre and
+        ElastoPlastic (a GMS with ``Fs > Fc`` or damping), or ``zoh`` is not a bool.
     """
     friction, mass = check_system(system, lugre=True)
-    if isinstance(friction, ElastoPlastic):
-        raise TypeError("the sampled energy analysis of an ElastoPlastic model needs its bristle deflection, which "
-                        "the samples do not give in closed form (alpha depends on it): analyse its reversal table "
-                        "with prefriction.energy.analyze_table(result.reversals, system=system) (the stored energy "
-                        "F_i^2 / (2 sigma0) at each reversal, exact)")
     method = check_method(method)
     zoh = check_flag("zoh", zoh)
     if u is None:
@@ -121,7 +123,7 @@ def analyze_samples(
         t, x, v, F = check_samples(t=t, x=x, v=v, F=F)
     else:
         t, x, v, F, u = check_samples(t=t, x=x, v=v, F=F, u=u)
-    if not isinstance(friction, LuGre):
+    if friction.rate_independent:
         over = np.abs(F) > friction.Fc * (1.0 + ROUNDING)
         if np.any(over):
             i = int(np.flatnonzero(over)[0])
@@ -140,15 +142,23 @@ def analyze_samples(
     W = input_work(t, x, v, rev, method, u=cont, held=held)
     if isinstance(friction, LuGre):
         return analyze_lugre_samples(t, v, F, rev, W, system=system, method=method)
-    # the samples obey |F| <= Fc; extrapolation to a reversal may overshoot near saturation
-    E_p = branch_energy(np.clip(rev.F, -friction.Fc, friction.Fc), rev.direction, friction=friction)
-    E_0 = float(kinetic_energy(v[0], mass=mass) + branch_energy(F[0], rev.initial_direction, friction=friction))
-    if cont is None and held is None:
+    if friction.rate_independent:
+        # the samples obey |F| <= Fc; extrapolation to a reversal may overshoot near saturation
+        E_p = branch_energy(np.clip(rev.F, -friction.Fc, friction.Fc), rev.direction, friction=friction)
+        E_0 = float(kinetic_energy(v[0], mass=mass) + branch_energy(F[0], rev.initial_direction, friction=friction))
+        bound = bound_check(E_p, friction=friction, E_0=E_0)
+    else:  # a bristle that unloads elastically at a reversal (ElastoPlastic): its branch energy there
+        F_max = friction.max_hysteretic_force
+        E_p = stored_energy(np.clip(reversal_forces(t, F, rev), -F_max, F_max), rev.direction, friction=friction)
+        E_0 = float(kinetic_energy(v[0], mass=mass)) + initial_stored_energy(
+            float(F[0]), float(v[0]), rev.initial_direction, friction=friction, scales=Scales.of(system))
+        bound = lugre_bound(E_p, friction, E_0)
+    if cont is None and held is None and friction.rate_independent:
         check = _peak_kinetic(t, kinetic_energy(v, mass=mass), rev)
         label = "peak kinetic energy per half-cycle"
         dev = _rel_residual(check - E_p[: check.size], float(np.max(E_p))) if check.size else None
     else:
-        check, label, dev = None, "peak kinetic energy (unforced only)", None
+        check, label, dev = None, "peak kinetic energy (unforced rate-independent models only)", None
     E_d = np.concatenate(([E_0 + float(W[0]) - float(E_p[0])], dissipation(E_p, input_work=W[1:])))
     S, R = series(E_p, E_d[1:])
     # (2.10) against the friction force's own work int F dx = int F v dt per half-cycle ((2.5), (2.7))
@@ -160,7 +170,7 @@ def analyze_samples(
         W_u=W, E_0=E_0, series_partial=S, series_remainder=R,
         residual_2_10=_rel_residual(E_d - E_d_F, float(np.max(E_p))),
         E_p_check=check, E_p_check_label=label, E_p_check_max_rel_dev=dev,
-        bound=bound_check(E_p, friction=friction, E_0=E_0),
+        bound=bound,
     )
 
 

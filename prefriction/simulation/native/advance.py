@@ -9,12 +9,15 @@ four arrays and join the run's :class:`~prefriction.simulation.reversal_log.Reve
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from prefriction.simulation.native.library import HEAD
 from prefriction.simulation.stiff import advance_stiff
+
+if TYPE_CHECKING:
+    from prefriction.simulation.run_state import RunState
 
 __all__ = ["BLOCK", "advance_native"]
 
@@ -31,9 +34,8 @@ _WHY = {
 }
 
 
-def advance_native(run: Any, t_target: float, n_target: float) -> bool:
-    """:meth:`Run.advance` (``run``: the :class:`~prefriction.simulation.run.Run`, which imports this
-    module) on the native driver: integrate to normalised time ``t_target`` or
+def advance_native(run: "RunState", t_target: float, n_target: float) -> bool:
+    """:meth:`~prefriction.simulation.run.Run.advance` (``run``: its state) on the native driver: integrate to normalised time ``t_target`` or
     ``n_target`` reversals (True if the latter), appending the reversals to ``run.rev`` and their
     half-cycles' model events to ``run.rev_events``; ``SolverError`` if the driver stops early."""
     drv, st, model = run.native, run.st, run.model

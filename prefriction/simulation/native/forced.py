@@ -27,19 +27,18 @@ import casadi as ca
 import numpy as np
 
 from prefriction.models.base import FrictionModel
-from prefriction.models.sizes import check_sizes
+from prefriction.signals.compiled import linear_pieces
 from prefriction.simulation.compiled import CompileInfo, jit_available, library
 from prefriction.simulation.native.advance import BLOCK
 from prefriction.simulation import library_store as store
 from prefriction.simulation.native.library import _DRIVER
 from prefriction.simulation.native.model_code import model_source
+from prefriction.simulation.samples import DENSE_STEP, SampleBuffer
 
 if TYPE_CHECKING:
-    from prefriction.simulation.dense import SampleBuffer
-    from prefriction.simulation.run import Run
+    from prefriction.simulation.run_state import RunState
 
-__all__ = ["FORCED_SOURCE", "ForcedDriver", "SAMPLE_BLOCK", "forced_driver", "input_function", "linear_pieces",
-           "run_forced"]
+__all__ = ["FORCED_SOURCE", "ForcedDriver", "SAMPLE_BLOCK", "forced_driver", "input_function", "run_forced"]
 
 FHEAD = 14  # run-state entries before z and m (forced.c: st[])
 SAMPLE_BLOCK = 1 << 14  # requested times per C call (4 x 128 kB of output)
@@ -93,7 +92,6 @@ def forced_driver(model: FrictionModel, u_sig: Any) -> tuple[Optional[ForcedDriv
         if key in _CACHE:
             return _CACHE[key], 0.0
         start = time.perf_counter()
-        check_sizes(model)
         extra = () if u_sig is None else (input_function(u_sig),)
         head = f"#define PF_FORCED {int(u_sig is not None)}\n#define PF_NPC {0 if u_sig is None else u_sig.n_piece}\n"
         source = head + model_source(model, extra) + _DRIVER + FORCED_SOURCE
@@ -106,17 +104,7 @@ def forced_driver(model: FrictionModel, u_sig: Any) -> tuple[Optional[ForcedDriv
         return driver, time.perf_counter() - start
 
 
-def linear_pieces(sig: Any, ta: np.ndarray, tb: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Value at ``ta`` and slope of a piecewise-linear signal (the simulator's compiled form,
-    ``key == ("PiecewiseLinear",)``) on each interval ``[ta, tb]`` [s] (no break inside), in one
-    vectorised pass: the line through the quarter points (exact for a linear piece)."""
-    q1, q3 = ta + 0.25 * (tb - ta), ta + 0.75 * (tb - ta)
-    u1, u3 = np.asarray(sig.base(q1), dtype=float), np.asarray(sig.base(q3), dtype=float)
-    slope = (u3 - u1) / (q3 - q1)
-    return u1 - slope * (q1 - ta), slope
-
-
-def _pieces(run: "Run", drv: ForcedDriver, t_end: float) -> tuple[np.ndarray, np.ndarray]:
+def _pieces(run: "RunState", drv: ForcedDriver, t_end: float) -> tuple[np.ndarray, np.ndarray]:
     """The break times (normalised, below ``t_end``) and the per-interval numbers, one row per
     interval ``[b_{k-1}, b_k]`` (``b_{-1} = 0``, the last row to ``t_end``)."""
     sig, sc = run.spec.u_sig, run.sc
@@ -134,13 +122,11 @@ def _pieces(run: "Run", drv: ForcedDriver, t_end: float) -> tuple[np.ndarray, np
     return np.ascontiguousarray(brk, dtype=float), np.ascontiguousarray(table.ravel())
 
 
-def run_forced(run: "Run", t_end: float, n_target: float, times: Optional[np.ndarray],
-               buf: Optional["SampleBuffer"]) -> None:
+def run_forced(run: "RunState", t_end: float, n_target: float, times: Optional[np.ndarray],
+               buf: Optional[SampleBuffer]) -> None:
     """The whole run of ``run`` on its forced driver up to the normalised ``t_end`` or
     ``n_target`` reversals, samples at the normalised ``times`` into ``buf`` (``times`` None
-    and ``buf`` given: every :data:`~prefriction.simulation.dense.DENSE_STEP`)."""
-    from prefriction.simulation.dense import DENSE_STEP
-
+    and ``buf`` given: every :data:`~prefriction.simulation.samples.DENSE_STEP`)."""
     drv, st, model, sc = run.native_forced, run.st, run.model, run.sc
     state = np.empty(drv.width)
     state[:FHEAD] = (st["t"], st["x"], st["v"], st["s"], st.get("ne", 0), st["rest"], st["W"], st["Ef"],

@@ -19,7 +19,6 @@ from typing import Hashable, Optional
 import numpy as np
 
 from prefriction.models.base import FrictionModel
-from prefriction.models.sizes import check_sizes
 from prefriction.simulation import library_store as store
 from prefriction.simulation.compiled import CompileInfo, jit_available, library
 from prefriction.simulation.native.model_code import model_source
@@ -60,7 +59,6 @@ def native_driver(model: FrictionModel) -> tuple[Optional[NativeDriver], float]:
         if key in _CACHE:
             return _CACHE[key], 0.0
         start = time.perf_counter()
-        check_sizes(model)
         handle, info = library(f"native_{type(model).__name__.lower()}", model_source(model) + _DRIVER,
                                "unforced runs in C",
                                functools.partial(store.load_verified, symbols=("pf_run",)),
