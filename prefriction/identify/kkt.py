@@ -16,15 +16,20 @@ ed., Springer 2006, (16.4) and 18.1, the KKT system of the Gauss-Newton model)
 
 (the first row gives ``s = r + J d``, the second ``J^T (r + J d) + delta d + A^T lam = 0``, the
 third ``A d = -g``). Unlike the normal equations ``J^T J``, (2) does not square the condition
-number of ``J``. Multiple shooting makes (2) block-banded: a residual row touches the parameters
-and one node, a continuity row the parameters and two neighbouring nodes, so a sparse LU
-(SuperLU through :func:`scipy.sparse.linalg.splu`, COLAMD ordering) factorises it with fill and
-time linear in the number of samples, where an iterative solve (LSMR) of the same steps stalls
-on these ill-conditioned matrices.
+number of ``J``. Multiple shooting makes (2) banded apart from the parameters: a residual row
+touches the parameters and one node, a continuity row the parameters and two neighbouring nodes.
+Ordered segment by segment, the rest is a band of constant width (about 120 for segments of 50
+samples), which LAPACK's banded LU factorises in time and memory linear in the number of samples;
+the parameters follow from their Schur complement. A general sparse LU (SuperLU through
+:func:`scipy.sparse.linalg.splu`) fills in quadratically on the same matrices whatever its
+ordering (COLAMD, or minimum degree on ``K + K^T``: 5.6 s against 0.17 s at 500 segments of 50
+samples with 6 parameters and 3 node entries, 21 s against 0.34 s at 1,000), and an iterative
+solve (LSMR) of the same steps stalls on these ill-conditioned matrices.
 
 :func:`polish` takes such steps from the end point of the augmented Lagrangian: sequential
 quadratic programming with the exact-penalty merit ``0.5 |r|^2 + nu |g|_1`` and a backtracking
-line search (Nocedal and Wright 18.3, (18.28)). The constraints are linearised exactly, so the
+line search (Nocedal and Wright 18.3, (18.28)), with a second-order correction of a rejected
+full step (18.30). The constraints are linearised exactly, so the
 defects fall quadratically; the step in the parameters stops mattering once its length is a small
 fraction of their standard errors, which is how convergence is judged (see :func:`polish`).
 """
