@@ -29,6 +29,7 @@ from prefriction.models import Oscillator
 from prefriction.simulation.loops.compiled_loop import MAX_DELAY
 
 from ._pid import PID
+from .compensators.lugre_observer import LuGreObserver
 
 REGIMES = ("presliding", "sliding")
 
@@ -272,6 +273,7 @@ def design_pid(
     N: float = 10.0,
     u_max: Optional[float] = None,
     t_track: Optional[float] = None,
+    observer: Optional[LuGreObserver] = None,
 ) -> PID:
     """PID gains that place the closed-loop poles at ``wn``, ``zeta`` and a real pole ``-alpha wn``.
 
@@ -294,6 +296,20 @@ def design_pid(
         Real pole at ``-alpha wn`` [-], ``0 < alpha < inf``.
     regime, N, u_max, t_track
         As in :func:`design_pd` and :class:`PID`.
+    observer : controllers.LuGreObserver, optional
+        The LuGre observer the PID will run with: its gain condition
+        (:meth:`controllers.LuGreObserver.gain_condition`) is checked on the designed PID. A
+        designed PID has a derivative filter, with which the condition fails at high frequency,
+        so this raises; the message names the alternatives (``docs/compensation.md#lugre-observer``).
+
+    Raises
+    ------
+    ValueError
+        If ``wn`` is too low for a pre-sliding design (the message names ``regime="sliding"``),
+        or ``observer``'s gain condition fails for the designed PID (the message says what fails
+        and names :class:`controllers.FrictionObserver` and :class:`controllers.Feedforward`).
+    TypeError
+        If ``observer`` is not a :class:`controllers.LuGreObserver`.
     """
     m, k = _plant_numbers(system, regime)
     wn = check_positive("wn", wn)
@@ -314,4 +330,9 @@ def design_pid(
         u_max=u_max, t_track=t_track,
     )
     warn_if_unstable(closed_loop(system, ctrl, regime=regime, warn=False), what=f"PID design ({regime})", stacklevel=2)
+    if observer is not None:
+        if not isinstance(observer, LuGreObserver):
+            raise TypeError(f"observer must be a controllers.LuGreObserver (the one compensator whose stability "
+                            f"depends on the PID), got {type(observer).__name__}")
+        observer.require_gain_condition(ctrl, system.mass)
     return ctrl

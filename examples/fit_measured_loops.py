@@ -115,7 +115,8 @@ def main(argv: list[str] | None = None) -> int:
     print(f"tribometer record: fitted on {FIT[0]:g}-{FIT[1]:g} s (every {step}. sample), validated on "
           f"{HELD_OUT[0]:g}-{HELD_OUT[1]:g} s (initial state from the first {SKIP:g} s, not scored), offset fitted")
     print(table(results))
-    both = identify.fit(pf.Dahl(sigma=4e4, Fc=2.4, gamma=1.5), tribometer().window(*FIT, step=step), offset=True)
+    both = identify.fit(pf.Dahl(sigma=4e4, Fc=2.4, gamma=1.5), tribometer().window(*FIT, step=step), offset=True,
+                        structures="both")
     print(both.notes[-1])
     print(f"figure: {figure(results, args.outdir / 'fit_measured_loops.png')}")
     return 0

@@ -2,15 +2,19 @@
 
 The stage: a 2.5 kg carriage whose friction is a Dahl model (3.2) with rest stiffness
 ``sigma = 2e6 N/m``, Coulomb force ``Fc = 3 N``, ``gamma = 1``, run by a PID at 5 kHz reading a
-10 nm encoder; its drive reports the motor force 0.2 N high. Every step writes a figure into ``OUTDIR``:
+10 nm encoder; its drive applies 0.2 N less than the controller commands (an amplifier offset).
+Every step writes a figure into ``OUTDIR``:
 
-1. ``1_record.png``: a closed-loop record (reference, encoder position, motor force). By default
+1. ``1_record.png``: a closed-loop record (reference, encoder position, commanded force). By default
    synthetic, from an independent scipy integration of the stage (LSODA per sample interval,
    restarted at every velocity reversal; :func:`synthetic_record`); or a user's CSV with the
-   columns ``t, x, u`` [s, m, N] (a header line, comma-separated), a positioning loop's record.
-2. ``2_fit.png``, ``2_validation.png``: a Dahl model, the mass and the offset fitted to the first
-   60 % of the record (:class:`prefriction.identify.Motion`, multiple shooting) and validated on
-   the held-out 40 % (the fitted stage driven by the recorded force).
+   columns ``t, x, u[, r]`` [s, m, N, m] (a header line, comma-separated), a positioning loop's
+   record (with the reference ``r``, set ``RECORD_PID`` to the loop's controller).
+2. ``2_fit.png``, ``2_validation.png``: a Dahl model and the offset fitted to the first 60 % of
+   the record by the closed-loop output error (:func:`prefriction.identify.fit_closed_loop`: the
+   model simulated in the record's loop) and validated on the held-out 40 % (the fitted stage in
+   the same loop: its controller force against the recorded one). A user's CSV without the
+   reference is fitted as force against displacement instead (a slow record).
 3. ``3_compensation.png``: the PID designed on the fitted stage, alone, with the fitted model's
    feedforward and with a friction observer of the fitted model, tracking back-and-forth moves in
    the *true* stage's sampled loop, with the encoder step, measurement noise and the fitted
@@ -21,7 +25,8 @@ The stage: a 2.5 kg carriage whose friction is a Dahl model (3.2) with rest stif
    with gcc and run in closed loop with the exported stage; its positions against the Python loop.
 
 The identification step is one function, :func:`identify_stage`: swap it for another route
-(e.g. a closed-loop or inverse-model fit) and the rest of the chain is unchanged.
+(e.g. the inverse model, :func:`prefriction.identify.fit_inverse`) and the rest of the chain is
+unchanged.
 
 Run: ``python examples/stage_workflow.py OUTDIR [RECORD.csv] [--quick]`` (``--quick``: a
 shorter record and loop, for the tests).
@@ -36,6 +41,7 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
+import control
 import numpy as np
 from scipy.integrate import solve_ivp
 
@@ -48,6 +54,7 @@ MASS, SIGMA, FC, OFFSET = 2.5, 2e6, 3.0, 0.2      # kg, N/m, N, N: the true stag
 TS, QUANTUM, NOISE = 2e-4, 1e-8, 2e-9             # s (5 kHz), m (10 nm encoder), m rms
 WN = 2.0 * math.pi * 200.0                        # rad/s: the PID's closed-loop bandwidth
 U_MAX = 12.0                                      # N: the optimal move's force limit
+RECORD_PID = (7.5e6, 5.0e9, 7.5e3)                # N/m, N/(m s), N s/m: the record's PID, poles near 200 Hz
 
 
 def log(message: str) -> None:
@@ -79,16 +86,16 @@ def record_reference(n: int) -> np.ndarray:
 def synthetic_record(seconds: float, seed: int = 1) -> Record:
     """The stage's closed-loop record from scipy, independent of the simulator.
 
-    ``m x'' = u - F`` with Dahl's ``F' = sigma v (1 - sign(v) F / Fc)``, integrated by
+    ``m x'' = u - OFFSET - F`` with Dahl's ``F' = sigma v (1 - sign(v) F / Fc)``, integrated by
     LSODA (``rtol = 1e-10``) over each sample interval under the held force and restarted at
     every velocity reversal; a digital PID ``u = kp e + ki Ts sum(e) + kd (e_k - e_(k-1)) / Ts``
-    on the encoder position (rounded to 10 nm after 2 nm rms noise). The recorded force is the
-    drive's reading, biased by ``OFFSET`` [N] (a current-sensor offset).
+    on the encoder position (rounded to 10 nm after 2 nm rms noise). The record holds the
+    commanded force ``u``; the drive applies ``u - OFFSET`` (an amplifier offset [N]).
     """
     rng = np.random.default_rng(seed)
     n = int(round(seconds / TS))
     r = record_reference(n)
-    kp, ki, kd = 7.5e6, 5.0e9, 7.5e3  # N/m, N/(m s), N s/m: poles near 200 Hz on the pre-sliding stage
+    kp, ki, kd = RECORD_PID
 
     def rhs(_t: float, y: np.ndarray, u: float) -> list[float]:
         v, F = y[1], y[2]
@@ -110,25 +117,27 @@ def synthetic_record(seconds: float, seed: int = 1) -> Record:
         e_prev = e
         t0, t1 = k * TS, (k + 1) * TS
         for _ in range(100):  # one sample interval, restarted at each reversal
-            direction = np.sign(y[1]) or np.sign(rhs(t0, y, u[k])[1]) or 1.0
+            direction = np.sign(y[1]) or np.sign(rhs(t0, y, u[k] - OFFSET)[1]) or 1.0
             reversal.direction = -direction  # type: ignore[attr-defined]
-            sol = solve_ivp(rhs, (t0, t1), y, method="LSODA", rtol=1e-10, atol=1e-15, args=(u[k],),
+            sol = solve_ivp(rhs, (t0, t1), y, method="LSODA", rtol=1e-10, atol=1e-15, args=(u[k] - OFFSET,),
                             events=reversal)
             y, t0 = sol.y[:, -1].copy(), float(sol.t[-1])
             if sol.status != 1 or t0 >= t1:
                 break
             y[1] = 0.0
-    return Record(np.arange(n) * TS, r, x, u + OFFSET)
+    return Record(np.arange(n) * TS, r, x, u)
 
 
 def read_record(path: Path) -> Record:
-    """A user's record from a CSV file with a header and the columns ``t, x, u`` [s, m, N]."""
+    """A user's record from a CSV file with a header and the columns ``t, x, u[, r]`` [s, m, N, m]
+    (``r``: the reference, when known)."""
     data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
-    if data.shape[1] < 3 or len(data) < 200:
-        raise ValueError(f"{path}: expected the columns t, x, u [s, m, N] and at least 200 rows, got "
+    if data.shape[1] not in (3, 4) or len(data) < 200:
+        raise ValueError(f"{path}: expected the columns t, x, u [s, m, N] (and r [m]) and at least 200 rows, got "
                          f"{data.shape[1]} columns and {len(data)} rows")
     t, x, u = data[:, 0], data[:, 1], data[:, 2]
-    return Record(t - t[0], np.full_like(t, np.nan), x, u)
+    r = data[:, 3] if data.shape[1] == 4 else np.full_like(t, np.nan)
+    return Record(t - t[0], r, x, u)
 
 
 def plot_record(rec: Record, outdir: Path) -> Path:
@@ -144,7 +153,7 @@ def plot_record(rec: Record, outdir: Path) -> Path:
         axes[1].plot(rec.t, (rec.r - rec.x) * 1e9, lw=0.6, color="C3")
         axes[1].set_ylabel("tracking error [nm]")
     axes[-1].plot(rec.t, rec.u, lw=0.6, color="C2")
-    axes[-1].set_ylabel("drive's force u [N]")
+    axes[-1].set_ylabel("commanded force u [N]")
     axes[-1].set_xlabel("time [s]")
     axes[0].set_title("1. closed-loop record (PID at 5 kHz, 10 nm encoder)")
     return save(fig, outdir, "1_record.png")
@@ -161,24 +170,47 @@ class Identified:
     stage: pf.Oscillator
 
 
-def identify_stage(rec: Record, mass: float = MASS) -> Identified:
-    """Fit a Dahl model and a force offset to the first 60 % of a slow closed-loop record, score
-    it on the rest.
+def record_loop(dt: float = TS) -> identify.DigitalLoop:
+    """The record's controller as the closed-loop fit simulates it: the digital PID of
+    :func:`synthetic_record` with the gains ``RECORD_PID`` at the sample time ``dt`` [s],
+    ``C(z) = kp + ki dt z / (z - 1) + kd (z - 1) / (dt z)``. For a record of your own loop, set
+    ``RECORD_PID`` to its gains, or return its law here (any python-control system)."""
+    kp, ki, kd = RECORD_PID
+    z = control.tf([1.0, 0.0], [1.0], dt)
+    return identify.DigitalLoop.from_controller(kp + ki * dt * z / (z - 1.0) + kd * (z - 1.0) / (dt * z), dt)
 
-    At 4 Hz the inertial force is below 1 % of the friction, so the motor force is the friction
-    force plus the offset: a :class:`prefriction.identify.ForceDisplacement` fit (least squares,
-    seconds). The start values are an engineer's guesses (half the stiffness, 2/3 of the Coulomb
-    force); ``structures="given"`` with ``gamma`` fixed at 1 keeps the structure that the
-    friction observer, the optimal move and the exported controller all accept. The mass [kg]
-    is the data sheet's. Another identification route (a closed-loop ``Motion`` fit with the
-    mass free) replaces this one function and nothing else.
+
+def identify_stage(rec: Record, mass: float = MASS) -> Identified:
+    """Fit a Dahl model and a force offset to the first 60 % of a closed-loop record, score it on
+    the rest.
+
+    A record with its reference (the synthetic one, or a CSV with the column ``r``): the closed-loop output error
+    (:func:`prefriction.identify.fit_closed_loop`): the model simulated inside the record's loop
+    (:func:`record_loop`) fitted to the measured positions and forces, the route for a record
+    taken under feedback (an open-loop :class:`prefriction.identify.Motion` replay of a stiff
+    loop's force drifts away from the positions). The held-out 40 %: the fitted stage in the
+    same loop, run over the whole reference, its controller force against the recorded one.
+    A CSV without the reference: a slow record's force is the friction plus the offset
+    (:class:`prefriction.identify.ForceDisplacement`), scored on held-out data.
+
+    The start values are an engineer's guesses (half the stiffness, 2/3 of the Coulomb force);
+    ``gamma`` is held at 1, the structure the friction observer, the optimal move and the
+    exported controller all take. The mass [kg] is the data sheet's. Another identification
+    route replaces this one function and nothing else.
     """
     split = int(0.6 * len(rec.t))
-    part = identify.ForceDisplacement(rec.t[:split], rec.x[:split], rec.u[:split])
-    held_out = identify.ForceDisplacement(rec.t[split:], rec.x[split:], rec.u[split:])
     start = pf.Dahl(sigma=1e6, Fc=2.0, gamma=1.0)
-    fit = identify.fit(start, part, fixed=["gamma"], offset=True, structures="given")
-    return Identified(fit, fit.validate(held_out), pf.Oscillator(fit.model, mass=mass))
+    if not np.all(np.isfinite(rec.r)):
+        part = identify.ForceDisplacement(rec.t[:split], rec.x[:split], rec.u[:split])
+        held_out = identify.ForceDisplacement(rec.t[split:], rec.x[split:], rec.u[split:])
+        fit = identify.fit(start, part, fixed=["gamma"], offset=True)
+        return Identified(fit, fit.validate(held_out), pf.Oscillator(fit.model, mass=mass))
+    loop = record_loop(float(rec.t[1] - rec.t[0]))
+    part = identify.Motion(rec.t[:split], rec.x[:split], rec.u[:split], mass=mass)
+    fit = identify.fit_closed_loop(start, part, loop, rec.r[:split], fixed=["gamma"])
+    _, force = identify.simulate_closed_loop(fit.model, loop, rec.t, rec.r, mass=mass, offset=fit.estimate("offset"))
+    validation = identify.Validation(rec.t[split:], rec.u[split:], force[split:], "N", "Dahl")
+    return Identified(fit, validation, pf.Oscillator(fit.model, mass=mass))
 
 
 # --- 3. compensation ------------------------------------------------------------------------------
@@ -217,7 +249,7 @@ def main(outdir: "str | Path", record_csv: "str | None" = None, quick: bool = Fa
     # 2. fit on the first 60 %, validate on the rest
     ident = identify_stage(rec)
     fit, val, stage = ident.fit, ident.validation, ident.stage
-    out["figures"] += [fit.plot(outdir / "2_fit.png"), val.plot(outdir / "2_validation.png")]
+    out["figures"] += [fit.plot(outdir / "2_fit.png"), plot_validation(val, outdir)]
     out["fit"], out["validation"] = fit, val
     log(f"2. fit: sigma {fit.model.sigma:.4g} N/m, Fc {fit.model.Fc:.4g} N, offset {fit.estimate('offset'):.3g} N; "
         f"held out: rms {val.rms:.3g} N, fit {val.fit_percent:.3g} % ({time.perf_counter() - clock:.1f} s)")
@@ -258,7 +290,23 @@ def main(outdir: "str | Path", record_csv: "str | None" = None, quick: bool = Fa
     return out
 
 
-# --- figures of steps 3 to 5 ------------------------------------------------------------------------
+# --- figures of steps 2 to 5 ------------------------------------------------------------------------
+
+def plot_validation(val: identify.Validation, outdir: Path) -> Path:
+    """The held-out force: recorded against the fitted stage's (in the loop, or the friction of a
+    force-displacement fit plus the offset)."""
+    fig, axes = new_figure(2, 1, size=(8.0, 5.5), sharex=True)
+    ax1, ax2 = axes[:, 0]
+    ax1.plot(val.t, val.measured, color="0.55", lw=0.8, label="recorded")
+    ax1.plot(val.t, val.predicted, color="C0", lw=1.2, label="fitted stage")
+    ax1.set_ylabel("force u [N]")
+    ax1.legend(loc="upper center", bbox_to_anchor=(0.5, -0.02), ncol=2, fontsize=8, frameon=False)
+    ax2.plot(val.t, val.measured - val.predicted, color="C3", lw=0.6)
+    ax2.set_ylabel("recorded - fitted [N]")
+    ax2.set_xlabel("time [s]")
+    ax1.set_title(f"2. held-out 40 %: rms {val.rms:.3g} N, fit {val.fit_percent:.1f} %")
+    return save(fig, outdir, "2_validation.png")
+
 
 def plot_compensation(loops: dict, outdir: Path) -> Path:
     fig, axes = new_figure(2, 1, size=(8.0, 5.5))

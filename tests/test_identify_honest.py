@@ -64,13 +64,14 @@ def test_denoised_path_keeps_the_reversals_and_halves_the_error():
 def test_declared_encoder_noise_removes_the_bias():
     t, _, xm, F = encoder_record()
     with pytest.warns(NoisyPositionsWarning, match="x_noise"):
-        raw = identify.fit(pf.Dahl(sigma=1e6, Fc=2.0, gamma=1.5), ForceDisplacement(t, xm, F), offset=True)
+        raw = identify.fit(pf.Dahl(sigma=1e6, Fc=2.0, gamma=1.5), ForceDisplacement(t, xm, F), offset=True,
+                           structures="both")
     assert abs(raw.estimate("sigma") / 2e6 - 1.0) > 0.03       # the reproducer's bias
     data = ForceDisplacement(t, xm, F, x_noise=3e-9, quantum=1e-8)
     with warnings.catch_warnings():
         warnings.simplefilter("error", ResidualWarning)
         warnings.simplefilter("error", NoisyPositionsWarning)
-        res = identify.fit(pf.Dahl(sigma=1e6, Fc=2.0, gamma=1.5), data, offset=True)
+        res = identify.fit(pf.Dahl(sigma=1e6, Fc=2.0, gamma=1.5), data, offset=True, structures="both")
     assert res.model.gamma == pytest.approx(1.0, abs=0.01)
     for name, truth in (("sigma", 2e6), ("Fc", 3.0), ("offset", 0.2)):
         lo, hi = res.interval(name)

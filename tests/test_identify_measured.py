@@ -37,7 +37,7 @@ def record():
 def dahl_fit(record):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", BoundWarning)
-        return identify.fit(pf.Dahl(sigma=4e4, Fc=2.4, gamma=1.5), record[0], offset=True)
+        return identify.fit(pf.Dahl(sigma=4e4, Fc=2.4, gamma=1.5), record[0], offset=True, structures="both")
 
 
 def test_real_record_dahl_with_offset_holds_on_held_out_cycles(dahl_fit, record):

@@ -1,7 +1,8 @@
 """examples/stage_workflow.py end to end (--quick): every step's numbers against the true stage.
 
-The record comes from the script's scipy generator (independent of the simulator); the fit is
-held to the true parameters, the compensated loop to the PID alone, the exported C loop to the
+The record comes from the script's scipy generator (independent of the simulator); the fit (the
+closed-loop output error; a CSV without the reference: force against displacement) is held to
+the true parameters, the compensated loop to the PID alone, the exported C loop to the
 Python loop, the optimal move to its target."""
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ def test_every_step_of_the_chain(tmp_path):
     w = _script()
     out = w.main(tmp_path, quick=True)
     fit, val = out["fit"], out["validation"]
+    assert "closed-loop output error" in fit.summary()           # the route for a record under feedback
     assert fit.model.sigma == pytest.approx(w.SIGMA, rel=0.05)
     assert fit.model.Fc == pytest.approx(w.FC, rel=0.03)
     assert fit.estimate("offset") == pytest.approx(w.OFFSET, abs=0.03)
@@ -48,8 +50,12 @@ def test_a_users_csv_record_is_read_and_fitted(tmp_path):
     np.savetxt(path, np.column_stack([rec.t + 10.0, rec.x, rec.u]), delimiter=",", header="t,x,u", comments="")
     back = w.read_record(path)
     assert back.t[0] == 0.0 and np.array_equal(back.x, rec.x) and np.all(np.isnan(back.r))
-    ident = w.identify_stage(back)
-    assert ident.fit.model.Fc == pytest.approx(w.FC, rel=0.05)
+    ident = w.identify_stage(back)                                  # no reference: force against displacement
+    assert ident.fit.model.Fc == pytest.approx(w.FC, rel=0.05) and "closed-loop" not in ident.fit.summary()
+    np.savetxt(path, np.column_stack([rec.t, rec.x, rec.u, rec.r]), delimiter=",", header="t,x,u,r", comments="")
+    ident = w.identify_stage(w.read_record(path))                   # with it: inside the record's loop
+    assert "closed-loop output error" in ident.fit.summary()
+    assert ident.fit.model.Fc == pytest.approx(w.FC, rel=0.03)
     np.savetxt(path, np.column_stack([rec.t[:10], rec.x[:10]]), delimiter=",", header="t,x", comments="")
     with pytest.raises(ValueError, match="columns t, x, u"):
         w.read_record(path)

@@ -146,5 +146,48 @@ class LuGreObserver(Compensator):
         low = float(np.min(H.real))
         return bool(self.gain > 0.0 and stable and low > 0.0 and degree_one), low
 
+    def require_gain_condition(self, controller: "control.LTI | object", mass: float) -> None:
+        """Raise ``ValueError`` saying why, if :meth:`gain_condition` does not hold for ``controller``.
+
+        The message names what fails (for a :class:`controllers.PID`: ``sigma1 kd >= m sigma0``,
+        ``sigma0 kp >= sigma1 ki``, and the derivative filter, with which ``Re H(jw) < 0`` at high
+        frequency for any ``tau > 0``) and the alternatives: :class:`controllers.FrictionObserver`,
+        whose error dynamics do not involve the controller, or :class:`controllers.Feedforward`.
+
+        Parameters
+        ----------
+        controller : controllers.PID or control.TransferFunction
+            The continuous controller ``C(s)``.
+        mass : float
+            Moving mass [kg].
+
+        Raises
+        ------
+        ValueError
+            If the condition does not hold.
+        """
+        ok, low = self.gain_condition(controller, mass)
+        if ok:
+            return
+        m = self.model
+        why = [f"H(s) = (sigma1 s + sigma0) / (m s^2 + C(s)) is not strictly positive real (min Re H(jw) = "
+               f"{low:.3g} m/N)"]
+        kd, kp, ki, tau = (getattr(controller, n, None) for n in ("kd", "kp", "ki", "tau"))
+        if kd is not None:
+            if m.sigma1 * kd < mass * m.sigma0:
+                why.append(f"kd = {kd:.4g} N s/m < m sigma0 / sigma1 = "
+                           f"{mass * m.sigma0 / m.sigma1 if m.sigma1 > 0 else math.inf:.4g} N s/m")
+            if m.sigma0 * kp < m.sigma1 * ki:
+                why.append(f"sigma0 kp = {m.sigma0 * kp:.4g} < sigma1 ki = {m.sigma1 * ki:.4g}")
+            if kd > 0.0 and tau is not None:
+                why.append(f"the derivative filter tau = {tau:.3g} s makes Re H(jw) < 0 at high frequency (as any "
+                           f"filter does)")
+        raise ValueError(f"the LuGre observer's gain condition (Canudas de Wit et al. 1995, section V) fails for "
+                         f"this controller with mass = {mass:g} kg: {'; '.join(why)}. Its stability proof does not "
+                         f"cover this loop (simulate_loop still runs it; the condition is sufficient, not necessary). "
+                         f"Alternatives: controllers.FrictionObserver(model, pole), whose error dynamics "
+                         f"e' = M(t) e do not involve the controller, or controllers.Feedforward(model) "
+                         f"(docs/compensation.md#lugre-observer)")
+
     def __str__(self) -> str:
         return f"LuGreObserver(k={self.gain:.4g})"

@@ -52,15 +52,33 @@ class Stepper:
         start = time.perf_counter()
         self.exact = has_exact_step(model)
         self.substeps = None if self.exact else substeps
-        step = counted_interval_function(model, substeps)
+        self.step = counted_interval_function(model, substeps)
         tag = repr((type(model).__qualname__, model.structure_key(), self.substeps)).encode()
-        name = "along_" + hashlib.sha256(tag).hexdigest()[:12]
-        block = step.mapaccum(name, BLOCK)
-        self.block, self.info = compiled(block, f"friction_along, {type(model).__name__}")
-        self.step = step
+        self._name = "along_" + hashlib.sha256(tag).hexdigest()[:12]
+        self._what = f"friction_along, {type(model).__name__}"
+        self._block: tuple[ca.Function, CompileInfo] | None = None
         self._single: ca.Function | None = None
         self.n_x = model.n_states + model.n_flags
         self.setup_time = time.perf_counter() - start
+
+    def _compiled_block(self) -> tuple[ca.Function, CompileInfo]:
+        """The block Function, built and compiled on first use (the C pass of
+        :mod:`prefriction.along.native` does not need it)."""
+        if self._block is None:
+            start = time.perf_counter()
+            self._block = compiled(self.step.mapaccum(self._name, BLOCK), self._what)
+            self.setup_time += time.perf_counter() - start
+        return self._block
+
+    @property
+    def block(self) -> ca.Function:
+        """The step repeated over :data:`BLOCK` samples (``mapaccum``), compiled."""
+        return self._compiled_block()[0]
+
+    @property
+    def info(self) -> CompileInfo:
+        """How the block Function was obtained (compiled, cached, interpreted)."""
+        return self._compiled_block()[1]
 
     def buffered(self) -> "BufferedStep":
         """The single step, compiled on first use, behind CasADi's buffer interface (for a loop)."""

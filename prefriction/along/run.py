@@ -11,7 +11,7 @@ from prefriction._validation import check_count, check_finite
 from prefriction.along.engine import Units, stepper
 from prefriction._memory import check_memory
 from prefriction.along.motion import Motion
-from prefriction.along.native import along_driver, run_native
+from prefriction.along.native import along_driver, fast_samples, first_direction, run_native
 from prefriction.along.result import AlongResult
 from prefriction.models.base import FrictionModel
 
@@ -95,30 +95,37 @@ def friction_along(model: FrictionModel, t: Any, x: Any, *, F0: float = 0.0, v: 
     0.999955
     """
     model = check_model(model)
-    motion = Motion.of(t, x, v)
     substeps = check_count("substeps", substeps, 1, 64)
+    run = stepper(model, substeps)
+    lib = along_driver(model, run.substeps)
+    fast = None if lib is None else fast_samples(lib, t, x, v)  # checked in C
+    motion = Motion.of(t, x, v) if fast is None else None  # checks and names what is wrong
+    t_arr = motion.t if fast is None else fast[0]
     k = model.n_states + model.n_flags  # the state of every sample, kept three times at the peak
-    check_memory(f"friction_along of {type(model).__name__} ({k} states and flags per sample)", motion.t.size,
+    check_memory(f"friction_along of {type(model).__name__} ({k} states and flags per sample)", t_arr.size,
                  16 + 3 * k, "samples", "pass fewer samples, or feed the record through prefriction.FrictionStream "
                  "(one sample at a time, in constant memory)")
-    F0, X0 = initial_state(model, F0, motion.s0)
-    run = stepper(model, substeps)
+    s0 = motion.s0 if fast is None else first_direction(lib, fast[1])
+    F0, X0 = initial_state(model, F0, s0)
     start = time.perf_counter()
     U = Units.of(model)
     q = np.asarray(model.runtime_params(), dtype=float)
-    _X, F_first, _e = run.step(X0, 0.0, 0.0, motion.s0, motion.s0, motion.v_at[0] / U.v, q)
-    lib = along_driver(model, run.substeps)
-    if lib is not None:  # one C pass writing into the result's arrays (prefriction.along.native)
-        X, F, ev = run_native(lib, X0, float(F_first), motion, q, U)
+    if lib is not None:  # one C pass over the motion writing into the result's arrays (prefriction.along.native)
+        t_arr, x_arr, v_arr = fast if fast is not None else (motion.t, motion.x, None if v is None else motion.v_at)
+        v0 = (v_arr[0] if v_arr is not None else (x_arr[1] - x_arr[0]) / (t_arr[1] - t_arr[0])) / U.v
+        _X, F_first, _e = run.step(X0, 0.0, 0.0, s0, s0, v0, q)
+        X, F, ev, v_at, reversals = run_native(lib, X0, float(F_first), t_arr, x_arr, v_arr, s0, q, U)
     else:
+        v_at, reversals, x_arr = motion.v_at, motion.reversals, motion.x
+        _X, F_first, _e = run.step(X0, 0.0, 0.0, s0, s0, v_at[0] / U.v, q)
         rows = np.vstack([motion.v / U.v, motion.dt / U.t, motion.s_prev, motion.s, motion.v_at[1:] / U.v])
         Xb, Fb, evb = run.run(X0, rows, q)
         F = U.F * np.concatenate(([float(F_first)], Fb))
         X = np.hstack((X0[:, None], Xb)).T
         ev = np.concatenate(([0], evb.astype(int)))
-    _check_finite(F, motion.t)
+    _check_finite(F, t_arr)
     nz = model.n_states
-    return AlongResult(model, motion.t, motion.x, F, motion.v_at, X[:, :nz], X[:, nz:], ev, motion.reversals, F0,
+    return AlongResult(model, t_arr, x_arr, F, v_at, X[:, :nz], X[:, nz:], ev, reversals, F0,
                        "exact" if run.exact else f"rk4 x {substeps}", time.perf_counter() - start)
 
 

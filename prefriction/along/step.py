@@ -69,17 +69,21 @@ def interval_function(model: FrictionModel, n_sub: int = 16, snap: float = 1e-12
     return ca.Function("interval", ins, [X_next, F], _NAMES_IN, ["X_next", "F"])
 
 
-def counted_interval_function(model: FrictionModel, n_sub: int = 16, snap: float = 1e-12) -> ca.Function:
+def counted_interval_function(model: FrictionModel, n_sub: int = 16, snap: float = 1e-12,
+                              reversal: bool = True) -> ca.Function:
     """:func:`interval_function` with a third output: the number of model events in the
-    interval (flags set at its end that were clear after the reversal at its start)."""
-    ins, X_next, F, events = _interval(model, n_sub, snap)
+    interval (flags set at its end that were clear after the reversal at its start).
+    ``reversal=False``: the step of an interval that keeps the direction of the one before
+    (``s_prev`` unused), for a caller that chooses between the two."""
+    ins, X_next, F, events = _interval(model, n_sub, snap, reversal)
     return ca.Function("interval_counted", ins, [X_next, F, events], _NAMES_IN, ["X_next", "F", "events"])
 
 
 _NAMES_IN = ["X", "v", "dt", "s_prev", "s", "v_end", "q"]
 
 
-def _interval(model: FrictionModel, n_sub: int, snap: float) -> tuple[list[ca.SX], ca.SX, ca.SX, ca.SX]:
+def _interval(model: FrictionModel, n_sub: int, snap: float,
+              reversal: bool = True) -> tuple[list[ca.SX], ca.SX, ca.SX, ca.SX]:
     """Inputs and outputs ``(X_next, F, events)`` of the interval step (SX)."""
     nz, nm, nq = model.n_states, model.n_flags, len(model.runtime_params())
     X = ca.SX.sym("X", nz + nm)
@@ -88,10 +92,12 @@ def _interval(model: FrictionModel, n_sub: int, snap: float) -> tuple[list[ca.SX
     q = [qs[i] for i in range(nq)]
     z = [X[i] for i in range(nz)]
     m = [X[nz + i] for i in range(nm)]
-    zr, mr = model.reverse(z, m, s, q, snap)
-    rev = s * s_prev < 0.0
-    z = [ca.if_else(rev, a, b) for a, b in zip(zr, z)]
-    m0 = m = [ca.if_else(rev, a, b) for a, b in zip(mr, m)]
+    if reversal:
+        zr, mr = model.reverse(z, m, s, q, snap)
+        rev = s * s_prev < 0.0
+        z = [ca.if_else(rev, a, b) for a, b in zip(zr, z)]
+        m = [ca.if_else(rev, a, b) for a, b in zip(mr, m)]
+    m0 = m
     exact = model.advance(z, m, v, dt, s, q)
     if exact is not None:
         z, m = list(exact[0]), list(exact[1])

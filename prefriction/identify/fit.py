@@ -22,7 +22,7 @@ __all__ = ["fit"]
 
 def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequence[str] | None = None,
         fixed: Sequence[str] | None = None, bounds: dict[str, tuple[float, float]] | None = None,
-        offset: bool = False, structures: str = "both", mass0: float | None = None, offset0: float | None = None,
+        offset: bool = False, structures: str = "given", mass0: float | None = None, offset0: float | None = None,
         reversals: Sequence[float] | None = None, substeps: int | None = None, max_iter: int = 200,
         tol: float = 1e-10, identifiability_limit: float = 0.5) -> FitResult:
     """Fit a friction model's parameters to measured data.
@@ -61,12 +61,14 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
         force (:class:`ForceDisplacement`) or to the friction of a :class:`Motion`
         (``m x'' + F + F_off = u``, a bias of the force sensor or the drive); estimated, with its
         interval, like any parameter.
-    structures : {"both", "given"}, default "both"
+    structures : {"given", "both"}, default "given"
         For :class:`prefriction.Dahl` with ``gamma`` free and not bounded by ``bounds``:
+        ``"given"`` fits the start model's structure only (``gamma >= 1`` from the default
+        ``gamma = 1``: the structure every later step takes, ``docs/conventions.md#fits-downstream``);
         ``"both"`` fits the start model's structure and the other one (``gamma < 1`` started at
         0.5, or ``gamma >= 1`` started at 1.5; the two use different states), keeps the one with
-        the smaller residual, and says in ``FitResult.notes`` what it compared; ``"given"`` fits
-        the start model's structure only.
+        the smaller residual, and says in ``FitResult.notes`` what it compared and, when it keeps
+        ``gamma < 1``, which later steps refuse that structure.
     mass0 : float, optional
         Start value of the mass [kg] when ``data.mass`` is ``None`` (the mass is then fitted).
         Default: the static least-squares fit of the force balance of a forced record

@@ -128,6 +128,9 @@ def fit_structures(model: FrictionModel, one: Callable[[FrictionModel], FitResul
         lines.append(f"{_label(start)}: rms {res.rms:.4g} N, gamma = {g:.4g}" + (f", {flag}" if flag else ""))
     kept = "gamma >= 1" if _gamma(best[1].model) >= 1.0 else "gamma < 1"
     note = f"compared both Dahl structures: {'; '.join(lines)}; kept {kept} (smaller residual)"
+    if kept == "gamma < 1":
+        note += ("; controllers.FrictionObserver and optimal.point_to_point refuse gamma < 1 (fit with "
+                 "structures='given' from gamma >= 1 for them, docs/conventions.md#fits-downstream)")
     for w in best[2]:
         warnings.warn(w.message, w.category, stacklevel=3)
     return dataclasses.replace(best[1], notes=best[1].notes + (note,))

@@ -16,6 +16,7 @@ from prefriction.models.base import FrictionModel
 from prefriction.models.sizes import check_sizes
 from prefriction.simulation.feedback import LinearFeedback
 from prefriction.simulation.integrator import integrator
+from prefriction.simulation.native.closed import closed_driver
 from prefriction.simulation.native.forced import forced_driver
 from prefriction.simulation.native.library import native_driver
 from prefriction.simulation.plant import Layout, PlantSpec
@@ -36,6 +37,8 @@ def build_plant(model: FrictionModel, spec: PlantSpec, fb: Optional[LinearFeedba
     drv_forced = None
     if native and jit and fb is None and not spec.stops_at_reversal:
         drv_forced, setup = forced_driver(model, spec.u_sig)
+    elif native and jit and spec.fb == "continuous":  # the controller in C (native/closed.py)
+        drv_forced, setup = closed_driver(model, spec)
     if drv_forced is not None:
         return BuiltPlant(L, None, drv, drv_forced, setup, drv_forced.info.mode if setup else "cached")
     if drv is not None:

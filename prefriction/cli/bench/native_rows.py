@@ -142,6 +142,47 @@ def _forced_rows(rounds: int) -> list[NativeRow]:
     return rows
 
 
+def _feedback_rows(rounds: int) -> list[NativeRow]:
+    """``simulate(..., feedback=)`` with a continuous PID loop around Dahl (a sine reference, 1 s)
+    against the numba integrator of the same closed loop at matched error (reversals against the
+    numba loop at rtol 1e-13)."""
+    import prefriction as pf
+    from prefriction.cli.bench import numba_refs as nr
+    from prefriction.signals import Sine
+
+    kp, ki, kd, tau, r_amp = 300.0, 3000.0, 5.0, 1e-3, 2e-3  # N/m, N/(m s), N s/m, s, m
+    fb = pf.LinearFeedback([[0.0, 0.0], [0.0, -1.0 / tau]], [[1.0], [1.0 / tau]], [[ki, -kd / tau]],
+                           [[kp + kd / tau]], reference=Sine(r_amp, FREQ))
+    system = pf.Oscillator(pf.Dahl(SIGMA, FC), MASS)
+    mp = np.array([SIGMA, FC, MASS])
+    up = np.array([r_amp, 2 * np.pi * FREQ, kp, ki, kd / tau, 1.0 / tau])
+    scale = np.array([FC / SIGMA, FC / math.sqrt(SIGMA * MASS), FC, FC / ki, FC / (kd / tau)])
+    none = np.zeros(1)
+
+    def reference(rtol: float) -> tuple:
+        return nr.forced_run(nr.DAHL, mp, nr.PID, up, none, none, np.zeros(5), 1.0, 1.0, rtol, rtol * scale,
+                             np.zeros(0))
+
+    def sim(method: str = "native") -> Any:
+        return pf.simulate(system, 0.0, t_end=1.0, rtol=1e-8, feedback=fb, method=method)
+
+    exact = reference(1e-13)[0]
+    res = sim()
+    sim_err = _error(res.reversals.t, res.reversals.x, res.reversals.F, exact)
+    chosen, ref_err = _LADDER[-1], math.inf
+    for rtol in _LADDER:  # the loosest reference at least as accurate as simulate
+        rev = reference(rtol)[0]
+        err = _error(rev[0], rev[1], rev[2], exact)
+        if err <= sim_err:
+            chosen, ref_err = rtol, err
+            break
+    sim_s, ref_s = _interleaved(sim, lambda: reference(chosen), rounds)
+    _, same_s = _interleaved(lambda: None, lambda: reference(1e-8), rounds)
+    erk_s, _ = _interleaved(lambda: sim("erk"), lambda: None, max(2, rounds // 5))
+    return [NativeRow("Dahl in a continuous PID loop, sine reference", f"numba({chosen:.0e})", sim_s, ref_s, sim_err,
+                      ref_err, 2.0, same_s, erk_s)]
+
+
 def _loop_rows(rounds: int) -> list[NativeRow]:
     """10 kHz PID loops (1 s, a 5 um sine reference) around Dahl and LuGre stages: time per sample
     of ``controllers.simulate_loop`` against the numba loop at the loosest tolerance that matches
@@ -283,6 +324,7 @@ def run(quick: bool = False) -> list[NativeRow]:
         rows += _headline_rows(rounds)
     if numba_refs.available():
         rows += _forced_rows(rounds)
+        rows += _feedback_rows(rounds)
         rows += _loop_rows(rounds)
         rows += _along_rows(rounds)
     return rows

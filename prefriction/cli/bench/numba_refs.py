@@ -10,8 +10,11 @@ One ``numba.njit`` function integrates the forced oscillator ``m x'' = u(t) - F`
 with the Dormand-Prince 5(4) pair of :class:`scipy.integrate.RK45` (its coefficients, its
 quartic dense output, its error norm and step control), every velocity reversal located on the
 dense output (Illinois regula falsi) and the branch direction ``s`` switched there. Inputs: a
-sine, or samples linear in between (the steps broken at the sample times, the piece read from
-the arrays). Optional samples at requested times from the dense output. numba is an optional
+sine, samples linear in between (the steps broken at the sample times, the piece read from
+the arrays), or a continuous PID loop around the stage (:data:`PID`: ``u = kp e + ki xi +
+kd / tau (e - xf)``, ``xi' = e``, ``xf' = (e - xf) / tau``, ``e = r - x`` with a sine reference
+``r``; the controller's states integrated with the stage's). Optional samples at requested
+times from the dense output. numba is an optional
 extra (the benchmark's peer rows only): :func:`available` says whether it is installed.
 """
 
@@ -22,10 +25,11 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["DAHL", "LUGRE", "SINE", "SAMPLES", "available", "forced_run", "maxwell_slip_along", "pid_loop"]
+__all__ = ["DAHL", "LUGRE", "PID", "SINE", "SAMPLES", "available", "forced_run", "maxwell_slip_along", "pid_loop"]
 
 DAHL, LUGRE = 0, 1
 SINE, SAMPLES = 0, 1
+PID = 3  # a continuous PID loop (the kind of forced_run): up = (r amplitude [m], r angular frequency [rad/s], kp, ki, kd / tau, 1 / tau)
 
 
 def available() -> bool:
@@ -60,7 +64,13 @@ def _kernel() -> Any:
     def rhs(t: float, y: np.ndarray, s: float, model: int, mp: np.ndarray, kind: int, up: np.ndarray,
             ts: np.ndarray, us: np.ndarray, k: int, dy: np.ndarray) -> float:
         v = y[1]
-        u = u_at(t, kind, up, ts, us, k)
+        if kind == 3:  # the continuous PID loop: states y[3] (integral of e), y[4] (filter of e)
+            e = up[0] * np.sin(up[1] * t) - y[0]
+            u = up[2] * e + up[3] * y[3] + up[4] * (e - y[4])
+            dy[3] = e
+            dy[4] = (e - y[4]) * up[5]
+        else:
+            u = u_at(t, kind, up, ts, us, k)
         if model == 0:  # Dahl, gamma = 1: mp = (sigma, Fc, m)
             F = y[2]
             dy[2] = mp[0] * v * (1.0 - s * F / mp[1])
@@ -243,8 +253,9 @@ def forced_run(model: int, mp: np.ndarray, kind: int, up: np.ndarray, ts: np.nda
         :data:`DAHL` (``mp = (sigma, Fc, m)``, state ``(x, v, F)``) or :data:`LUGRE`
         (``mp = (sigma0, sigma1, sigma2, Fc, Fs, vs, m)``, state ``(x, v, z)``); SI units.
     kind : int
-        :data:`SINE` (``up = (amplitude [N], angular frequency [rad/s])``) or :data:`SAMPLES`
-        (``ts`` [s], ``us`` [N]).
+        :data:`SINE` (``up = (amplitude [N], angular frequency [rad/s])``), :data:`SAMPLES`
+        (``ts`` [s], ``us`` [N]) or :data:`PID` (``up`` as there; the state has the controller's
+        two states after the stage's).
     y0, s0, t_end, rtol, atol : initial state, branch direction, end time [s], tolerances.
     td : numpy.ndarray
         Requested sample times [s] (empty: none).
@@ -257,6 +268,7 @@ def forced_run(model: int, mp: np.ndarray, kind: int, up: np.ndarray, ts: np.nda
     run = _kernel()[0]
     rev = np.empty((3, max_rev))
     dout = np.empty((3, max(td.size, 1)))
+    y0 = np.asarray(y0, dtype=float)
     nrev, nd, steps = run(model, mp, kind, up, ts, us, y0, s0, t_end, rtol, atol, td, rev, dout)
     return rev[:, :min(nrev, max_rev)], dout[:, :nd], int(steps)
 
