@@ -120,3 +120,33 @@ def test_pass_with_states_computes_the_same_forces() -> None:
         assert plain.X is None and full.X is not None and full.X.shape == (t.size, X0.size)
         assert plain.n_events == full.n_events == int(full.events.sum())
         np.testing.assert_array_equal(plain.reversals, full.reversals)
+
+
+def test_straight_line_c_matches_casadi(tmp_path) -> None:
+    """The straight-line C of an expression with truth values, their sums and quotients, picks,
+    sign, min and transcendental functions gives CasADi's numbers."""
+    import ctypes
+    import shutil
+    import subprocess
+
+    import casadi as ca
+
+    from prefriction.along.emit import straight_line
+
+    cc = shutil.which("gcc") or shutil.which("cc")
+    if cc is None:
+        pytest.skip("no C compiler")
+    a, b = ca.SX.sym("a"), ca.SX.sym("b")
+    outs = [ca.if_else(a < b, ca.exp(a), ca.sin(b)), ((a < b) + (b > 0.0)) / ((a > -1.0) + (b < 5.0)),
+            ca.sign(a) * ca.fmin(a, b) + ca.log1p(b * b), ca.logic_and(a < 0.5, b > 0.5) + ca.atan2(a, b)]
+    fun = ca.Function("f", [a, b], [ca.vertcat(*outs)])
+    body = straight_line(fun, [lambda j: "p[0]", lambda j: "p[1]"], [lambda j: f"r[{j}]"], "w")
+    src = tmp_path / "f.c"
+    src.write_text(f"#include <math.h>\nvoid f(const double* p, double* r) {{\n{body}\n}}\n")
+    lib_path = tmp_path / "f.so"
+    subprocess.run([cc, "-O2", "-shared", "-fPIC", "-o", str(lib_path), str(src), "-lm"], check=True)
+    lib = ctypes.CDLL(str(lib_path))
+    for p in ([0.3, 0.7], [0.9, -0.2], [-1.5, 2.0], [-0.5, -0.2], [0.0, 0.0]):  # [-0.5, -0.2]: 1 / 2
+        got = np.zeros(4)
+        lib.f(np.array(p).ctypes.data_as(ctypes.c_void_p), got.ctypes.data_as(ctypes.c_void_p))
+        np.testing.assert_allclose(got, np.array(fun(*p)).ravel(), rtol=1e-15, atol=0)

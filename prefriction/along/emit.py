@@ -22,7 +22,7 @@ __all__ = ["straight_line"]
 
 _BINARY: dict[int, Callable[[str, str], str]] = {
     ca.OP_ADD: lambda a, b: f"{a} + {b}", ca.OP_SUB: lambda a, b: f"{a} - {b}",
-    ca.OP_MUL: lambda a, b: f"{a} * {b}", ca.OP_DIV: lambda a, b: f"{a} / {b}",
+    ca.OP_MUL: lambda a, b: f"{a} * {b}", ca.OP_DIV: lambda a, b: f"(double){a} / {b}",  # an int over an int too
     ca.OP_LT: lambda a, b: f"{a} < {b}", ca.OP_LE: lambda a, b: f"{a} <= {b}",
     ca.OP_EQ: lambda a, b: f"{a} == {b}", ca.OP_NE: lambda a, b: f"{a} != {b}",
     ca.OP_AND: lambda a, b: f"{a} && {b}", ca.OP_OR: lambda a, b: f"{a} || {b}",
