@@ -150,3 +150,16 @@ def test_straight_line_c_matches_casadi(tmp_path) -> None:
         got = np.zeros(4)
         lib.f(np.array(p).ctypes.data_as(ctypes.c_void_p), got.ctypes.data_as(ctypes.c_void_p))
         np.testing.assert_allclose(got, np.array(fun(*p)).ravel(), rtol=1e-15, atol=0)
+
+
+def test_result_pickles_with_its_states() -> None:
+    import pickle
+
+    t, x = _motion()
+    res = pf.friction_along(pf.MaxwellSlip(K, W), t, x)
+    back = pickle.loads(pickle.dumps(res))
+    np.testing.assert_array_equal(back.F, res.F)
+    np.testing.assert_allclose(back.states[:, :3], _stop_operator(x) / W.sum(), rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(back.flags, res.flags)
+    np.testing.assert_array_equal(back.events, res.events)
+    assert back.n_events == res.n_events and repr(back) == repr(res)

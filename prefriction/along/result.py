@@ -80,6 +80,12 @@ class AlongResult:
                 self._made[key] = made
             return self._made[key]
 
+    def __reduce__(self) -> tuple:
+        """Pickled with its states made (a result travels to and from worker processes)."""
+        states, flags, events = self._split()
+        return (AlongResult, (self.model, self.t, self.x, self.F, self.v, (np.hstack((states, flags)), events),
+                              self.n_events, self.reversals, self.F0, self.step, self.seconds))
+
     @property
     def v(self) -> np.ndarray:
         """Velocity [m/s] at every sample that the rate-dependent part of the force used."""
