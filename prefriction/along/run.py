@@ -73,7 +73,8 @@ def friction_along(model: FrictionModel, t: Any, x: Any, *, F0: float = 0.0, v: 
     -------
     AlongResult
         ``t``, ``x``, ``F`` [N], the velocities used, the states and flags, the events per
-        interval and the reversal samples; ``summary()`` and ``plot(path)``.
+        interval (these four made on first access, ``docs/along.md#states-on-access``), the
+        number of events and the reversal samples; ``summary()`` and ``plot(path)``.
 
     Raises
     ------
