@@ -16,6 +16,7 @@ import numpy as np
 
 from prefriction.signals.compiled import linear_pieces
 from prefriction.simulation.dense import dense_loop
+from prefriction.simulation.loops.feedback_loop import run_feedback_loop
 from prefriction.simulation.native.forced import run_forced
 from prefriction.simulation.run import Run
 from prefriction.simulation.run_state import RunState
@@ -53,10 +54,15 @@ def drive(run: Run, t_end: float, n_target: float, times: Optional[np.ndarray], 
     return ([] if buf is None else buf), []
 
 
-def sampled_loop(run: Run, xc0: np.ndarray, t_end: float, n_target: float) -> tuple[SampleBuffer, list]:
+def sampled_loop(run: Run, xc0: np.ndarray, t_end: float,
+                 n_target: float) -> tuple[SampleBuffer, Union[list, np.ndarray]]:
     """Closed loop with a sampled controller: hold its output over each period ``Ts`` up to the
     normalised time ``t_end`` or ``n_target`` reversals; returns the samples at ``k Ts`` and the
-    total applied force there [N]."""
+    total applied force there [N]. On the native sampled loop where it was built
+    (:func:`~prefriction.simulation.loops.feedback_loop.run_feedback_loop`), else one CasADi call
+    per period."""
+    if run.native_loop is not None:
+        return run_feedback_loop(run, xc0, t_end, n_target)
     system, feedback, sc = run.system, run.fb, run.sc
     samples = SampleBuffer(len(xc0))
     u_hist: list = []

@@ -45,7 +45,7 @@ from prefriction.simulation.drive import RAMP_ROUNDOFF, drive
 from prefriction.simulation.samples import N_DENSE, samples_si
 from prefriction.simulation.rest import initial_direction
 from prefriction.simulation.run import Run
-from prefriction.simulation.plant import PlantSpec
+from prefriction.simulation.plant import EPS_CAL, PlantSpec
 from prefriction.simulation.force_scale import MAX_AMPLITUDE, MIN_AMPLITUDE, applied_force_scale, check_amplitude
 from prefriction.simulation.budget import check_input_budget
 from prefriction.simulation.build import build_plant
@@ -71,7 +71,7 @@ its table in memory: about 100 bytes per reversal at the peak, so about 1 GB;
 ``docs/simulator.md#limits``)."""
 MAX_PERIODS = 10**7
 """Most sample periods ``t_end / Ts`` of a sampled controller (one Python step and one sample each)."""
-_CAL = 0.1  # calibration of the run-time tolerance eps: global error over 50 reversals ~ 0.7 rtol
+_CAL = EPS_CAL  # calibration of the run-time tolerance eps: global error over 50 reversals ~ 0.7 rtol
 
 
 def simulate(
@@ -225,7 +225,7 @@ def simulate(
         breaks.append(np.asarray(feedback.reference.breaks()) / sc.t)
     breaks = _sample_times(np.unique(np.concatenate(breaks)) if breaks else np.zeros(0))
     t_end_n = t_end_si / sc.t
-    plant = build_plant(system.friction, spec, feedback, jit, native=method == "native")
+    plant = build_plant(system.friction, spec, feedback, jit, native=method == "native", unforced=not system.forced)
     # error control on states scaled by amplitude * eps (the plant's run-time tolerance)
     eps = min(rtol, atol) * _CAL * math.sqrt(plant.L.n_active / plant.L.nx)
     run = Run(system, spec, feedback, eps, plant, sc=sc)
