@@ -249,7 +249,7 @@ def _sampled_feedback_row(stage: Any, Cd: Any, ref: Any, t_end: float, stroke: f
     sim_s, ref_s = _interleaved(sim, lambda: reference(chosen), max(3, rounds // 5))
     erk_s, _ = _interleaved(lambda: sim("erk"), lambda: None, 2)
     n = exact.size - 1
-    return NativeRow("sampled feedback= (simulate) around Dahl (per sample)", f"numba({chosen:.0e})", sim_s / n,
+    return NativeRow("sampled feedback= around Dahl (per sample)", f"numba({chosen:.0e})", sim_s / n,
                      ref_s / n, err, ref_err, 3.0, erk_s=erk_s / n)
 
 
