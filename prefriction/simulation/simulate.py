@@ -70,7 +70,7 @@ MAX_REVERSALS = 10**7
 its table in memory: about 100 bytes per reversal at the peak, so about 1 GB;
 ``docs/simulator.md#limits``)."""
 MAX_PERIODS = 10**7
-"""Most sample periods ``t_end / Ts`` of a sampled controller (one Python step and one sample each)."""
+"""Most sample periods ``t_end / Ts`` of a sampled controller (one controller step and one sample each)."""
 _CAL = EPS_CAL  # calibration of the run-time tolerance eps: global error over 50 reversals ~ 0.7 rtol
 
 
@@ -122,8 +122,8 @@ def simulate(
     method : str, default "native"
         One of :data:`METHODS`. ``"native"``: the C driver (the model's and the input's
         generated code driven by a Runge-Kutta 5(4) in C, one C call per run or block;
-        ``docs/simulator.md#native``) where it applies (no sampled or continuous controller,
-        a C compiler), else CasADi's integrator. ``"erk"``: CasADi's integrator (adaptive
+        ``docs/simulator.md#native``) where it applies (a C compiler; a sampled controller only
+        around an oscillator without input force), else CasADi's integrator. ``"erk"``: CasADi's integrator (adaptive
         explicit Runge-Kutta 5(4) with events; ``"rosenbrock"`` works with the same events but
         is 5-10 times slower on these non-stiff problems; ``cvodes``/``idas`` events and
         ``collocation`` fail: docs/simulator.md, why only erk). Both agree to the tolerance.

@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Optional
 
 import numpy as np
 
+from prefriction._memory import check_memory
 from prefriction.models.base import FrictionModel
 from prefriction.simulation.feedback import sample_count
 from prefriction.simulation.samples import SampleBuffer
@@ -61,6 +62,8 @@ def run_feedback_loop(run: "RunState", xc0: np.ndarray, t_end: float,
     L = LL.plant
     Ts_n = fb.Ts / sc.t
     n_s = sample_count(t_end, Ts_n, t_end / Ts_n)
+    check_memory(f"the sampled loop of {type(run.model).__name__}", n_s, LL.nw + LL.nrec + 6 + n,
+                 "sample instants", "increase Ts or split the run")
     tk = np.minimum(np.arange(n_s) * Ts_n, t_end)
     par = np.zeros(LL.npar)
     P0 = loop_params(par, LL, L, run.model, sc, fb, run.eps, run.snap, run.force_scale)
