@@ -6,8 +6,9 @@ open-loop runs on the forced native driver (:mod:`prefriction.simulation.native.
 continuous controller on the same driver (:mod:`prefriction.simulation.native.closed`), a sampled
 controller around an oscillator without input force on the native sampled loop
 (:mod:`prefriction.simulation.loops.feedback_loop`), and everything else (a sampled controller
-with an input force, ``method="erk"``, ``jit=False``) on CasADi's integrator (:mod:`prefriction.simulation.integrator`). Each is built once per model structure
-and process and reused (numbers and tolerances are run-time inputs).
+with an input force, ``method="erk"``, ``jit=False``) on CasADi's integrator
+(:mod:`prefriction.simulation.integrator`). Each is built once per model structure and process
+and reused (numbers and tolerances are run-time inputs).
 """
 
 from __future__ import annotations
@@ -33,8 +34,9 @@ def build_plant(model: FrictionModel, spec: PlantSpec, fb: Optional[LinearFeedba
     """Build (or reuse) the plant of ``spec`` for the friction ``model``, on the native drivers
     where they apply (``native`` and ``jit``, no controller ``fb`` for the forced one), else on
     CasADi's integrator (compiled if ``jit``); ``unforced``: the oscillator has no input force of
-    its own (a sampled controller ``fb`` then runs on the native sampled loop). The model's sizes are checked first, once per
-    structure (:func:`~prefriction.models.sizes.check_sizes`), for every driver alike."""
+    its own (a sampled controller ``fb`` then runs on the native sampled loop). The model's sizes
+    are checked first, once per structure (:func:`~prefriction.models.sizes.check_sizes`), for
+    every driver alike."""
     check_sizes(model)
     L = Layout(spec)  # the same for any number of outputs per call
     drv, setup = native_driver(model) if spec.stops_at_reversal and jit and native else (None, 0.0)
