@@ -27,7 +27,8 @@ from prefriction.models.dahl import Dahl
 from prefriction.models.lugre import LuGre
 from prefriction.models.viscous import Viscous
 
-__all__ = ["STAGES", "Stage", "SuccessRow", "stage_record", "start_model", "success_table", "table_text"]
+__all__ = ["GRID", "STAGES", "Stage", "SuccessRow", "coverage_text", "pooled_text", "row_from_dict", "stage_record", "start_model",
+           "success_table", "table_text"]
 
 TOLERANCE = 0.05
 """Largest relative error of every estimate for a fit to count as a success."""
@@ -59,6 +60,10 @@ class Stage:
         Closed loop (PD at a bandwidth of ``rate / 50``) or open loop (multi-sine force).
     free : tuple of str
         The fitted parameters besides ``mass`` and ``offset``.
+    fit_offset : bool
+        Fit a force offset (``offset=True``); without it the stage has none.
+    pid : bool
+        Closed loop: PID (integral gain ``Kp wn / 5``) instead of PD.
     """
 
     name: str
@@ -71,6 +76,15 @@ class Stage:
     stroke: float
     closed: bool
     free: tuple = field(default=())
+    fit_offset: bool = True
+    pid: bool = False
+
+    @property
+    def label(self) -> str:
+        """The model column of the pooled table: friction, with ``+b`` for a fitted viscous term
+        (Dahl's :class:`prefriction.Viscous`, LuGre's ``sigma2``) and ``+offset`` for a fitted offset."""
+        kind = "Dahl" if isinstance(self.friction, Dahl) else "LuGre"
+        return kind + ("+b" if {"b", "sigma2"} & set(self.free) else "") + ("+offset" if self.fit_offset else "")
 
     @property
     def loop(self) -> ClosedLoop:
@@ -81,7 +95,7 @@ class Stage:
 
     def model(self) -> FrictionModel:
         """The true model as fitted (Dahl plus a :class:`prefriction.Viscous` term)."""
-        return self.friction + Viscous(self.b) if isinstance(self.friction, Dahl) else self.friction
+        return self.friction + Viscous(self.b) if "b" in self.free else self.friction
 
     def truth(self) -> dict[str, float]:
         """True values of the fitted parameters, ``mass`` and ``offset`` included."""
@@ -89,7 +103,9 @@ class Stage:
 
         values = {e.name: e.value for e in _entries(self.model())}
         out = {n: values[n] for n in self.free}
-        out.update(mass=self.mass, offset=self.offset)
+        out["mass"] = self.mass
+        if self.fit_offset:
+            out["offset"] = self.offset
         return out
 
 
@@ -110,11 +126,49 @@ STAGES = (
 closed and open loop."""
 
 
+def _grid() -> tuple[Stage, ...]:
+    """Three stages (0.3 kg / 10 kHz / 1 nm; the 2.5 kg / 5 kHz / 10 nm stage of a user with
+    ``sigma = 2e6`` N/m and ``Fc = 3`` N; an EMPS-like 95.1 kg / 1 kHz / 50 nm stage), each
+    with Dahl (``gamma = 1``) and LuGre friction, each with a viscous term and an offset or with
+    neither, each in a closed loop (PID) and in open loop."""
+    import dataclasses
+
+    stages = []
+    for mass, rate, quantum, stroke, dahl, lugre, b, offset in (
+            (0.3, 10_000.0, 1e-9, 1e-4, Dahl(sigma=5e5, Fc=0.5, gamma=1.0),
+             LuGre(sigma0=5e5, sigma1=10.0, sigma2=2.0, Fc=0.5, Fs=0.5, vs=1e-3), 2.0, 0.05),
+            (2.5, 5_000.0, 1e-8, 1e-3, Dahl(sigma=2e6, Fc=3.0, gamma=1.0),
+             LuGre(sigma0=2e6, sigma1=50.0, sigma2=8.0, Fc=3.0, Fs=3.0, vs=1e-3), 8.0, 0.2),
+            (95.1, 1_000.0, 5e-8, 0.05, Dahl(sigma=1e6, Fc=20.39, gamma=1.0),
+             LuGre(sigma0=2e5, sigma1=300.0, sigma2=203.5, Fc=20.39, Fs=20.39, vs=0.01), 203.5, -3.16)):
+        for friction in (dahl, lugre):
+            for extras in (True, False):
+                if isinstance(friction, Dahl):
+                    free = ("sigma", "Fc", "b") if extras else ("sigma", "Fc")
+                    fr, bb = friction, (b if extras else 0.0)
+                else:
+                    free = ("sigma0", "sigma2", "Fc", "Fs") if extras else ("sigma0", "Fc", "Fs")
+                    fr, bb = (friction if extras else dataclasses.replace(friction, sigma2=0.0)), 0.0
+                for closed in (True, False):
+                    st = Stage("", fr, mass, bb, offset if extras else 0.0, rate, quantum,
+                               stroke if closed else 2.0, closed, free, fit_offset=extras, pid=closed)
+                    name = (f"{st.label} {'closed (PID)' if closed else 'open'} {mass:g} kg {rate / 1e3:g} kHz "
+                            f"{quantum * 1e9:g} nm")
+                    stages.append(dataclasses.replace(st, name=name))
+    return tuple(stages)
+
+
+GRID = _grid()
+"""The grid of the done-when: 3 stages x {Dahl, LuGre} x {with viscous and offset, without} x
+{closed loop (PID), open loop}, 24 stages."""
+
+
 def stage_record(stage: Stage, n: int, rng: np.random.Generator) -> Motion:
     """``n`` samples of ``stage`` (mass not given: fitted), from scipy (see the module text).
 
     Closed loop: six moves of random length up to ``stage.stroke`` [m] with alternating
-    directions, cosine velocity profiles and rests, scaled to the record. Open loop: the force
+    directions, cosine velocity profiles and rests, scaled to the record; the loop a PD (a PID
+    with ``stage.pid``: ``u = Kp e + Ki sum(e) dt - Kd dx/dt``). Open loop: the force
     ``u = A Fc (sin(w t) + 0.4 sin(2.7 w t + 1))`` with ``A = stage.stroke`` and three periods
     of ``w`` in the record, from rest.
     """
@@ -128,10 +182,13 @@ def stage_record(stage: Stage, n: int, rng: np.random.Generator) -> Motion:
         x, u = np.empty(n), np.empty(n)
         y = np.array([r[0], 0.0, 0.0])
         prev = np.round(r[0] / loop.quantum) * loop.quantum
+        Ki = loop.Kp * 2.0 * math.pi * stage.rate / 50.0 / 5.0 if stage.pid else 0.0
+        integral = 0.0
         for k in range(n):
             xq = np.round((y[0] + noise[k]) / loop.quantum) * loop.quantum
             x[k] = xq
-            u[k] = loop.Kp * (r[k] - xq) - loop.Kd * (xq - prev) / dt
+            integral += (r[k] - xq) * dt
+            u[k] = loop.Kp * (r[k] - xq) + Ki * integral - loop.Kd * (xq - prev) / dt
             prev = xq
             if k < n - 1:
                 y = _interval(rhs, y, k * dt, (k + 1) * dt, u[k], 1e-10)
@@ -165,7 +222,15 @@ def _moves(n: int, rng: np.random.Generator, stroke: float) -> np.ndarray:
 
 @dataclass(frozen=True)
 class SuccessRow:
-    """One line of :func:`success_table`: a stage at one start distance."""
+    """One line of :func:`success_table`: a stage at one start distance.
+
+    ``held`` counts, per parameter, the fits whose 95 % interval holds the true value (among the
+    ``returned`` fits that gave estimates); ``spread`` holds, per fit, the largest realised start
+    factor ``max |ln(start / truth)|`` over the multiplicative parameters (``exp`` of it is the
+    fit's realised start distance) and whether the fit succeeded; ``rss_mb`` is the peak
+    resident set size of the process [MB] when the row was done; ``first`` counts the successes
+    of the given start alone (without the second start from the data that a failed fit takes,
+    :func:`prefriction.identify.motion_start.data_start`)."""
 
     stage: str
     distance: float
@@ -176,6 +241,12 @@ class SuccessRow:
     median_time: float
     max_time: float
     worst: str
+    label: str = ""
+    returned: int = 0
+    held: dict = field(default_factory=dict)
+    spread: tuple = ()
+    rss_mb: float = 0.0
+    first: int = 0
 
     @property
     def rate(self) -> float:
@@ -183,10 +254,12 @@ class SuccessRow:
         return self.successes / max(self.fits, 1)
 
 
-def start_model(stage: Stage, rng: np.random.Generator, distance: float) -> tuple[FrictionModel, float, float]:
-    """Start model, start mass [kg] and start offset [N]: every free parameter at the truth times
-    ``exp(U(-ln d, ln d))`` (``gamma`` kept at 1 or above; LuGre's ``Fs`` at the start ``Fc``
-    times the true ratio ``Fs / Fc``), the offset at the truth plus ``U(-ln d, ln d) Fc``."""
+def start_model(stage: Stage, rng: np.random.Generator,
+                distance: float) -> tuple[FrictionModel, float, float | None]:
+    """Start model, start mass [kg] and start offset [N] (``None`` without a fitted offset):
+    every free parameter at the truth times ``exp(U(-ln d, ln d))`` (``gamma`` kept at 1 or
+    above; LuGre's ``Fs`` at the start ``Fc`` times the true ratio ``Fs / Fc``), the offset at
+    the truth plus ``U(-ln d, ln d) Fc``."""
     import dataclasses
 
     def factor() -> float:
@@ -201,10 +274,13 @@ def start_model(stage: Stage, rng: np.random.Generator, distance: float) -> tupl
     if isinstance(fr, LuGre):  # Fs - Fc started at the truth's ratio (0 for Fs = Fc: no Stribeck peak)
         new["Fs"] = new.get("Fc", fr.Fc) * fr.Fs / fr.Fc
     start = dataclasses.replace(fr, **new)
-    if isinstance(fr, Dahl):
+    if "b" in stage.free:
         start = start + Viscous(stage.b * factor())
+    mass0 = stage.mass * factor()
+    if not stage.fit_offset:
+        return start, mass0, None
     offset0 = stage.offset + rng.uniform(-math.log(distance), math.log(distance)) * fr.Fc
-    return start, stage.mass * factor(), offset0
+    return start, mass0, offset0
 
 
 def success_table(stages: tuple = STAGES, distances: tuple = (1.25, 1.5, 2.0), *, fits: int = 10, samples: int = 1000,
@@ -231,46 +307,93 @@ def success_table(stages: tuple = STAGES, distances: tuple = (1.25, 1.5, 2.0), *
     list of SuccessRow
         One row per stage and distance.
     """
+    rows = []
+    for i, stage in enumerate(stages):
+        known = STAGES + GRID
+        i = next((k for k, st in enumerate(known) if st is stage), i)  # a stage's draws do not depend on
+        data = stage_record(stage, samples, np.random.default_rng([seed, i]))  # which others run with it
+        for d in distances:
+            rng = np.random.default_rng([seed, i, int(round(100 * d))])
+            fits_done = []
+            for j in range(fits):
+                f = _one_fit(stage, data, *start_model(stage, rng, d))
+                fits_done.append(f)
+                if progress is not None:
+                    progress(f"{stage.name} d={d:g} fit {j + 1}/{fits}: {'ok' if f.good else 'FAIL'} "
+                             f"max error {f.error:.2%} (start within x{math.exp(f.spread):.2f}) in {f.time:.1f} s"
+                             + (" after a second start from the data" if f.retried else "")
+                             + (f" ({f.message})" if f.message else ""))
+            rows.append(_row(stage, d, samples, fits_done))
+    return rows
+
+
+@dataclass(frozen=True)
+class _Fit:
+    """One fit of :func:`success_table`."""
+
+    good: bool
+    converged: bool
+    error: float
+    worst: str
+    time: float
+    spread: float
+    held: dict
+    message: str
+    retried: bool = False
+
+
+def _one_fit(stage: Stage, data: Motion, start: FrictionModel, m0: float, off0: float | None) -> _Fit:
+    """Fit ``data`` from one start; errors, interval hits and the realised start distance."""
     from prefriction.identify.fit import fit
     from prefriction.identify.parameters import _entries
 
-    rows = []
-    for i, stage in enumerate(stages):
-        i = next((k for k, known in enumerate(STAGES) if known is stage), i)  # a stage's draws do not depend on
-        data = stage_record(stage, samples, np.random.default_rng([seed, i]))  # which others run with it
-        truth = stage.truth()
-        for d in distances:
-            rng = np.random.default_rng([seed, i, int(round(100 * d))])
-            ok = conv = 0
-            times, worst, worst_err = [], "", -1.0
-            for j in range(fits):
-                start, m0, off0 = start_model(stage, rng, d)
-                fixed = [e.name for e in _entries(start) if e.name not in stage.free]
-                t0 = time.perf_counter()
-                with warnings.catch_warnings():
-                    warnings.simplefilter("ignore")
-                    try:
-                        res = fit(start, data, fixed=fixed, offset=True, mass0=m0, offset0=off0)
-                        est = {n: res.estimate(n) for n in truth}
-                        conv += bool(res.success)
-                        msg = "" if res.success else res.message
-                    except Exception as exc:  # noqa: BLE001 - a failure is a row of the table
-                        est, msg = {}, f"{type(exc).__name__}: {exc}"
-                times.append(time.perf_counter() - t0)
-                errs = {n: _error(n, est.get(n, math.nan), v, stage) for n, v in truth.items()}
-                err = max(errs.values())
-                good = err <= TOLERANCE
-                ok += good
-                if not good and not err <= worst_err:
-                    worst_err = err
-                    name = max(errs, key=lambda n: errs[n] if math.isfinite(errs[n]) else math.inf)
-                    worst = f"{name} off {err:.0%}" + (f" ({msg[:80]})" if msg else "")
-                if progress is not None:
-                    progress(f"{stage.name} d={d:g} fit {j + 1}/{fits}: {'ok' if good else 'FAIL'} "
-                             f"max error {err:.2%} in {times[-1]:.1f} s" + (f" ({msg})" if msg else ""))
-            rows.append(SuccessRow(stage.name, d, samples, fits, ok, conv, float(np.median(times)),
-                                   float(np.max(times)), worst))
-    return rows
+    truth = stage.truth()
+    values = {e.name: e.value for e in _entries(start)}
+    values["mass"] = m0
+    spread = max(abs(math.log(values[n] / v)) for n, v in truth.items() if n != "offset")
+    fixed = [e.name for e in _entries(start) if e.name not in stage.free]
+    kw = {"offset": True, "offset0": off0} if stage.fit_offset else {}
+    t0 = time.perf_counter()
+    held: dict = {}
+    retried = False
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            res = fit(start, data, fixed=fixed, mass0=m0, **kw)
+            est = {n: res.estimate(n) for n in truth}
+            for n, v in truth.items():
+                lo, hi = res.interval(n)
+                held[n] = bool(lo <= v <= hi)
+            conv, msg = bool(res.success), ("" if res.success else res.message)
+            retried = any("second start from" in line for line in res.start)
+        except Exception as exc:  # noqa: BLE001 - a failure is a row of the table
+            est, conv, msg = {}, False, f"{type(exc).__name__}: {exc}"
+            retried = "second start from" in msg
+    elapsed = time.perf_counter() - t0
+    errs = {n: _error(n, est.get(n, math.nan), v, stage) for n, v in truth.items()}
+    err = max(errs.values())
+    name = max(errs, key=lambda n: errs[n] if math.isfinite(errs[n]) else math.inf)
+    return _Fit(err <= TOLERANCE, conv, err, name, elapsed, spread, held, msg, retried)
+
+
+def _row(stage: Stage, d: float, samples: int, fits: list[_Fit]) -> SuccessRow:
+    import resource
+
+    bad = [f for f in fits if not f.good]
+    worst = ""
+    if bad:
+        w = max(bad, key=lambda f: f.error if math.isfinite(f.error) else math.inf)
+        worst = f"{w.worst} off {w.error:.0%}" + (f" ({w.message[:80]})" if w.message else "")
+    held: dict = {}
+    for f in fits:
+        for n, h in f.held.items():
+            held[n] = held.get(n, 0) + int(h)
+    times = [f.time for f in fits]
+    return SuccessRow(stage.name, d, samples, len(fits), sum(f.good for f in fits), sum(f.converged for f in fits),
+                      float(np.median(times)), float(np.max(times)), worst, stage.label,
+                      sum(bool(f.held) for f in fits), held, tuple((f.spread, f.good) for f in fits),
+                      resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
+                      sum(f.good and not f.retried for f in fits))
 
 
 def _error(name: str, value: float, truth: float, stage: Stage) -> float:
@@ -281,19 +404,92 @@ def _error(name: str, value: float, truth: float, stage: Stage) -> float:
 
 
 def table_text(rows: list[SuccessRow]) -> str:
-    """The rows as a Markdown table."""
-    lines = ["| stage | start within | samples | success | converged | median [s] | max [s] | worst miss |",
-             "|---|---:|---:|---:|---:|---:|---:|---|"]
+    """The rows as a Markdown table, one line per stage and start distance."""
+    lines = ["| stage | start within | samples | success | converged | median [s] | max [s] | peak RSS [MB] | "
+             "worst miss |", "|---|---:|---:|---:|---:|---:|---:|---:|---|"]
     for r in rows:
         lines.append(f"| {r.stage} | x{r.distance:g} | {r.samples} | {r.successes}/{r.fits} | {r.converged}/{r.fits} "
-                     f"| {r.median_time:.1f} | {r.max_time:.1f} | {r.worst} |")
+                     f"| {r.median_time:.1f} | {r.max_time:.1f} | {r.rss_mb:.0f} | {r.worst} |")
     return "\n".join(lines)
 
 
+BINS = (1.25, 1.5, 2.0)
+"""Upper edges of the realised start distances ``exp(max |ln(start / truth)|)`` of the pooled table."""
+
+
+def pooled_text(rows: list[SuccessRow], key=lambda r: r.label) -> str:
+    """Success rates pooled over the stages with the same ``key`` (default: the model, e.g.
+    ``Dahl+b+offset``), per drawn start distance ``d`` and per realised start distance (the
+    largest factor of any parameter of a fit, binned at :data:`BINS`), with the median fit time
+    and the largest peak memory of the group; in brackets the successes of the given start alone
+    (without the second start from the data)."""
+    groups: dict = {}
+    for r in rows:
+        groups.setdefault(key(r), []).append(r)
+    groups["all"] = list(rows)
+    dists = sorted({r.distance for r in rows})
+    edges = (1.0,) + BINS
+    head = ("| model | " + " | ".join(f"drawn within x{d:g} (given start alone)" for d in dists) + " | "
+            + " | ".join(f"realised x{lo:g}-{hi:g}" for lo, hi in zip(edges, edges[1:]))
+            + " | median fit [s] | peak RSS [MB] |")
+    lines = [head, "|---|" + "---:|" * (len(dists) + len(BINS) + 2)]
+    for name, rs in groups.items():
+        cells = []
+        for d in dists:
+            sel = [r for r in rs if r.distance == d]
+            ok, n = sum(r.successes for r in sel), sum(r.fits for r in sel)
+            cells.append(_rate(ok, n) + f" ({sum(r.first for r in sel)})")
+        spread = [p for r in rs for p in r.spread]
+        for lo, hi in zip(edges, edges[1:]):
+            sel = [good for s, good in spread if math.log(lo) < s <= math.log(hi) or (lo == 1.0 and s == 0.0)]
+            cells.append(_rate(sum(sel), len(sel)))
+        med = float(np.median([r.median_time for r in rs]))
+        lines.append(f"| {name} | " + " | ".join(cells) + f" | {med:.1f} | {max(r.rss_mb for r in rs):.0f} |")
+    return "\n".join(lines)
+
+
+def coverage_text(rows: list[SuccessRow], key=lambda r: r.label) -> str:
+    """How often the 95 % intervals of the fits of :func:`success_table` hold the truth, per
+    parameter, pooled over the stages with the same ``key``. The fits of one stage share its
+    record (they differ only in the start), so each record counts once: its weight is spread
+    evenly over its fits that returned estimates."""
+    records: dict = {}
+    for r in rows:
+        rec = records.setdefault(r.stage, {"key": key(r), "held": {}, "returned": 0})
+        rec["returned"] += r.returned
+        for p, h in r.held.items():
+            rec["held"][p] = rec["held"].get(p, 0) + h
+    groups: dict = {}
+    for rec in records.values():
+        if rec["returned"]:
+            groups.setdefault(rec["key"], []).append(rec)
+    lines = ["| model | records | fits with estimates | coverage per parameter (records weighted equally) | pooled |",
+             "|---|---:|---:|---|---:|"]
+    for name, recs in groups.items():
+        per = {p: float(np.mean([rec["held"][p] / rec["returned"] for rec in recs])) for p in recs[0]["held"]}
+        text = ", ".join(f"{p} {v:.0%}" for p, v in per.items())
+        fits = sum(rec["returned"] for rec in recs)
+        lines.append(f"| {name} | {len(recs)} | {fits} | {text} | {float(np.mean(list(per.values()))):.0%} |")
+    return "\n".join(lines)
+
+
+def row_from_dict(d: dict) -> SuccessRow:
+    """A :class:`SuccessRow` from ``dataclasses.asdict`` of one, read back from JSON."""
+    return SuccessRow(**{k: (tuple(map(tuple, v)) if k == "spread" else v) for k, v in d.items()})
+
+
+def _rate(ok: int, n: int) -> str:
+    return f"{ok}/{n} ({ok / n:.0%})" if n else "-"
+
+
 def main(argv: list[str] | None = None) -> None:
-    """``python -m prefriction.identify._success [--fits N] [--samples N] [--distances 1.5,2]``:
-    print the table, one progress line per fit on stderr."""
+    """``python -m prefriction.identify._success [--grid] [--stages 0,3] [--fits N] [--samples N]
+    [--distances 1.5,2] [--jsonl FILE] [--report FILE]``: fit, print the tables (one progress
+    line per fit on stderr); ``--jsonl`` appends each row as a JSON line, ``--report`` prints
+    the tables of such a file without fitting."""
     import argparse
+    import dataclasses
+    import json
     import sys
 
     ap = argparse.ArgumentParser(prog="python -m prefriction.identify._success", description=main.__doc__)
@@ -301,11 +497,29 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--samples", type=int, default=1000)
     ap.add_argument("--distances", default="1.5,2")
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--grid", action="store_true", help="the 24 stages of GRID instead of STAGES")
+    ap.add_argument("--stages", default="", help="indices into the stage list (default: all)")
+    ap.add_argument("--jsonl", default="", help="append the rows to this file, one JSON line each")
+    ap.add_argument("--report", default="", help="print the tables of a --jsonl file and stop")
     args = ap.parse_args(argv)
-    rows = success_table(STAGES, tuple(float(d) for d in args.distances.split(",")), fits=args.fits,
-                         samples=args.samples, seed=args.seed,
-                         progress=lambda line: print(line, file=sys.stderr, flush=True))
-    print(table_text(rows))
+    if args.report:
+        with open(args.report, encoding="utf-8") as fh:
+            rows = [row_from_dict(json.loads(line)) for line in fh if line.strip()]
+    else:
+        stages = GRID if args.grid else STAGES
+        if args.stages:
+            stages = tuple(stages[int(k)] for k in args.stages.split(","))
+        rows = []
+        for stage in stages:
+            new = success_table((stage,), tuple(float(d) for d in args.distances.split(",")), fits=args.fits,
+                                samples=args.samples, seed=args.seed,
+                                progress=lambda line: print(line, file=sys.stderr, flush=True))
+            rows += new
+            if args.jsonl:
+                with open(args.jsonl, "a", encoding="utf-8") as fh:
+                    for r in new:
+                        fh.write(json.dumps(dataclasses.asdict(r)) + "\n")
+    print(table_text(rows) + "\n\n" + pooled_text(rows) + "\n\n" + coverage_text(rows))
 
 
 if __name__ == "__main__":

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 from typing import Any, Sequence
 
@@ -239,7 +240,7 @@ def _fit_prescribed(model: FrictionModel, data: ForceDisplacement, free: Any, fi
 def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bounds: Any, mass0: Any, offset0: Any,
                 reversals: Any, substeps: int | None, max_iter: int, tol: float, limit: float,
                 offset: bool) -> FitResult:
-    from prefriction.identify.motion_start import start_values
+    from prefriction.identify.motion_start import data_start, start_values
     from prefriction.identify.shooting import fit_motion
 
     if data.mass is None:
@@ -257,16 +258,44 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
                              f"(allowed without it: offset0=None)")
         offset0 = check_finite("offset0", offset0)
     start = start_values(model, data, mass0, offset0, offset)
-    scale = max(abs(float(model.Fc)), abs(start.offset))
-    space = ParameterSpace(model, free, fixed, bounds, mass=start.mass if data.mass is None else None,
-                           offset=scale if offset else None, offset0=start.offset)
+
+    def space_of(m: FrictionModel, mass_start: float | None, offset_start: float) -> ParameterSpace:
+        return ParameterSpace(m, free, fixed, bounds, mass=mass_start if data.mass is None else None,
+                              offset=max(abs(float(m.Fc)), abs(offset_start)) if offset else None,
+                              offset0=offset_start)
+
+    space = space_of(model, start.mass, start.offset)
+    first_steps = start.steps
     try:
-        sol = fit_motion(model, data, space, n_sub=substeps, max_iter=max_iter, tol=tol, reversals=reversals)
+        sol, error = fit_motion(model, data, space, n_sub=substeps, max_iter=max_iter, tol=tol,
+                                reversals=reversals), None
     except SolverError as err:
-        advice = _route_advice(data)
-        if advice:
-            raise SolverError(f"{err}; {advice}") from err
-        raise
+        sol, error = None, err
+    if sol is None or not sol.success:  # second start from the data alone (motion_start.data_start)
+        second = data_start(model, space.free, start)
+        first = str(error) if sol is None else sol.message
+        if second is not None:
+            try:
+                space2 = space_of(second[0], second[1], second[2])
+                sol2 = fit_motion(second[0], data, space2, n_sub=substeps, max_iter=max_iter, tol=tol,
+                                  reversals=reversals)
+            except (SolverError, ValueError) as err2:
+                start = dataclasses.replace(start, steps=start.steps + (
+                    f"the fit from these start values did not converge ({first[:200]}); a second start from "
+                    f"{second[3]} failed too ({str(err2)[:200]})",))
+            else:
+                keep = sol2.success or sol is None
+                start = dataclasses.replace(start, steps=start.steps + (
+                    f"the fit from these start values did not converge ({first[:200]}); second start from "
+                    f"{second[3]}: {'converged, its result kept' if sol2.success else 'did not converge either'}"
+                    + ("" if keep else ", the first fit's result kept"),))
+                if keep:
+                    sol, space, error = sol2, space2, None
+    if sol is None:
+        extra = "".join(f"; {x}" for x in (_route_advice(data), *start.steps[len(first_steps):]) if x)
+        if extra:
+            raise SolverError(f"{error}{extra}") from error
+        raise error
     message = sol.message
     if not sol.success:
         advice = _route_advice(data)

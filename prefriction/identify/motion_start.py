@@ -1,10 +1,10 @@
 """Start values of a :class:`Motion` fit from a static least-squares fit of the measured force.
 
 In sliding the friction of a dynamic model is close to its static map, so the record's force
-balance ``u = m a + Fc sign(v) + b v + F_off`` (Coulomb, viscous and offset; ``a``, ``v`` from
-a Savitzky-Golay fit of the positions) is linear in ``m``, ``Fc``, ``b`` and ``F_off``: ordinary
-least squares over the samples that move faster than a tenth of the largest speed gives them
-without any start value. A record that slides in one direction only cannot tell the offset
+balance ``u = m a + Fc sign(v) + b v + F_off`` (Coulomb, viscous and offset), integrated over
+short windows that slide faster than a tenth of the largest speed (no acceleration estimate), is
+linear in ``m``, ``Fc``, ``b`` and ``F_off``: ordinary least squares gives them without any
+start value. A record that slides in one direction only cannot tell the offset
 from ``Fc``: its offset starts at 0. These estimates fill in the start values the user did not
 give (the mass, the offset) and are otherwise reported as checks beside the user's values, with
 the pre-sliding stiffness from the transients after the reversals: the fit starts where the user
@@ -20,12 +20,19 @@ from scipy.signal import savgol_filter
 from prefriction.identify.data import Motion
 from prefriction.models.base import FrictionModel
 
-__all__ = ["Start", "StaticStart", "derivatives", "start_values", "static_start", "stiffness_from_reversals"]
+__all__ = ["Start", "StaticStart", "data_start", "derivatives", "start_values", "static_start", "stiffness_from_reversals"]
 
 _RESOLVED = 8
 """Fewest samples in the first third of a reversal transient for a stiffness estimate."""
+_SECANT = 2.0 / (3.0 * np.log(1.5))
+"""Secant slope of the first third of a reversal transient in units of the stiffness (exponential
+approach from the opposite sliding level: Dahl with ``gamma = 1``, LuGre at low speed)."""
 _WINDOW = 21
 """Samples of the Savitzky-Golay window (cubic) of the velocity and acceleration estimates."""
+_V_WINDOW = 11
+"""Samples of the Savitzky-Golay window of the velocities of the static balance."""
+_SPAN = 10
+"""Samples of each window over which the static balance is integrated."""
 
 
 @dataclass(frozen=True)
@@ -51,34 +58,53 @@ def derivatives(t: np.ndarray, x: np.ndarray, window: int = _WINDOW) -> tuple[np
 def static_start(data: Motion) -> StaticStart | None:
     """Least-squares Coulomb + viscous + offset (+ mass if ``data.mass`` is None) of a forced record.
 
+    The balance is integrated over windows of :data:`_SPAN` samples in which every sample slides
+    faster than a tenth of the top speed: ``m (v_j - v_i) = int u dt - Fc int sign(v) dt -
+    b (x_j - x_i) - F_off (t_j - t_i)``, the force integrated exactly as held (or linear) between
+    the samples, ``v`` from a cubic Savitzky-Golay fit over :data:`_V_WINDOW` samples. No
+    acceleration is estimated: a smoothed second derivative lags a heavy stage's force by more
+    than its Coulomb force (at 95 kg and 1 kHz it gave ``Fc`` of the wrong sign).
+
     Returns
     -------
     StaticStart or None
-        ``None`` for a free decay (``u = 0``: the force balance has no scale), when too few
-        samples slide, or when the estimates are not physical (a mass or ``Fc`` not positive, a
-        negative viscous coefficient: the record does not excite the balance enough).
+        ``None`` for a free decay (``u = 0``: the force balance has no scale), when fewer than 8
+        windows slide, or when the estimates are not physical (a mass or ``Fc`` not positive: the
+        record does not excite the balance enough). A negative viscous coefficient (a stage
+        without viscous friction, and noise) is refitted without the viscous column: ``b = 0``.
     """
     if data.free_decay:
         return None
-    _x, v, a = derivatives(data.t, data.x)
+    _x, v, _a = derivatives(data.t, data.x, _V_WINDOW)
     moving = np.abs(v) > 0.1 * float(np.max(np.abs(v)))
-    if np.count_nonzero(moving) < 8:
+    dt = np.diff(data.t)
+    held = data.u[:-1] if data.hold == "zoh" else 0.5 * (data.u[:-1] + data.u[1:])
+    cu = np.r_[0.0, np.cumsum(held * dt)]
+    cs = np.r_[0.0, np.cumsum(np.sign(v[:-1]) * dt)]
+    i = np.arange(0, data.x.size - _SPAN, _SPAN // 2)
+    i = i[[bool(np.all(moving[k:k + _SPAN + 1])) for k in i]]
+    if i.size < 8:
         return None
-    sv = np.sign(v[moving])
-    both = min(np.count_nonzero(sv > 0), np.count_nonzero(sv < 0)) >= 0.1 * sv.size
-    cols = [np.sign(v), v, np.ones_like(v) if both else np.zeros_like(v)]
-    rhs = data.u.copy()
+    j = i + _SPAN
+    dv, ds, dx, dtw, rhs = v[j] - v[i], cs[j] - cs[i], data.x[j] - data.x[i], data.t[j] - data.t[i], cu[j] - cu[i]
+    both = min(np.count_nonzero(ds > 0), np.count_nonzero(ds < 0)) >= 0.1 * i.size
+    cols = [ds, dx, dtw if both else np.zeros_like(dtw)]
     if data.mass is None:
-        cols.insert(0, a)
+        cols.insert(0, dv)
     else:
-        rhs = rhs - data.mass * a
-    M = np.column_stack(cols)[moving]
-    coef, *_ = np.linalg.lstsq(M, rhs[moving], rcond=None)  # no offset column in one direction: 0
+        rhs = rhs - data.mass * dv
+    M = np.column_stack(cols)
+    coef, *_ = np.linalg.lstsq(M, rhs, rcond=None)  # no offset column in one direction: 0
+    if not coef[-2] >= 0.0:  # a stage without viscous friction: noise makes b < 0; b = 0 is its estimate
+        col = len(cols) - 2
+        M[:, col] = 0.0
+        coef, *_ = np.linalg.lstsq(M, rhs, rcond=None)
+        coef[col] = 0.0
     if data.mass is None:
         mass, coef = float(coef[0]), coef[1:]
     else:
         mass = None
-    if (mass is not None and not mass > 0.0) or not coef[0] > 0.0 or not coef[1] >= 0.0:
+    if (mass is not None and not mass > 0.0) or not coef[0] > 0.0:
         return None  # a record that does not excite the balance (e.g. one short move): no physical fit
     return StaticStart(mass, float(coef[0]), float(coef[1]), float(coef[2]))
 
@@ -95,11 +121,20 @@ class Start:
         Start offset [N].
     steps : tuple of str
         One line per step of the start pipeline: what was set, and from what.
+    static : StaticStart or None
+        The static least-squares estimates (:func:`static_start`).
+    stiffness : float or None
+        The pre-sliding stiffness [N/m] from the reversal transients (:func:`stiffness_from_reversals`).
+    transients : int
+        The number of reversal transients it comes from (the second start uses it from 2 on).
     """
 
     mass: float | None
     offset: float
     steps: tuple[str, ...]
+    static: StaticStart | None = None
+    stiffness: float | None = None
+    transients: int = 0
 
 
 def start_values(model: FrictionModel, data: Motion, mass0: float | None, offset0: float | None,
@@ -156,11 +191,73 @@ def start_values(model: FrictionModel, data: Motion, mass0: float | None, offset
             if b is None:
                 b = sum(getattr(m, "b", 0.0) for m in getattr(model, "models", ()))
             checks.append(f"viscous {b:.4g} N s/m (static: {fit.b:.4g} N s/m)")
-    k = stiffness_from_reversals(data, mass0 if data.mass is None else data.mass, offset0 or 0.0)
+    if data.mass is not None:
+        m_data, off_data = data.mass, (fit.offset if fit is not None else offset0 or 0.0)
+    elif fit is not None:  # the check and the second start (data_start) from the data alone
+        m_data, off_data = fit.mass, fit.offset
+    else:
+        m_data, off_data = mass0, offset0 or 0.0
+    k = stiffness_from_reversals(data, m_data, off_data)
     if k is not None:
         checks.append(f"stiffness {model.sigma:.4g} N/m (rough check from {k[1]} reversal transients: {k[0]:.4g} N/m)")
     steps.append("friction parameters as given by the start model" + (": " + ", ".join(checks) if checks else ""))
-    return Start(mass0, float(offset0 or 0.0), tuple(steps))
+    return Start(mass0, float(offset0 or 0.0), tuple(steps), fit, None if k is None else k[0], 0 if k is None else k[1])
+
+
+_STIFFNESS = ("sigma", "sigma0")
+_VISCOUS = ("b", "sigma2")
+
+
+def data_start(model: FrictionModel, free: list[str], start: Start) -> tuple[FrictionModel, float | None, float,
+                                                                              str] | None:
+    """A second start from the data alone, for a fit that failed from the user's start: every free
+    Coulomb force at the static estimate (a free ``Fs`` moved with it, keeping the start's
+    ``Fs / Fc``), a free viscous coefficient at the static one (if positive), a free stiffness at
+    the one from the reversal transients (if two or more resolve it), the mass and the offset at
+    the static ones.
+
+    Returns
+    -------
+    tuple or None
+        ``(model, mass0, offset0, line)``, ``line`` saying what was set; ``None`` without static
+        estimates or when nothing would change.
+    """
+    from prefriction.identify.parameters import _build, _entries
+
+    fit = start.static
+    if fit is None:
+        return None
+    entries = [e for e in _entries(model) if e.field not in ("mass", "offset")]
+    values = {e.name: e.value for e in entries}
+    said = []
+    for e in entries:
+        base = e.name.rsplit(".", 1)[-1]
+        if e.name not in free:
+            continue
+        if base == "Fc":
+            values[e.name] = fit.Fc
+        elif base == "Fs":
+            values[e.name] = e.value * fit.Fc / float(model.Fc)
+        elif base in _VISCOUS and fit.b > 0.0:
+            values[e.name] = fit.b
+        elif base in _STIFFNESS and start.stiffness is not None and start.transients >= 2:
+            values[e.name] = start.stiffness
+        else:
+            continue
+        said.append(f"{e.name} {values[e.name]:.4g}")
+    mass0 = start.mass if fit.mass is None or "mass" not in free else fit.mass
+    offset0 = fit.offset if "offset" in free else start.offset
+    if mass0 != start.mass:
+        said.append(f"mass {mass0:.4g} kg")
+    if "offset" in free:
+        said.append(f"offset {offset0:.4g} N")
+    if not said:
+        return None
+    try:
+        new = _build(model, entries, values)
+    except ValueError:
+        return None
+    return new, mass0, offset0, "static least squares and reversal transients: " + ", ".join(said)
 
 
 def _check(value: float | None, unit: str) -> str:
@@ -172,9 +269,12 @@ def stiffness_from_reversals(data: Motion, mass: float, offset: float) -> tuple[
     record, and the number of transients used.
 
     After a reversal the friction force ``F = u - m a - F_off`` (``a`` from the smoothed
-    positions) moves from one sliding level to the other; its slope against the position over
-    the first third of that change is the pre-sliding stiffness (``dF/dx = sigma`` at a reversal
-    of Dahl (3.2) and LuGre). The median over the reversals is returned; ``None`` for a free
+    positions) moves from one sliding level to the other; its secant slope against the position
+    over the first third of that change, divided by :data:`_SECANT`, is the pre-sliding
+    stiffness: from the sliding level ``-s Fc`` the gap ``w = 1 - s F / Fc`` of Dahl (3.2) with
+    ``gamma = 1`` (and of LuGre at low speed) decays as ``dw/dx = -sigma w / Fc`` from 2 to
+    ``4/3`` over the first third, a secant slope of ``2 sigma / (3 ln 1.5) = 1.64 sigma``
+    (``dF/dx = sigma`` holds only from ``F = 0``). The median over the reversals is returned; ``None`` for a free
     decay or when no transient spans :data:`_RESOLVED` samples (at 1 kHz a stage's transient
     lasts a few samples and the smoothing spans it: the slope came out 50 times too stiff).
     """
@@ -197,7 +297,7 @@ def stiffness_from_reversals(data: Motion, mass: float, offset: float) -> tuple[
         near = np.abs(Fs - Fs[0]) <= span / 3.0
         if np.count_nonzero(near) < _RESOLVED or np.ptp(xseg[near]) <= 0.0:
             continue
-        slope = np.polyfit(xseg[near], Fs[near], 1)[0] * s
+        slope = np.polyfit(xseg[near], Fs[near], 1)[0] * s / _SECANT
         if slope > 0.0:
             slopes.append(slope)
     if not slopes:

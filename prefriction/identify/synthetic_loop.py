@@ -157,7 +157,10 @@ def closed_loop_record(loop: ClosedLoop, n: int, rng: np.random.Generator, *, rt
 
 
 def _interval(rhs, y: np.ndarray, t0: float, t1: float, u: float, rtol: float) -> np.ndarray:
-    """The state at ``t1`` from ``y`` at ``t0`` under the held force ``u``, restarted at reversals."""
+    """The state at ``t1`` from ``y`` at ``t0`` under the held force ``u``, restarted at reversals
+    (an exact equilibrium, every derivative zero, stays put)."""
+    if not np.any(rhs(t0, y, u)):
+        return y.copy()
     for _ in range(100):
         s = np.sign(y[1]) or np.sign(rhs(t0, y, u)[1]) or 1.0
 

@@ -1,10 +1,11 @@
 """``prefriction bench --identify``: success rate against the start distance, interval coverage, and
 the cost of force-displacement fits against the record length.
 
-- Success rate: :func:`prefriction.identify._success.success_table` (seeded synthetic stages,
-  every free parameter started log-uniformly within a factor ``d`` of the truth, a success when
-  every estimate lands within 5 %), one stage per fresh process so that its peak resident set
-  size (``ru_maxrss``) is its own.
+- Success rate: :func:`prefriction.identify._success.success_table` on the 24 stages of
+  :data:`prefriction.identify._success.GRID` (every free parameter started log-uniformly within
+  a factor 2 of the truth, a success when every estimate lands within 5 %), one stage per fresh
+  process so that its peak resident set size (``ru_maxrss``) is its own; pooled per model, with
+  the coverage of the fits' 95 % intervals.
 - Coverage: :func:`prefriction.identify._coverage.coverage_table` (how often the 95 % intervals
   hold the truth on seeded records generated from the equations).
 - Cost: a Maxwell-slip(3) :class:`ForceDisplacement` fit of the tribometer record (12-60 s) at
@@ -36,48 +37,49 @@ def _rss_mb() -> float:
 
 
 def _success_stage(index: int, fits: int, samples: int, distances: tuple[float, ...]) -> list[dict]:
-    """One stage of the success table, in this process; rows with the process's peak RSS."""
+    """One stage of :data:`prefriction.identify._success.GRID`, in this process; rows with the
+    process's peak RSS."""
     from prefriction.identify import _success
 
-    stage = _success.STAGES[index]
-    rows = _success.success_table((stage,), distances, fits=fits, samples=samples, seed=index,
+    stage = _success.GRID[index]
+    rows = _success.success_table((stage,), distances, fits=fits, samples=samples, seed=0,
                                   progress=lambda line: print(line, file=sys.stderr, flush=True))
-    peak = _rss_mb()
-    return [dict(dataclasses.asdict(r), rss_mb=peak) for r in rows]
+    return [dataclasses.asdict(r) for r in rows]
+
+
+QUICK_STAGES = (3, 7, 17, 20)
+"""Stages of the grid in ``--quick``: one per model (Dahl, LuGre, Dahl+b+offset, LuGre+b+offset)."""
 
 
 def success_lines(quick: bool) -> tuple[list[str], bool]:
-    """The success-rate table (one fresh process per stage); ``ok`` is True when every stage
-    succeeds in at least 90 % of the fits at the largest distance."""
-    try:
-        from prefriction.identify import _success
-    except ImportError:
-        return ["success rate: the seeded harness prefriction.identify._success is not in this build; "
-                "table skipped"], True
-    fits, samples = (2, 500) if quick else (10, 1000)
-    distances = (1.5, 2.0) if quick else (1.25, 1.5, 2.0)
-    lines = [f"Motion fits from starts log-uniform within a factor d of the truth (every free parameter, mass "
-             f"and offset included), {fits} seeded starts per cell, success = every estimate within 5 %",
-             "| stage | d | samples | success | converged | median [s] | max [s] | peak RSS [MB] | worst miss |",
-             "|---|---:|---:|---:|---:|---:|---:|---:|---|"]
-    ok = True
-    for i, stage in enumerate(_success.STAGES):
+    """The success-rate tables of the stage grid (one fresh process per stage): per stage, pooled
+    per model against the start distance, and the coverage of the fits' intervals; ``ok`` when
+    at least 90 % of all fits succeed at the largest distance."""
+    from prefriction.identify import _success
+
+    fits, samples = (1, 500) if quick else (4, 1000)
+    distances = (2.0,)
+    stages = QUICK_STAGES if quick else range(len(_success.GRID))
+    rows, failed = [], []
+    for i in stages:
+        stage = _success.GRID[i]
         print(f"bench --identify: success rate of {stage.name} ...", file=sys.stderr, flush=True)
         out = subprocess.run([sys.executable, "-m", "prefriction.cli.bench.identify_rates", "success", str(i),
                               str(fits), str(samples), ",".join(map(str, distances))],
                              stdout=subprocess.PIPE, text=True, check=False)  # its progress on our stderr
         if out.returncode != 0:
-            lines.append(f"| {stage.name} | - | {samples} | FAILED | | | | | exit code {out.returncode}, "
-                         f"see the messages above |")
-            ok = False
+            failed.append(f"{stage.name}: exit code {out.returncode}, see the messages above")
             continue
-        for r in json.loads(out.stdout.strip().splitlines()[-1]):
-            lines.append(f"| {r['stage']} | x{r['distance']:g} | {r['samples']} | {r['successes']}/{r['fits']} | "
-                         f"{r['converged']}/{r['fits']} | {r['median_time']:.1f} | {r['max_time']:.1f} | "
-                         f"{r['rss_mb']:.0f} | {r['worst']} |")
-            if r["distance"] == max(distances):
-                ok &= r["successes"] >= 0.9 * r["fits"]
-    lines.append(f"target every stage >= 90 % success from a factor {max(distances):g}: {'PASS' if ok else 'FAIL'}")
+        rows += [_success.row_from_dict(r) for r in json.loads(out.stdout.strip().splitlines()[-1])]
+    lines = [f"Motion fits from starts log-uniform within a factor d of the truth (every free parameter, mass "
+             f"and offset included), {fits} seeded starts per stage, success = every estimate within 5 %",
+             _success.table_text(rows), "", "Pooled per model (in brackets: successes of the given start alone, "
+             "without the second start from the data)", _success.pooled_text(rows), "",
+             "Coverage of the 95 % intervals of these fits", _success.coverage_text(rows)]
+    lines += [f"stage FAILED: {f}" for f in failed]
+    top = [r for r in rows if r.distance == max(distances)]
+    ok = not failed and sum(r.successes for r in top) >= 0.9 * sum(r.fits for r in top)
+    lines.append(f"target >= 90 % of the fits within 5 % from a factor {max(distances):g}: {'PASS' if ok else 'FAIL'}")
     return lines, ok
 
 
