@@ -77,7 +77,7 @@ def sampled_loop(run: Run, xc0: np.ndarray, t_end: float,
         run.st["uhold"] = uk
         run.st["xc"] = xc.copy()
         samples.append(run.sample())
-        u_hist.append(uk + (float(system.u(t_si)) if system.forced else 0.0))
+        u_hist.append(uk + (_input_after(run, t_si, feedback.Ts) if system.forced else 0.0))
         if tk >= t_end * (1 - 1e-12):
             break
         xc = feedback.A @ xc + feedback.B[:, 0] * e
@@ -85,6 +85,16 @@ def sampled_loop(run: Run, xc0: np.ndarray, t_end: float,
             break
         k += 1
     return samples, u_hist
+
+
+def _input_after(run: Run, t: float, Ts: float) -> float:
+    """The oscillator's input force [N] applied from the sample instant ``t`` [s] on: a
+    piecewise-linear input's piece over ``[t, t + Ts]`` (its value after a break at ``t``, which
+    the round-off of ``t`` could place before it), else the input at ``t``."""
+    sig = run.spec.u_sig
+    if sig is not None and sig.key == ("PiecewiseLinear",):
+        return float(linear_pieces(sig, np.array([t]), np.array([t + Ts]))[0][0])
+    return float(run.system.u(t))
 
 
 def check_ramps(run: RunState, t_end: float, rtol: float) -> None:

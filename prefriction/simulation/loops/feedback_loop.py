@@ -6,9 +6,13 @@ x(k Ts)`` is the loop's law without force limit, measurement effects or compensa
 (:func:`~prefriction.simulation.loops.compiled_loop.control_law`); the held force is the input
 piece of the forced native driver over each period, every reversal located inside it, the step
 size carried over from period to period; :data:`NATIVE_BLOCK` periods per C call. It applies to
-an oscillator without its own input force (``system.u`` None); a run that asks for ``reversals``
-stops after the block in which they came and keeps the samples up to the last reversal, as the
-CasADi loop of :func:`prefriction.simulation.drive.sampled_loop` does.
+an oscillator without an input force of its own, or with one that is linear over every sample
+period (a piecewise-linear kind, :class:`~prefriction.signals.Samples`,
+:class:`~prefriction.signals.ZeroOrderHold`, steps and ramps, whose break times all lie on the
+sample instants ``k Ts``: :func:`input_fits_periods`); its line over each period joins the held
+force. A run that asks for ``reversals`` stops after the block in which they came and keeps the
+samples up to the last reversal, as the CasADi loop of
+:func:`prefriction.simulation.drive.sampled_loop` does.
 """
 
 from __future__ import annotations
@@ -18,7 +22,10 @@ from typing import TYPE_CHECKING, Optional
 import numpy as np
 
 from prefriction._memory import check_memory
+from prefriction.models import Oscillator
 from prefriction.models.base import FrictionModel
+from prefriction.signals import compiled_form
+from prefriction.signals.compiled import linear_pieces
 from prefriction.simulation.feedback import sample_count
 from prefriction.simulation.samples import SampleBuffer
 
@@ -30,13 +37,26 @@ if TYPE_CHECKING:
     from prefriction.simulation.plant import PlantSpec
     from prefriction.simulation.run_state import RunState
 
-__all__ = ["MIN_ORDER", "NATIVE_BLOCK", "feedback_loop_driver", "run_feedback_loop"]
+__all__ = ["MIN_ORDER", "NATIVE_BLOCK", "feedback_loop_driver", "input_fits_periods", "run_feedback_loop"]
 
 NATIVE_BLOCK = 4096
 """Sample periods per C call (bounds the records' buffers and the overshoot of a ``reversals`` stop)."""
 MIN_ORDER = 2
 """Controllers are padded to this order: P, PD and PID loops share one library (and share it with
 ``controllers.simulate_loop``)."""
+
+
+def input_fits_periods(system: Oscillator, Ts: float, t_end: float) -> bool:
+    """True if the input force of ``system`` is linear over every sample period ``[k Ts, (k+1) Ts]``
+    [s] up to ``t_end`` [s]: none, or a piecewise-linear kind whose break times are sample
+    instants (to round-off, ``1e-12 max(t_end, Ts)``)."""
+    if not system.forced:
+        return True
+    if compiled_form(system.u).key != ("PiecewiseLinear",):
+        return False
+    b = np.asarray(system.u.breaks(), dtype=float)
+    b = b[(b > 0.0) & (b < t_end)]
+    return bool(np.all(np.abs(b - Ts * np.round(b / Ts)) <= 1e-12 * max(t_end, Ts)))
 
 
 def _spec(spec: "PlantSpec", n_c: int) -> LoopSpec:
@@ -68,6 +88,10 @@ def run_feedback_loop(run: "RunState", xc0: np.ndarray, t_end: float,
     par = np.zeros(LL.npar)
     P0 = loop_params(par, LL, L, run.model, sc, fb, run.eps, run.snap, run.force_scale)
     Wall = sample_inputs(LL, fb, sc, tk, t_end, Ts_n, 0)
+    ii, ta = LL.inp, tk * sc.t  # the input's line over each period [k Ts, (k+1) Ts] (SI; zero unforced)
+    tb = np.append(ta[1:], ta[-1] + fb.Ts)
+    Wall[:, ii["tl"]] = ta
+    Wall[:, ii["da"]], Wall[:, ii["db"]] = linear_pieces(run.spec.u_sig, ta, tb)
     ix = LL.state
     S = np.zeros(LL.nS)
     S[ix["x"]], S[ix["v"]], S[ix["s"]], S[ix["rest"]] = st["x"], st["v"], st["s"], float(st["rest"])
