@@ -46,7 +46,7 @@ def build_plant(model: FrictionModel, spec: PlantSpec, fb: Optional[LinearFeedba
     elif native and jit and spec.fb == "continuous":  # the controller in C (native/closed.py)
         drv_forced, setup = closed_driver(model, spec)
     if native and jit and fb is not None and fb.sampled and held_input:
-        drv_loop, setup = feedback_loop_driver(model, spec, fb.n_states)
+        drv_loop, setup = feedback_loop_driver(spec, fb.n_states)
         if drv_loop is not None:
             return BuiltPlant(L, None, None, None, setup, drv_loop.info.mode if setup else "cached", drv_loop)
     if drv_forced is not None:

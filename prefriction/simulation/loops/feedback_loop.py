@@ -23,7 +23,6 @@ import numpy as np
 
 from prefriction._memory import check_memory
 from prefriction.models import Oscillator
-from prefriction.models.base import FrictionModel
 from prefriction.signals import compiled_form
 from prefriction.signals.compiled import linear_pieces
 from prefriction.simulation.feedback import sample_count
@@ -63,11 +62,25 @@ def _spec(spec: "PlantSpec", n_c: int) -> LoopSpec:
     return LoopSpec(spec, max(n_c, MIN_ORDER), NATIVE_BLOCK)
 
 
-def feedback_loop_driver(model: FrictionModel, spec: "PlantSpec", n_c: int) -> tuple[Optional[LoopDriver], float]:
-    """The native loop of a sampled controller of ``n_c`` states around ``model`` on the open-loop
-    plant ``spec`` (zero input, the held force in its piece) and the setup time [s]; ``(None, 0)``
+def feedback_loop_driver(spec: "PlantSpec", n_c: int) -> tuple[Optional[LoopDriver], float]:
+    """The native loop of a sampled controller of ``n_c`` states around the open-loop plant
+    ``spec`` (a piecewise-linear input, the held force in its piece) and the setup time [s]; ``(None, 0)``
     where it cannot be used (:func:`~prefriction.simulation.loops.native_loop.loop_driver`)."""
     return loop_driver(_spec(spec, n_c))
+
+
+def _loop_state(run: "RunState", LL: LoopLayout, xc0: np.ndarray, n: int) -> np.ndarray:
+    """The loop state of ``LL`` at the start: the plant's from ``run.st``, the controller's ``xc0``
+    (padded to ``n`` states), the rest zero."""
+    st, ix = run.st, LL.state
+    S = np.zeros(LL.nS)
+    S[ix["x"]], S[ix["v"]], S[ix["s"]], S[ix["rest"]] = st["x"], st["v"], st["s"], float(st["rest"])
+    for i, zi in enumerate(st["z"]):
+        S[ix[f"z{i}"]] = zi
+    for i, mi in enumerate(st["m"]):
+        S[ix[f"m{i}"]] = mi
+    S[ix["xc0"]: ix["xc0"] + n] = padded(np.reshape(xc0, (1, -1)), n, (1, n))[0]
+    return S
 
 
 def run_feedback_loop(run: "RunState", xc0: np.ndarray, t_end: float,
@@ -88,18 +101,11 @@ def run_feedback_loop(run: "RunState", xc0: np.ndarray, t_end: float,
     par = np.zeros(LL.npar)
     P0 = loop_params(par, LL, L, run.model, sc, fb, run.eps, run.snap, run.force_scale)
     Wall = sample_inputs(LL, fb, sc, tk, t_end, Ts_n, 0)
-    ii, ta = LL.inp, tk * sc.t  # the input's line over each period [k Ts, (k+1) Ts] (SI; zero unforced)
-    tb = np.append(ta[1:], ta[-1] + fb.Ts)
-    Wall[:, ii["tl"]] = ta
-    Wall[:, ii["da"]], Wall[:, ii["db"]] = linear_pieces(run.spec.u_sig, ta, tb)
-    ix = LL.state
-    S = np.zeros(LL.nS)
-    S[ix["x"]], S[ix["v"]], S[ix["s"]], S[ix["rest"]] = st["x"], st["v"], st["s"], float(st["rest"])
-    for i, zi in enumerate(st["z"]):
-        S[ix[f"z{i}"]] = zi
-    for i, mi in enumerate(st["m"]):
-        S[ix[f"m{i}"]] = mi
-    S[ix["xc0"]: ix["xc0"] + n] = padded(np.reshape(xc0, (1, -1)), n, (1, n))[0]
+    if run.system.forced:  # the input's line over each period [k Ts, (k+1) Ts] (SI)
+        ii, ta = LL.inp, tk * sc.t
+        Wall[:, ii["tl"]] = ta
+        Wall[:, ii["da"]], Wall[:, ii["db"]] = linear_pieces(run.spec.u_sig, ta, np.append(ta[1:], ta[-1] + fb.Ts))
+    S = _loop_state(run, LL, xc0, n)
     cfg = np.array([run.eps_native, run.eps, run.snap, sc.t, 1.0 / sc.F, run.force_scale, 0.0, 1.0, 0.0])
     recs, cols, calls, steps, fst = run_blocks(drv, LL, S, Wall, n_s, par, np.ascontiguousarray(P0[L.q]), cfg,
                                                NATIVE_BLOCK, n_target)
@@ -111,7 +117,7 @@ def run_feedback_loop(run: "RunState", xc0: np.ndarray, t_end: float,
         recs = recs[:max(int(np.searchsorted(tk[:len(recs)], cols[0][n_rev - 1], side="right")), 1)]
     run.rev.extend_columns(cols[0][:n_rev], cols[1][:n_rev], cols[2][:n_rev], cols[3][:n_rev])
     run.rev_events.extend(cols[4][:n_rev].astype(int).tolist())
-    last = recs[-1]
+    ix, last = LL.state, recs[-1]
     st.update(t=float(tk[len(recs) - 1]), x=float(last[ix["x"]]), v=float(last[ix["v"]]), s=float(last[ix["s"]]),
               z=[float(last[ix[f"z{i}"]]) for i in range(L.nz)], m=[float(last[ix[f"m{i}"]]) for i in range(L.nm)],
               rest=float(last[ix["rest"]]), W=float(last[ix["W"]]), ne=int(fst[4]), F=float(last[LL.rec["F"]]),
