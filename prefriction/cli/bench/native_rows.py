@@ -13,7 +13,8 @@ machine), and prints the ratio (``docs/bench.md#native``):
   that of ``simulate``, both errors measured against the reference at ``rtol = 1e-13``.
 
 Targets: unforced headline <= 2x, forced sine rows <= 2x, Samples and dense rows
-<= 3x, loose-tolerance headline <= 3x, the exported C loop (``prefriction.export``, the same
+<= 3x, loose-tolerance headline <= 3x, 10 kHz PID loops (``controllers.simulate_loop`` and a
+sampled ``simulate(..., feedback=)``) <= 3x, the exported C loop (``prefriction.export``, the same
 native driver) <= 2x the numba loop.
 """
 
@@ -227,8 +228,29 @@ def _loop_rows(rounds: int) -> list[NativeRow]:
         rows.append(NativeRow(name + " (per sample)", f"numba({chosen:.0e})", sim_s / n, ref_s / n, sim_err, ref_err,
                               3.0, erk_s=erk_s / n))
         if kind == nr.DAHL:
+            rows.append(_sampled_feedback_row(stage, Cd, ref, t_end, stroke, exact, chosen, ref_err, reference, rounds))
             rows.append(_exported_row(stage, r, Ts, stroke, exact, chosen, ref_err, reference, rounds))
     return rows
+
+
+def _sampled_feedback_row(stage: Any, Cd: Any, ref: Any, t_end: float, stroke: float, exact: np.ndarray,
+                          chosen: float, ref_err: float, reference: Callable, rounds: int) -> NativeRow:
+    """``simulate(..., feedback=LinearFeedback(..., Ts=))``: the same discrete PID loop as the
+    row before it (the native sampled loop), per sample, next to the same numba loop; the CasADi
+    path (``method="erk"``, one CasADi call per period) is timed too."""
+    import prefriction as pf
+
+    fb = pf.LinearFeedback(A=Cd.A, B=Cd.B, C=Cd.C, D=Cd.D, Ts=Cd.dt, reference=ref)
+
+    def sim(method: str = "native") -> Any:
+        return pf.simulate(stage, 0.0, t_end=t_end, rtol=1e-8, feedback=fb, method=method)
+
+    err = float(np.max(np.abs(sim().x - exact))) / stroke
+    sim_s, ref_s = _interleaved(sim, lambda: reference(chosen), max(3, rounds // 5))
+    erk_s, _ = _interleaved(lambda: sim("erk"), lambda: None, 2)
+    n = exact.size - 1
+    return NativeRow("sampled feedback= around Dahl (per sample)", f"numba({chosen:.0e})", sim_s / n,
+                     ref_s / n, err, ref_err, 3.0, erk_s=erk_s / n)
 
 
 def _exported_row(stage: Any, r: np.ndarray, Ts: float, stroke: float, exact: np.ndarray, chosen: float,
