@@ -58,8 +58,7 @@ def _source(funs: list[ca.Function], nx: int) -> str:
     without a straight-line form), then ``native.c``."""
     nq = funs[0].nnz_in(6)
     head = (f"#include <math.h>\n#define PF_NX {nx}\n#define PF_NQ {nq}\n" + _INLINE
-            + "".join(f"#define PF_COPY_{what}(d, s) do {{{''.join(f' (d)[{i}] = (s)[{i}];' for i in range(n))} }} while (0)\n"
-                      for what, n in (("X", nx), ("Q", nq))))  # written out: the compiler keeps the copies in registers
+            + _copy_macro("PF_COPY_X", nx) + _copy_macro("PF_COPY_Q", nq))
     inputs = [lambda j: f"X[{j}]", lambda j: "dxn", lambda j: "dtn", lambda j: "sp", lambda j: "s", lambda j: "ve",
               lambda j: f"q[{j}]"]
     outputs = [lambda j: f"Xn[{j}]", lambda j: "*F", lambda j: "*e"]
@@ -69,6 +68,11 @@ def _source(funs: list[ca.Function], nx: int) -> str:
         return head + _generated(funs) + _SOURCE
     return head + "".join(f"PF_INLINE void {fun.name()}_in{_SIGNATURE} {{\n{body}\n}}\n"
                           for fun, body in zip(funs, bodies)) + _SOURCE
+
+
+def _copy_macro(name: str, n: int) -> str:
+    """A macro copying ``n`` doubles, one statement each (the compiler then keeps them in registers)."""
+    return f"#define {name}(d, s) do {{{''.join(f' (d)[{i}] = (s)[{i}];' for i in range(n))} }} while (0)\n"
 
 
 def _generated(funs: list[ca.Function]) -> str:
