@@ -123,24 +123,35 @@ def _forced_rows(rounds: int) -> list[NativeRow]:
                       kind: int = kind, scale: np.ndarray = scale, up: np.ndarray = up) -> tuple:
             return nr.forced_run(model, mp, kind, up, ts, us, np.zeros(3), 1.0, 1.0, rtol, rtol * scale, tds)
 
-        exact = reference(1e-13)[0]
         kw = {} if dense is None else {"dense": dense}
-        res = pf.simulate(system, 0.0, t_end=1.0, rtol=1e-8, **kw)
-        sim_err = _error(res.reversals.t, res.reversals.x, res.reversals.F, exact)
-        chosen, ref_err = _LADDER[-1], math.inf
-        for rtol in _LADDER:  # the loosest reference at least as accurate as simulate
-            rev = reference(rtol)[0]
-            err = _error(rev[0], rev[1], rev[2], exact)
-            if err <= sim_err:
-                chosen, ref_err = rtol, err
-                break
-        sim_s, ref_s = _interleaved(lambda: pf.simulate(system, 0.0, t_end=1.0, rtol=1e-8, **kw),
-                                    lambda: reference(chosen), rounds)
-        _, same_s = _interleaved(lambda: None, lambda: reference(1e-8), rounds)
-        erk_s, _ = _interleaved(lambda: pf.simulate(system, 0.0, t_end=1.0, rtol=1e-8, method="erk", **kw),
-                                lambda: None, max(2, rounds // 5))
-        rows.append(NativeRow(name, f"numba({chosen:.0e})", sim_s, ref_s, sim_err, ref_err, target, same_s, erk_s))
+
+        def sim(method: str = "native", system: Any = system, kw: dict = kw) -> Any:
+            return pf.simulate(system, 0.0, t_end=1.0, rtol=1e-8, method=method, **kw)
+
+        rows.append(_matched_row(name, sim, reference, target, rounds))
     return rows
+
+
+def _matched_row(name: str, sim: Callable[..., Any], reference: Callable[[float], tuple], target: float,
+                 rounds: int) -> NativeRow:
+    """The row of a simulate run ``sim(method)`` against the numba ``reference(rtol)`` at matched error:
+    the loosest reference rtol of :data:`_LADDER` whose reversals are at least as accurate as
+    simulate's against the reference at rtol 1e-13; also the reference at simulate's own rtol 1e-8
+    and CasADi's path (``method="erk"``)."""
+    exact = reference(1e-13)[0]
+    res = sim()
+    sim_err = _error(res.reversals.t, res.reversals.x, res.reversals.F, exact)
+    chosen, ref_err = _LADDER[-1], math.inf
+    for rtol in _LADDER:  # the loosest reference at least as accurate as simulate
+        rev = reference(rtol)[0]
+        err = _error(rev[0], rev[1], rev[2], exact)
+        if err <= sim_err:
+            chosen, ref_err = rtol, err
+            break
+    sim_s, ref_s = _interleaved(sim, lambda: reference(chosen), rounds)
+    _, same_s = _interleaved(lambda: None, lambda: reference(1e-8), rounds)
+    erk_s, _ = _interleaved(lambda: sim("erk"), lambda: None, max(2, rounds // 5))
+    return NativeRow(name, f"numba({chosen:.0e})", sim_s, ref_s, sim_err, ref_err, target, same_s, erk_s)
 
 
 def _feedback_rows(rounds: int) -> list[NativeRow]:
@@ -167,21 +178,7 @@ def _feedback_rows(rounds: int) -> list[NativeRow]:
     def sim(method: str = "native") -> Any:
         return pf.simulate(system, 0.0, t_end=1.0, rtol=1e-8, feedback=fb, method=method)
 
-    exact = reference(1e-13)[0]
-    res = sim()
-    sim_err = _error(res.reversals.t, res.reversals.x, res.reversals.F, exact)
-    chosen, ref_err = _LADDER[-1], math.inf
-    for rtol in _LADDER:  # the loosest reference at least as accurate as simulate
-        rev = reference(rtol)[0]
-        err = _error(rev[0], rev[1], rev[2], exact)
-        if err <= sim_err:
-            chosen, ref_err = rtol, err
-            break
-    sim_s, ref_s = _interleaved(sim, lambda: reference(chosen), rounds)
-    _, same_s = _interleaved(lambda: None, lambda: reference(1e-8), rounds)
-    erk_s, _ = _interleaved(lambda: sim("erk"), lambda: None, max(2, rounds // 5))
-    return [NativeRow("Dahl in a continuous PID loop, sine reference", f"numba({chosen:.0e})", sim_s, ref_s, sim_err,
-                      ref_err, 2.0, same_s, erk_s)]
+    return [_matched_row("Dahl in a continuous PID loop, sine reference", sim, reference, 2.0, rounds)]
 
 
 def _loop_rows(rounds: int) -> list[NativeRow]:
