@@ -92,6 +92,7 @@ def test_linear_hold_matches_scipy_with_u_linear_between_samples(fitted, held_ou
     assert np.max(np.abs(zoh - x_hat)) > 1e3 * np.max(np.abs(x_hat - np.array(x_ref)))  # the hold matters
 
 
+@pytest.mark.slow  # six fits (20 s of CPU); the fast suite keeps one closed-loop fit against the truth (above)
 def test_intervals_cover_the_truth_over_seeds():
     """Dahl + Viscous (6 records of 800 samples): each parameter inside its 95 % interval in >= 5 of 6."""
     true = pf.Dahl(sigma=1.0e6, Fc=20.39)

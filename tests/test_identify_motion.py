@@ -80,12 +80,8 @@ def test_free_decay_cannot_separate_mass_sigma_and_Fc(clean, exact_times):
     assert res.estimate("Fc") / res.estimate("mass") == pytest.approx(TRUE.Fc / MASS, rel=0.02)
 
 
-def test_motion_rejects_models_with_events(clean):
+def test_motion_rejects_invalid_reversal_times(clean):
     data = noisy(clean, 0)
-    with pytest.raises(ValueError, match="Motion fits support models without in-branch events"):
-        identify.fit(pf.Dahl(1e4, 1.0, 0.5), data, fixed=["gamma"])
-    with pytest.raises(ValueError, match="Motion fits support models without in-branch events"):
-        identify.fit(pf.MaxwellSlip([1e4], [1.0]), data)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         with pytest.raises(ValueError, match="reversals must be finite times inside the record"):

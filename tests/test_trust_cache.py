@@ -12,6 +12,7 @@ root, "another user" is uid 12345 (``os.chown``).
 
 from __future__ import annotations
 
+import functools
 import os
 import shutil
 import stat
@@ -85,6 +86,7 @@ def _chown_tree(path: Path, uid: int) -> None:
         os.chown(p, uid, uid)
 
 
+@functools.cache  # one Radau integration (0.8 s) for the four tests that compare with it
 def _second_reversal() -> float:
     """The force [N] at the second reversal of the victim's run, from an independent Radau
     integration of the equations (m x'' = -F, dF/dt = sigma v (1 - F/Fc sgn v), branch by branch)."""

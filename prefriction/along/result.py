@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import threading
 from pathlib import Path
+from typing import Callable, Union
 
 import numpy as np
 
@@ -11,10 +12,17 @@ from prefriction.models.base import FrictionModel
 
 __all__ = ["AlongResult"]
 
+Detail = tuple[np.ndarray, np.ndarray]
+"""The states ``[z, m]`` at every sample (``n x (n_states + n_flags)``) and the events per interval."""
 
-@dataclass(frozen=True, repr=False)
+
 class AlongResult:
     """Friction force of a model along a prescribed motion (:func:`prefriction.friction_along`).
+
+    The force, the reversals and the number of events come with the run. The velocities, the
+    states, the flags and the events per sample are made on first access (the states by the
+    same deterministic pass run again with its states written, ``docs/along.md#states-on-access``), so a
+    run that needs only the force does not pay for them. ``t`` and ``x`` are read-only.
 
     Attributes
     ----------
@@ -34,6 +42,8 @@ class AlongResult:
     events : numpy.ndarray
         Number of model events (saturations, element slips) in the interval that ends at each
         sample (0 at the first).
+    n_events : int
+        Total number of model events along the motion.
     reversals : numpy.ndarray
         Indices of the samples where the motion reverses.
     F0 : float
@@ -41,26 +51,63 @@ class AlongResult:
     step : str
         ``"exact"`` (the model's closed-form step) or ``"rk4 x N"`` (``N`` Runge-Kutta sub-steps).
     seconds : float
-        Wall time of the run [s] (without the one-off build and compilation).
+        Wall time of the run [s] (without the one-off build and compilation, and without the
+        states made on first access).
     """
 
-    model: FrictionModel
-    t: np.ndarray
-    x: np.ndarray
-    F: np.ndarray
-    v: np.ndarray
-    states: np.ndarray
-    flags: np.ndarray
-    events: np.ndarray
-    reversals: np.ndarray
-    F0: float
-    step: str
-    seconds: float
+    def __init__(self, model: FrictionModel, t: np.ndarray, x: np.ndarray, F: np.ndarray,
+                 v: Union[np.ndarray, Callable[[], np.ndarray]], detail: Union[Detail, Callable[[], Detail]],
+                 n_events: int, reversals: np.ndarray, F0: float, step: str, seconds: float) -> None:
+        self.model, self.t, self.x, self.F, self.reversals = model, t, x, F, reversals
+        self.n_events, self.F0, self.step, self.seconds = int(n_events), float(F0), step, float(seconds)
+        for a in (t, x):  # the motion that the states made on first access follow
+            a.flags.writeable = False
+        self._made: dict[str, object] = {}
+        self._makers = {"v": v, "detail": detail}
+        self._lock = threading.Lock()
+
+    def _get(self, key: str) -> object:
+        """The value ``key`` (``"v"``, or ``"detail"``: states, flags, events), made once on first
+        access (thread-safe)."""
+        with self._lock:
+            if key not in self._made:
+                maker = self._makers[key]
+                made = maker() if callable(maker) else maker
+                if key == "detail":
+                    X, ev = made
+                    nz = self.model.n_states
+                    made = (X[:, :nz], X[:, nz:], ev)
+                self._made[key] = made
+            return self._made[key]
+
+    def __reduce__(self) -> tuple:
+        """Pickled with its states made (a result travels to and from worker processes)."""
+        states, flags, events = self._split()
+        return (AlongResult, (self.model, self.t, self.x, self.F, self.v, (np.hstack((states, flags)), events),
+                              self.n_events, self.reversals, self.F0, self.step, self.seconds))
 
     @property
-    def n_events(self) -> int:
-        """Total number of model events along the motion."""
-        return int(self.events.sum())
+    def v(self) -> np.ndarray:
+        """Velocity [m/s] at every sample that the rate-dependent part of the force used."""
+        return self._get("v")  # type: ignore[return-value]
+
+    def _split(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        return self._get("detail")  # type: ignore[return-value]
+
+    @property
+    def states(self) -> np.ndarray:
+        """The model's continuous states ``z`` at every sample, shape ``(n, n_states)`` (normalised)."""
+        return self._split()[0]
+
+    @property
+    def flags(self) -> np.ndarray:
+        """The model's flags ``m`` (0 or 1) at every sample, shape ``(n, n_flags)``."""
+        return self._split()[1]
+
+    @property
+    def events(self) -> np.ndarray:
+        """Number of model events in the interval that ends at each sample (0 at the first)."""
+        return self._split()[2]
 
     def __repr__(self) -> str:
         return (f"AlongResult({type(self.model).__name__}: {self.t.size} samples over {self.t[-1] - self.t[0]:.4g} s, "

@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
+import functools
 import time
-from typing import Any
+from typing import Any, Optional
 
 import numpy as np
 
@@ -72,7 +73,8 @@ def friction_along(model: FrictionModel, t: Any, x: Any, *, F0: float = 0.0, v: 
     -------
     AlongResult
         ``t``, ``x``, ``F`` [N], the velocities used, the states and flags, the events per
-        interval and the reversal samples; ``summary()`` and ``plot(path)``.
+        interval (these four made on first access, ``docs/along.md#states-on-access``), the
+        number of events and the reversal samples; ``summary()`` and ``plot(path)``.
 
     Raises
     ------
@@ -100,33 +102,57 @@ def friction_along(model: FrictionModel, t: Any, x: Any, *, F0: float = 0.0, v: 
     lib = along_driver(model, run.substeps)
     fast = None if lib is None else fast_samples(lib, t, x, v)  # checked in C
     motion = Motion.of(t, x, v) if fast is None else None  # checks and names what is wrong
-    t_arr = motion.t if fast is None else fast[0]
-    k = model.n_states + model.n_flags  # the state of every sample, kept three times at the peak
+    if fast is not None:
+        t_arr, x_arr, v_arr = fast
+    else:  # Motion.of's arrays are its own
+        t_arr, x_arr, v_arr = motion.t, motion.x, None if v is None else motion.v_at
+    v_arr = None if v_arr is None else v_arr.copy()  # the result's own
+    k = model.n_states + model.n_flags  # the states of every sample (made on first access), three times at the peak
     check_memory(f"friction_along of {type(model).__name__} ({k} states and flags per sample)", t_arr.size,
                  16 + 3 * k, "samples", "pass fewer samples, or feed the record through prefriction.FrictionStream "
                  "(one sample at a time, in constant memory)")
-    s0 = motion.s0 if fast is None else first_direction(lib, fast[1])
+    s0 = motion.s0 if fast is None else first_direction(lib, x_arr)
     F0, X0 = initial_state(model, F0, s0)
     start = time.perf_counter()
     U = Units.of(model)
     q = np.asarray(model.runtime_params(), dtype=float)
-    if lib is not None:  # one C pass over the motion writing into the result's arrays (prefriction.along.native)
-        t_arr, x_arr, v_arr = fast if fast is not None else (motion.t, motion.x, None if v is None else motion.v_at)
+    step = "exact" if run.exact else f"rk4 x {substeps}"
+    v_at = functools.partial(_velocities, t_arr, x_arr, v_arr)
+    if lib is not None:  # one C pass over the motion writing the forces (prefriction.along.native)
         v0 = (v_arr[0] if v_arr is not None else (x_arr[1] - x_arr[0]) / (t_arr[1] - t_arr[0])) / U.v
         _X, F_first, _e = run.step(X0, 0.0, 0.0, s0, s0, v0, q)
-        X, F, ev, v_at, reversals = run_native(lib, X0, float(F_first), t_arr, x_arr, v_arr, s0, q, U)
-    else:
-        v_at, reversals, x_arr = motion.v_at, motion.reversals, motion.x
-        _X, F_first, _e = run.step(X0, 0.0, 0.0, s0, s0, v_at[0] / U.v, q)
-        rows = np.vstack([motion.v / U.v, motion.dt / U.t, motion.s_prev, motion.s, motion.v_at[1:] / U.v])
-        Xb, Fb, evb = run.run(X0, rows, q)
-        F = U.F * np.concatenate(([float(F_first)], Fb))
-        X = np.hstack((X0[:, None], Xb)).T
-        ev = np.concatenate(([0], evb.astype(int)))
+        done = run_native(lib, X0, float(F_first), t_arr, x_arr, v_arr, s0, q, U)
+        if not done.finite:
+            _check_finite(done.F, t_arr)
+        replay = functools.partial(_replay, lib, X0, float(F_first), t_arr, x_arr, v_arr, s0, q, U)
+        return AlongResult(model, t_arr, x_arr, done.F, v_at, replay, done.n_events, done.reversals, F0, step,
+                           time.perf_counter() - start)
+    _X, F_first, _e = run.step(X0, 0.0, 0.0, s0, s0, motion.v_at[0] / U.v, q)
+    rows = np.vstack([motion.v / U.v, motion.dt / U.t, motion.s_prev, motion.s, motion.v_at[1:] / U.v])
+    Xb, Fb, evb = run.run(X0, rows, q)
+    F = U.F * np.concatenate(([float(F_first)], Fb))
     _check_finite(F, t_arr)
-    nz = model.n_states
-    return AlongResult(model, t_arr, x_arr, F, v_at, X[:, :nz], X[:, nz:], ev, reversals, F0,
-                       "exact" if run.exact else f"rk4 x {substeps}", time.perf_counter() - start)
+    X = np.hstack((X0[:, None], Xb)).T
+    ev = np.concatenate(([0], evb.astype(np.int64)))
+    return AlongResult(model, t_arr, x_arr, F, v_at, (X, ev), int(ev.sum()), motion.reversals, F0, step,
+                       time.perf_counter() - start)
+
+
+def _velocities(t: np.ndarray, x: np.ndarray, v: Optional[np.ndarray]) -> np.ndarray:
+    """The velocities [m/s] at the samples (``docs/along.md#motion``): the user's ``v``, else the
+    velocity of the interval that ends at each sample (of the first interval at the first)."""
+    if v is not None:
+        return v
+    vi = np.diff(x) / np.diff(t)
+    return np.concatenate((vi[:1], vi))
+
+
+def _replay(lib: Any, X0: np.ndarray, F_first: float, t: np.ndarray, x: np.ndarray, v: Optional[np.ndarray],
+            s0: float, q: np.ndarray, U: Units) -> tuple[np.ndarray, np.ndarray]:
+    """The states and event counts at every sample: the run's C pass again, its states written."""
+    done = run_native(lib, X0, F_first, t, x, v, s0, q, U, states=True)
+    assert done.X is not None and done.events is not None
+    return done.X, done.events
 
 
 def _check_finite(F: np.ndarray, t: np.ndarray) -> None:

@@ -255,6 +255,11 @@ def fit_closed_loop(model: FrictionModel, data: Motion, loop: DigitalLoop, refer
 
     if not isinstance(model, FrictionModel):
         raise TypeError(f"model must be a prefriction.FrictionModel, got {type(model).__name__}")
+    if model.n_flags:
+        raise ValueError(f"model {type(model).__name__} has {model.n_flags} event flags (in-branch events): the "
+                         f"closed-loop simulation carries none; fit it with identify.fit_inverse (any model) or "
+                         f"the open-loop identify.fit on Motion data, or use a model without flags (Dahl with "
+                         f"gamma >= 1, LuGre, ElastoPlastic(..., crossings=False))")
     if not isinstance(data, Motion):
         raise TypeError(f"data must be prefriction.identify.Motion, got {type(data).__name__}")
     check_solver(max_iter, tol, identifiability_limit)

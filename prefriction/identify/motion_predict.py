@@ -87,14 +87,14 @@ def predict_motion(result: Any, data: Motion, *, v0: float | None = None, F0: fl
         raise ValueError(f"substeps must be an integer in [1, 64], got {substeps!r}")
     n_sub = _substeps(model, data, m, float(np.max(np.abs(v))), substeps)
     s0 = 1.0 if v0 > 0 else -1.0 if v0 < 0 else (1.0 if data.u[0] - off - F0 >= 0 else -1.0)
-    z0 = model.initial_state(F0 / model.Fc, s0)[0]
+    z0, m0 = model.initial_state(F0 / model.Fc, s0)
     sc = Scales(x=model.Fc / model.sigma, F=model.Fc, t=math.sqrt(m / model.sigma),
                 v=model.Fc / math.sqrt(m * model.sigma), E=model.Fc**2 / model.sigma)
     pp = np.r_[m, model.sigma, model.Fc, off, np.asarray(model.runtime_params_for(sc), dtype=float)]
     u0 = data.u[:-1]
     u1 = u0 if data.hold == "zoh" else data.u[1:]
     sim = _simulator(model, n_sub, len(data) - 1)
-    Y = np.asarray(sim(np.r_[float(data.x[0]), v0, z0, s0], u0[None, :], u1[None, :], np.diff(data.t)[None, :], pp))
+    Y = np.asarray(sim(np.r_[float(data.x[0]), v0, z0, m0, s0], u0[None, :], u1[None, :], np.diff(data.t)[None, :], pp))
     return np.r_[data.x[0], Y[0]]
 
 

@@ -14,6 +14,12 @@ e.g. Dahl's log-gap), Runge-Kutta on the new branch for the rest. A velocity lef
 on the old side of zero by the cut does not turn the branch back. No step straddles a reversal
 by more than the error of that prediction, where the velocity and so the rates are small.
 
+A model with in-branch events carries its flags beside the direction. On the part of a
+sub-step before a reversal each event is located at the zero of its indicator (secant from a
+Runge-Kutta trial step, refined by one Newton step on the quadratic through three values), the
+model's ``on_event`` applied there and the rest integrated (:func:`_branch`); the event time is
+a differentiable function of the state and the parameters, so the sensitivities carry its jump.
+
 Forward sensitivities ride along: the carried matrix ``S = dy/dw`` of a segment is propagated
 sample by sample, ``S <- (dy+/dy) S + (dy+/dp) (dp/dw)``, with the small Jacobians of one sample
 built symbolically once. A segment is that step repeated with ``mapaccum`` over ``K`` samples;
@@ -51,14 +57,15 @@ def _rk4(f: Any, y: list[Any], tau: Any, h: Any) -> list[Any]:
 def step_function(model: FrictionModel, n_sub: int) -> ca.Function:
     """``(y, u0, u1, dt, pp) -> y+``: one sample of the forced oscillator (SX ``Function``).
 
-    ``y = [x, v, z, s]`` (position [m], velocity [m/s], the model's normalised states, the
-    direction +-1), ``u0``, ``u1`` the applied force [N] at the start and end of the sample (equal
-    for a held force), ``dt`` [s] the sample interval (0 leaves ``y`` unchanged) and
-    ``pp = [m, sigma, Fc, F_off, q]`` (mass [kg], reference stiffness [N/m], reference force [N],
-    force offset [N], the model's run-time numbers).
+    ``y = [x, v, z, m, s]`` (position [m], velocity [m/s], the model's normalised states, its
+    flags (none for a model without events), the direction +-1), ``u0``, ``u1`` the applied
+    force [N] at the start and end of the sample (equal for a held force), ``dt`` [s] the sample
+    interval (0 leaves ``y`` unchanged) and ``pp = [m, sigma, Fc, F_off, q]`` (mass [kg],
+    reference stiffness [N/m], reference force [N], force offset [N], the model's run-time
+    numbers). In-branch events are located inside the sub-steps (:func:`_branch`).
     """
-    nz, nq = model.n_states, len(model.runtime_params())
-    y = ca.SX.sym("y", 3 + nz)
+    nz, nf, nq = model.n_states, model.n_flags, len(model.runtime_params())
+    y = ca.SX.sym("y", 3 + nz + nf)
     u0, u1, dt = ca.SX.sym("u0"), ca.SX.sym("u1"), ca.SX.sym("dt")
     pp = ca.SX.sym("pp", 4 + nq)
     m, sigma, Fc, off = pp[0], pp[1], pp[2], pp[3]
@@ -66,30 +73,103 @@ def step_function(model: FrictionModel, n_sub: int) -> ca.Function:
     T, V = ca.sqrt(m / sigma), Fc / ca.sqrt(m * sigma)
     slope = (u1 - u0) / ca.fmax(dt, 1e-300)
 
-    def rhs(s: Any) -> Any:
+    def rhs(s: Any, flags: list[Any]) -> Any:
         def f(yy: list[Any], tau: Any) -> list[Any]:
             z, vn = yy[2:], yy[1] / V
-            F = Fc * model.force(z, [], vn, s, q)
-            return [yy[1], (u0 + slope * tau - F - off) / m, *[r / T for r in model.rate(z, [], vn, s, q)]]
+            F = Fc * model.force(z, flags, vn, s, q)
+            return [yy[1], (u0 + slope * tau - F - off) / m, *[r / T for r in model.rate(z, flags, vn, s, q)]]
         return f
 
+    passes = min(model.n_events, MAX_EVENTS)
     h = dt / n_sub
     yl = [y[i] for i in range(2 + nz)]
-    s = y[2 + nz]
+    fl = [y[2 + nz + i] for i in range(nf)]
+    s = y[2 + nz + nf]
     for k in range(n_sub):
         tau = k * h
-        a0 = rhs(s)(yl, tau)[1]
+        a0 = rhs(s, fl)(yl, tau)[1]
         v0, v1 = yl[1], yl[1] + h * a0
         turn = ca.logic_or(s * v0 < 0.0, s * v1 < 0.0)
         frac = ca.if_else(turn, ca.if_else(s * v0 > 0.0, v0 / (v0 - v1), 0.0), 1.0)
-        ya = _rk4(rhs(s), yl, tau, frac * h)
+        if passes:
+            ya, fa = _branch(model, rhs, yl, fl, s, tau, frac * h, passes, V, q)
+        else:
+            ya, fa = _rk4(rhs(s, fl), yl, tau, frac * h), fl
         s_new = ca.if_else(turn, -s, s)
-        zr, _ = model.reverse(ya[2:], [], s_new, q, 1e-12)
+        zr, fr = model.reverse(ya[2:], fa, s_new, q, 1e-12)
         zr = [ca.fmin(ca.fmax(a, -STATE_CAP), STATE_CAP) for a in zr]
         ya = ya[:2] + [ca.if_else(turn, a, b) for a, b in zip(zr, ya[2:])]
-        yl = _rk4(rhs(s_new), ya, tau + frac * h, (1.0 - frac) * h)
+        fl = [ca.if_else(turn, a, b) for a, b in zip(fr, fa)]
+        yl = _rk4(rhs(s_new, fl), ya, tau + frac * h, (1.0 - frac) * h)
         s = s_new
-    return ca.Function("motion_step", [y, u0, u1, dt, pp], [ca.vertcat(*yl, s)])
+    return ca.Function("motion_step", [y, u0, u1, dt, pp], [ca.vertcat(*yl, *fl, s)])
+
+
+MAX_EVENTS = 4
+"""Most in-branch events located inside one sub-step (on its part before a reversal); a further
+one fires at the start of the next sub-step (its indicator is then negative)."""
+
+
+def _branch(model: FrictionModel, rhs: Any, y: list[Any], flags: list[Any], s: Any, tau: Any, length: Any,
+            passes: int, V: Any, q: list[Any]) -> tuple[list[Any], list[Any]]:
+    """``length`` of time on the branch of direction ``s`` from ``(y, flags)`` at ``tau``, the
+    in-branch events located inside it (symbolic, one expression).
+
+    Each pass takes a Runge-Kutta trial step over what is left. An event whose indicator is
+    positive at the start and not at the trial's end is located at the zero of the indicator's
+    secant, ``theta = g0 / (g0 - g1)`` of the remaining length; one already not positive fires at
+    once (``theta = 0``). The earliest event is applied: Runge-Kutta up to it, ``on_event``, and
+    the next pass continues from there. ``theta`` is a differentiable function of the state and
+    the parameters, so the forward sensitivities carry the jump of the event time (saltation).
+    After ``passes`` passes a last Runge-Kutta step covers the rest of the length.
+    """
+    nz = model.n_states
+    left = length
+    for _ in range(passes):
+        trial = _rk4(rhs(s, flags), y, tau, left)
+        g0 = model.events(y[2:], flags, y[1] / V, s, q)
+        g1 = model.events(trial[2:], flags, trial[1] / V, s, q)
+        best, sel = ca.SX(2.0), ca.SX(-1.0)
+        for k, (a, b) in enumerate(zip(g0, g1)):
+            cross = ca.logic_and(a > 0.0, b <= 0.0)
+            theta = ca.if_else(a <= 0.0, 0.0, ca.if_else(cross, a / ca.if_else(cross, a - b, 1.0), 2.0))
+            better = theta < best
+            best = ca.if_else(better, theta, best)
+            sel = ca.if_else(better, float(k), sel)
+        hit = best <= 1.0
+        theta = ca.if_else(hit, best, 1.0)
+        # one Newton step on the quadratic through the indicator at 0, theta and 1
+        ym = _rk4(rhs(s, flags), y, tau, theta * left)
+        gs = _selected(sel, g0), _selected(sel, model.events(ym[2:], flags, ym[1] / V, s, q)), _selected(sel, g1)
+        inner = ca.logic_and(theta > 0.0, theta < 1.0)
+        d0, d1 = theta, 1.0 - theta
+        slope = (ca.if_else(inner, (gs[1] - gs[0]) / ca.if_else(inner, d0, 1.0) + (gs[2] - gs[1]) / ca.if_else(inner, d1, 1.0), 0.0)
+                 - (gs[2] - gs[0]))
+        newton = theta - gs[1] / ca.if_else(slope < 0.0, slope, -1.0)
+        theta = ca.if_else(ca.logic_and(inner, slope < 0.0), ca.fmin(ca.fmax(newton, 0.0), 1.0), theta)
+        step = theta * left
+        ye = _rk4(rhs(s, flags), y, tau, step)
+        ze, fe = _fire(model, sel, ye[2:], flags, s, q)
+        y = ye[:2] + [ca.if_else(hit, a, b) for a, b in zip(ze, ye[2:2 + nz])]
+        flags = [ca.if_else(hit, a, b) for a, b in zip(fe, flags)]
+        tau, left = tau + step, left - step
+    return _rk4(rhs(s, flags), y, tau, left), flags
+
+
+def _fire(model: FrictionModel, sel: Any, z: list[Any], flags: list[Any], s: Any,
+          q: list[Any]) -> tuple[list[Any], list[Any]]:
+    """The state just after the in-branch event of symbolic index ``sel`` (``on_event_at`` where
+    the model has it: one expression for every index; else ``on_event`` of each, selected)."""
+    at = getattr(model, "on_event_at", None)
+    if at is not None:
+        zn, fn = at(sel, z, flags, s, q)
+        return list(zn), list(fn)
+    zo, fo = list(z), list(flags)
+    for k in range(model.n_events):
+        zk, fk = model.on_event(k, z, flags, s, q)
+        zo = [ca.if_else(sel == k, a, b) for a, b in zip(zk, zo)]
+        fo = [ca.if_else(sel == k, a, b) for a, b in zip(fk, fo)]
+    return zo, fo
 
 
 def _units_function(model: FrictionModel, space: ParameterSpace, mass_free: bool) -> ca.Function:
@@ -111,26 +191,28 @@ def segment_functions(model: FrictionModel, space: ParameterSpace, K: int, n_sub
                       mass_free: bool) -> tuple[ca.Function, ca.Function]:
     """The shooting segment of ``K`` samples, with and without forward sensitivities (cached).
 
-    Inputs of both: ``node`` (the scaled start state ``[x / Xs, v / Vs, z]``), ``s0`` (its
-    direction), ``s_to`` (the direction of the next node), ``theta`` and ``scale`` (the free
+    Inputs of both: ``node`` (the scaled start state ``[x / Xs, v / Vs, z]``), ``m0`` (its
+    flags, none for a model without events), ``s0`` (its direction), ``s_to`` (the direction of
+    the next node), ``theta`` and ``scale`` (the free
     parameters are ``theta * scale``), ``fixed``, ``mass``,
     ``U0``, ``U1``, ``DT`` (rows of ``K`` samples) and ``scl = [Xs, Vs]``. Outputs: ``X``
-    (``2 x (K + 1)``: position [m] and velocity [m/s] at the node and after each sample) and
-    ``Ye`` (the scaled end state in the coordinates of ``s_to``); the sensitive one adds ``dX``
+    (``2 x (K + 1)``: position [m] and velocity [m/s] at the node and after each sample), ``Ye``
+    (the scaled end state in the coordinates of ``s_to``) and ``Me`` (its flags in those
+    coordinates: they ride along like the direction, without derivatives); the sensitive one adds ``dX``
     (``ncol x (K + 1)``: ``dx/dw`` of each position) and ``dYe`` (``ny x ncol``), ``w`` the
     segment's ``[theta, node]``.
     """
     key = (type(model), model.structure_key(), tuple(space.free), tuple(space.fixed), K, n_sub, mass_free)
     if key in _CACHE:
         return _CACHE[key]
-    nz, nq = model.n_states, len(model.runtime_params())
+    nz, nf, nq = model.n_states, model.n_flags, len(model.runtime_params())
     ny, nth = 2 + nz, space.n_free
     ncol = nth + ny
     step = step_function(model, n_sub)
     units = _units_function(model, space, mass_free)
 
-    # one sample with sensitivities: carry c = [y (ny + 1); vec(S) (ny * ncol)]
-    y = ca.SX.sym("y", ny + 1)
+    # one sample with sensitivities: carry c = [y (ny + nf + 1); vec(S) (ny * ncol)]
+    y = ca.SX.sym("y", ny + nf + 1)
     S = ca.SX.sym("S", ny, ncol)
     u0, u1, dt = ca.SX.sym("u0"), ca.SX.sym("u1"), ca.SX.sym("dt")
     pp = ca.SX.sym("pp", 4 + nq)
@@ -147,20 +229,23 @@ def segment_functions(model: FrictionModel, space: ParameterSpace, K: int, n_sub
     plain_acc = plain_step.mapaccum("plain_segment", K)
 
     # the end state in the coordinates of the next node's direction, scaled
-    ye = ca.SX.sym("ye", ny + 1)
+    ye = ca.SX.sym("ye", ny + nf + 1)
     s_to = ca.SX.sym("s_to")
     scl = ca.SX.sym("scl", 2)
     q = [pp[4 + i] for i in range(nq)]
-    zr, _ = model.reverse([ye[2 + i] for i in range(nz)], [], s_to, q, 1e-12)
-    flip = ye[ny] != s_to
+    fe = [ye[ny + i] for i in range(nf)]
+    zr, fr = model.reverse([ye[2 + i] for i in range(nz)], fe, s_to, q, 1e-12)
+    flip = ye[ny + nf] != s_to
     z_to = [ca.if_else(flip, a, ye[2 + i]) for i, a in enumerate(zr)]
     Ye = ca.vertcat(ye[0] / scl[0], ye[1] / scl[1], *z_to)
-    end = ca.Function("end", [ye, s_to, pp, scl], [Ye])
+    Me = ca.vertcat(*[ca.if_else(flip, a, b) for a, b in zip(fr, fe)]) if nf else ca.SX(0, 1)
+    end = ca.Function("end", [ye, s_to, pp, scl], [Ye, Me])
     Se = ca.SX.sym("Se", ny, ncol)
     dYe = ca.mtimes(ca.jacobian(Ye, ye[:ny]), Se) + ca.mtimes(ca.jacobian(Ye, pp), dpp)
-    end_sens = ca.Function("end_sens", [ye, Se, s_to, pp, dpp, scl], [Ye, dYe])
+    end_sens = ca.Function("end_sens", [ye, Se, s_to, pp, dpp, scl], [Ye, Me, dYe])
 
     node = ca.MX.sym("node", ny)
+    m0 = ca.MX.sym("m0", nf)
     s0, s_next = ca.MX.sym("s0"), ca.MX.sym("s_to")
     th = ca.MX.sym("theta", nth)
     scale = ca.MX.sym("scale", nth)
@@ -169,13 +254,14 @@ def segment_functions(model: FrictionModel, space: ParameterSpace, K: int, n_sub
     U0, U1, DT = ca.MX.sym("U0", 1, K), ca.MX.sym("U1", 1, K), ca.MX.sym("DT", 1, K)
     sc = ca.MX.sym("scl", 2)
     p_mx = units(th, scale, fx, mass)
-    y0 = ca.vertcat(node[0] * sc[0], node[1] * sc[1], node[2:], s0)
-    inputs = [node, s0, s_next, th, scale, fx, mass, U0, U1, DT, sc]
-    names = ["node", "s0", "s_to", "theta", "scale", "fixed", "mass", "U0", "U1", "DT", "scl"]
+    y0 = ca.vertcat(node[0] * sc[0], node[1] * sc[1], node[2:], m0, s0)
+    inputs = [node, m0, s0, s_next, th, scale, fx, mass, U0, U1, DT, sc]
+    names = ["node", "m0", "s0", "s_to", "theta", "scale", "fixed", "mass", "U0", "U1", "DT", "scl"]
 
     C, O = plain_acc(y0, U0, U1, DT, ca.repmat(p_mx, 1, K))
     X = ca.horzcat(y0[:2], O)
-    plain = ca.Function("segment", inputs, [X, end(C[:, K - 1], s_next, p_mx, sc)], names, ["X", "Ye"])
+    Ye, Me = end(C[:, K - 1], s_next, p_mx, sc)
+    plain = ca.Function("segment", inputs, [X, Ye, Me], names, ["X", "Ye", "Me"])
 
     w = ca.vertcat(th, node)
     dp_mx = ca.horzcat(ca.jacobian(p_mx, th), ca.MX.zeros(4 + nq, ny))
@@ -184,7 +270,15 @@ def segment_functions(model: FrictionModel, space: ParameterSpace, K: int, n_sub
     X = ca.horzcat(y0[:2], O[:2, :])
     dX = ca.horzcat(S0[0, :].T, O[2:, :])
     cK = C[:, K - 1]
-    Ye, dYe = end_sens(cK[: ny + 1], ca.reshape(cK[ny + 1:], ny, ncol), s_next, p_mx, dp_mx, sc)
-    sens = ca.Function("segment_sens", inputs, [X, Ye, dX, dYe], names, ["X", "Ye", "dX", "dYe"])
+    Ye, Me, dYe = end_sens(cK[: ny + nf + 1], ca.reshape(cK[ny + nf + 1:], ny, ncol), s_next, p_mx, dp_mx, sc)
+    sens = ca.Function("segment_sens", inputs, [X, Ye, Me, dX, dYe], names, ["X", "Ye", "Me", "dX", "dYe"])
     _CACHE[key] = (plain, sens)
     return plain, sens
+
+
+def _selected(sel: Any, values: list[Any]) -> Any:
+    """``values[sel]`` for a symbolic index ``sel`` (0 where ``sel`` is no index)."""
+    out = ca.SX(0.0)
+    for k, value in enumerate(values):
+        out = ca.if_else(sel == k, value, out)
+    return out

@@ -123,7 +123,13 @@ def _mapped(model: FrictionModel, space: ParameterSpace, K: int, n_sub: int, mas
 
 
 class _Problem:
-    """Residuals, constraints and their sparse Jacobians of one record, layout and parameter set."""
+    """Residuals, constraints and their sparse Jacobians of one record, layout and parameter set.
+
+    A model with flags gets them at each node as inputs, like the direction: at the first node
+    those of its start state, at the others none set, so that the node's state decides (an event
+    indicator not positive fires at once: a saturated Dahl or a slipping Maxwell-slip element sits
+    on its limit). Flags inherited from the segment before would jump with the defects of a
+    multiple-shooting iterate and make the residuals discontinuous."""
 
     def __init__(self, model: FrictionModel, space: ParameterSpace, data: Motion, lay: _Layout, n_sub: int,
                  mass_free: bool, mass: float, xs: float) -> None:
@@ -136,7 +142,9 @@ class _Problem:
         self.gw = np.ones((lay.J - 1) * self.ny)
         s = lay.s
         self.args = dict(s0=s, s_to=np.r_[s[1:], s[-1]], scale=space.scale, fixed=self.fixed, mass=mass,
-                         U0=lay.U0[None, :], U1=lay.U1[None, :], DT=lay.DT[None, :], scl=lay.scl)
+                         U0=lay.U0[None, :], U1=lay.U1[None, :], DT=lay.DT[None, :], scl=lay.scl,
+                         m0=np.zeros((model.n_flags, lay.J)))
+        self.first_flags: list[float] = [0.0] * model.n_flags
 
     def carry_states(self, w: np.ndarray, single: ca.Function, everything: bool = False) -> np.ndarray:
         """``w`` with every node's model state after the first replaced by the end state of the
@@ -146,11 +154,13 @@ class _Problem:
         w = w.copy()
         th, nodes = self.split(w)
         a, K = self.args, self.lay.K
+        if a["m0"].size:
+            a["m0"][:, 0] = self.first_flags
         for j in range(self.lay.J - 1):
             cols = slice(j * K, (j + 1) * K)
-            out = single(node=nodes[:, j], theta=th, s0=a["s0"][j], s_to=a["s_to"][j], scale=a["scale"], fixed=a["fixed"],
-                         mass=a["mass"], U0=a["U0"][:, cols], U1=a["U1"][:, cols], DT=a["DT"][:, cols],
-                         scl=a["scl"])
+            out = single(node=nodes[:, j], m0=a["m0"][:, j], theta=th, s0=a["s0"][j], s_to=a["s_to"][j],
+                         scale=a["scale"], fixed=a["fixed"], mass=a["mass"], U0=a["U0"][:, cols],
+                         U1=a["U1"][:, cols], DT=a["DT"][:, cols], scl=a["scl"])
             ye = np.asarray(out["Ye"]).ravel()
             if np.all(np.isfinite(ye)):
                 nodes[:, j + 1] = ye if everything else np.r_[nodes[:2, j + 1], np.clip(ye[2:], -STATE_CAP, STATE_CAP)]
@@ -252,15 +262,17 @@ def _stiffness(model: FrictionModel, v: float, mass: float) -> float:
     lam = 0.0
     for vv in (v, 0.1 * v, 0.01 * v):
         for f in (-0.5, 0.0, 0.5):
-            z = [float(c) for c in model.initial_state(f, 1.0)[0]]
-            r0 = model.rate(z, [], vv, 1.0, q)
-            for i in range(len(z)):
-                dz = 1e-6 * max(1.0, abs(z[i]))
-                zp = list(z)
-                zp[i] += dz
-                lam = max(lam, max(abs(float(a) - float(b)) / dz for a, b in zip(model.rate(zp, [], vv, 1.0, q), r0)))
-            dv = 1e-6 * max(1.0, vv)
-            lam = max(lam, abs(float(model.force(z, [], vv + dv, 1.0, q)) - float(model.force(z, [], vv, 1.0, q))) / dv)
+            z0, m0 = model.initial_state(f, 1.0)
+            z = [float(c) for c in z0]
+            for m in ([float(c) for c in m0], [1.0] * model.n_flags):  # flags: as loaded, and every mode on
+                r0 = model.rate(z, m, vv, 1.0, q)
+                for i in range(len(z)):
+                    dz = 1e-6 * max(1.0, abs(z[i]))
+                    zp = list(z)
+                    zp[i] += dz
+                    lam = max(lam, max(abs(float(a) - float(b)) / dz for a, b in zip(model.rate(zp, m, vv, 1.0, q), r0)))
+                dv = 1e-6 * max(1.0, vv)
+                lam = max(lam, abs(float(model.force(z, m, vv + dv, 1.0, q)) - float(model.force(z, m, vv, 1.0, q))) / dv)
     return lam
 
 
@@ -281,16 +293,11 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
     Raises
     ------
     ValueError
-        If the model has in-branch events (not supported for motion data) or given reversal
-        times are invalid.
+        If given reversal times are invalid.
     prefriction.SolverError
         If the motion is not finite at the start values (a fit that does not converge returns
         with ``success = False`` instead).
     """
-    if model.n_events or model.n_flags:
-        raise ValueError(f"Motion fits support models without in-branch events or flags (Dahl with gamma >= 1, "
-                         f"LuGre, ElastoPlastic(..., crossings=False)); {type(model).__name__} has {model.n_events} events: "
-                         f"fit it to ForceDisplacement data{_without_events(model)}")
     steps: list[str] = []
     theta0 = space.theta0
     progress = _progress if verbose or len(data) >= LONG else None
@@ -350,7 +357,8 @@ def _solve_record(model: FrictionModel, data: Motion, space: ParameterSpace, the
     prob = _Problem(model, space, data, lay, n_sub, mass_free, mass, xs)
     single = segment_functions(model, space, lay.K, n_sub, mass_free)[0]
     for level in (0.5, 0.0):  # node states of the force balance, else of zero force (see _start)
-        w0 = prob.carry_states(_start(model, data, theta0, lay, xsm, v, a, mass, offset0, level), single)
+        w0, prob.first_flags = _start(model, data, theta0, lay, xsm, v, a, mass, offset0, level)
+        w0 = prob.carry_states(w0, single)
         prob.weigh(w0)
         r0, g0 = prob.plain_eval(w0)
         if np.all(np.isfinite(r0)) and np.all(np.isfinite(g0)):
@@ -363,7 +371,8 @@ def _solve_record(model: FrictionModel, data: Motion, space: ParameterSpace, the
     def restart(w: np.ndarray) -> np.ndarray:
         th = w[: space.n_free]
         at = space.values(th)
-        fresh = _start(space.build(at), data, th, lay, xsm, v, a, at.get("mass", mass), at.get("offset", 0.0), 0.5)
+        fresh, prob.first_flags = _start(space.build(at), data, th, lay, xsm, v, a, at.get("mass", mass),
+                                         at.get("offset", 0.0), 0.5)
         return prob.carry_states(fresh, single)
 
     out = solve(prob.full_eval, prob.plain_eval, w0, lo, hi, max_iter=max_iter, tol=tol, gtol=GTOL,
@@ -477,16 +486,19 @@ def _directions(t: np.ndarray, x: np.ndarray, v: np.ndarray, given: Any) -> np.n
 
 
 def _start(model: FrictionModel, data: Motion, theta: np.ndarray, lay: _Layout, xsm: np.ndarray,
-           v: np.ndarray, a: np.ndarray, mass: float, offset0: float, level: float) -> np.ndarray:
+           v: np.ndarray, a: np.ndarray, mass: float, offset0: float, level: float) -> tuple[np.ndarray, list[float]]:
     """Start vector: scaled parameters, then each node's ``[x / X, v / V, z]`` from the smoothed
     data, ``z`` the state of the force balance's friction ``u - m a - F_off`` clipped to
-    ``+-level Fc``."""
+    ``+-level Fc``; and the flags of that state at the first node."""
     X, V = lay.scl
-    nodes = []
+    nodes: list[float] = []
+    first: list[float] = []
     for k, s in zip(lay.nodes, lay.s):
         f = float(np.clip((data.u[k] - mass * a[k] - offset0) / model.Fc, -level, level))
-        nodes += [xsm[k] / X, v[k] / V, *model.initial_state(f, s)[0]]
-    return np.concatenate([theta, nodes])
+        z, m = model.initial_state(f, s)
+        nodes += [xsm[k] / X, v[k] / V, *z]
+        first = first or [float(c) for c in m]
+    return np.concatenate([theta, nodes]), first
 
 
 def _nuisance(model: FrictionModel, space: ParameterSpace, w: np.ndarray, prob: _Problem, data: Motion,
@@ -502,14 +514,9 @@ def _nuisance(model: FrictionModel, space: ParameterSpace, w: np.ndarray, prob: 
     q = [float(c) for c in fitted.runtime_params_for(sc)]
     node0 = w[space.n_free: space.n_free + prob.ny]
     v0 = float(node0[1] * prob.lay.scl[1])
-    F0 = float(model.force(list(node0[2:]), [], v0 / V, float(prob.lay.s[0]), q)) * fitted.Fc
+    F0 = float(model.force(list(node0[2:]), list(prob.args["m0"][:, 0]), v0 / V, float(prob.lay.s[0]), q)) * fitted.Fc
     t = data.t[prob.samples[prob.rows]]
     k = np.flatnonzero(np.sign(vel[1:]) * np.sign(vel[:-1]) < 0)
     tau = t[k] + (t[k + 1] - t[k]) * vel[k] / (vel[k] - vel[k + 1])
     return {"initial velocity v0 [m/s]": v0, "initial force F0 [N]": F0, "reversal times [s]": tau}
 
-
-def _without_events(model: FrictionModel) -> str:
-    """The hint for a model that has a form without events (ElastoPlastic's ``crossings=False``)."""
-    return ", or give it with crossings=False (the crossings inside the right-hand side)" \
-        if hasattr(model, "crossings") else ""

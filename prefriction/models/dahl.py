@@ -42,9 +42,11 @@ def force_of_p(p: Any, gamma: Any) -> Any:
     e = 1.0 - gamma
     q = e * p
     if _sym(p, gamma):
-        inside = -ca.expm1(ca.log1p(-ca.fmin(q, 1.0 - 1e-16)) / e)
+        # fmax: no branch force below -1 (|F| <= Fc; an unreachable state, e.g. a trial point of
+        # a fit, would overflow for gamma near 1); fmin past saturation likewise
+        inside = -ca.expm1(ca.log1p(-ca.fmin(ca.fmax(q, 1.0 - 2.0 ** e), 1.0 - 1e-16)) / e)
         # fmax: pow(0, y) with a symbolic y has a NaN derivative in y (log 0 * 0)
-        past = 1.0 - ca.cos(math.pi / e) * ca.fmax(q - 1.0, 1e-300) ** (1.0 / e)
+        past = 1.0 - ca.cos(math.pi / e) * ca.fmin(ca.fmax(q - 1.0, 1e-300), 1.0) ** (1.0 / e)
         return ca.if_else(q < 1.0, inside, past)
     if q >= 1.0:
         return 1.0
@@ -55,8 +57,8 @@ def p_of_force(f: Any, gamma: Any) -> Any:
     """Branch distance ``p = (1 - (1 - f)^e) / e`` of the branch force ``f`` for gamma < 1
     (inverse of :func:`force_of_p`; ``1 / e`` at saturation ``f >= 1``)."""
     e = 1.0 - gamma
-    if _sym(f, gamma):
-        return -ca.expm1(e * ca.log1p(-ca.fmin(f, 1.0))) / e
+    if _sym(f, gamma):  # if_else: log1p(-1) = -inf would make the derivative at saturation inf * 0
+        return ca.if_else(f < 1.0, -ca.expm1(e * ca.log1p(-f)) / e, 1.0 / e)
     if f >= 1.0:
         return 1.0 / e
     return -math.expm1(e * math.log1p(-f)) / e

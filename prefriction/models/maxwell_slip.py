@@ -239,7 +239,7 @@ class MaxwellSlip(ParallelElements):
         zn, mn = list(z), list(m)
         for i in range(n):
             w = q[n + i]
-            z1 = z[i] + q[i] * v * dt * (1.0 - m[i])
+            z1 = z[i] + q[i] * (v * dt) * (1.0 - m[i])  # v dt: the displacement (exact where v = dx / dt)
             hit = s * z1 >= w * (1.0 - TIE)
             zn[i], mn[i] = pick(hit, s * w, z1), pick(hit, 1.0, m[i])
         return zn, mn

@@ -16,6 +16,7 @@ import numpy as np
 
 from prefriction.signals.compiled import linear_pieces
 from prefriction.simulation.dense import dense_loop
+from prefriction.simulation.loops.feedback_loop import run_feedback_loop
 from prefriction.simulation.native.forced import run_forced
 from prefriction.simulation.run import Run
 from prefriction.simulation.run_state import RunState
@@ -53,10 +54,15 @@ def drive(run: Run, t_end: float, n_target: float, times: Optional[np.ndarray], 
     return ([] if buf is None else buf), []
 
 
-def sampled_loop(run: Run, xc0: np.ndarray, t_end: float, n_target: float) -> tuple[SampleBuffer, list]:
+def sampled_loop(run: Run, xc0: np.ndarray, t_end: float,
+                 n_target: float) -> tuple[SampleBuffer, Union[list, np.ndarray]]:
     """Closed loop with a sampled controller: hold its output over each period ``Ts`` up to the
     normalised time ``t_end`` or ``n_target`` reversals; returns the samples at ``k Ts`` and the
-    total applied force there [N]."""
+    total applied force there [N]. On the native sampled loop where it was built
+    (:func:`~prefriction.simulation.loops.feedback_loop.run_feedback_loop`), else one CasADi call
+    per period."""
+    if run.native_loop is not None:
+        return run_feedback_loop(run, xc0, t_end, n_target)
     system, feedback, sc = run.system, run.fb, run.sc
     samples = SampleBuffer(len(xc0))
     u_hist: list = []
@@ -71,7 +77,7 @@ def sampled_loop(run: Run, xc0: np.ndarray, t_end: float, n_target: float) -> tu
         run.st["uhold"] = uk
         run.st["xc"] = xc.copy()
         samples.append(run.sample())
-        u_hist.append(uk + (float(system.u(t_si)) if system.forced else 0.0))
+        u_hist.append(uk + (_input_after(run, t_si, feedback.Ts) if system.forced else 0.0))
         if tk >= t_end * (1 - 1e-12):
             break
         xc = feedback.A @ xc + feedback.B[:, 0] * e
@@ -79,6 +85,16 @@ def sampled_loop(run: Run, xc0: np.ndarray, t_end: float, n_target: float) -> tu
             break
         k += 1
     return samples, u_hist
+
+
+def _input_after(run: Run, t: float, Ts: float) -> float:
+    """The oscillator's input force [N] applied from the sample instant ``t`` [s] on: a
+    piecewise-linear input's piece over ``[t, t + Ts]`` (its value after a break at ``t``, which
+    the round-off of ``t`` could place before it), else the input at ``t``."""
+    sig = run.spec.u_sig
+    if sig is not None and sig.key == ("PiecewiseLinear",):
+        return float(linear_pieces(sig, np.array([t]), np.array([t + Ts]))[0][0])
+    return float(run.system.u(t))
 
 
 def check_ramps(run: RunState, t_end: float, rtol: float) -> None:

@@ -35,8 +35,9 @@ DIED_OUT = 1e-20  # normalised speed below which an unforced motion has died out
 class BuiltPlant:
     """The plant of a run (:func:`prefriction.simulation.build.build_plant`): its layout ``L``
     and exactly one driver (``f1``: CasADi's integrator; ``native``: the unforced native driver;
-    ``native_forced``: the forced one; the others None), the setup time [s] (0 if reused) and
-    the JIT mode (``"interpreted"``, ``"cached"``, ...)."""
+    ``native_forced``: the forced one; ``native_loop``: the sampled loop of a sampled controller;
+    the others None), the setup time [s] (0 if reused) and the JIT mode (``"interpreted"``,
+    ``"cached"``, ...)."""
 
     L: Layout
     f1: Optional[BufferedIntegrator]
@@ -44,6 +45,7 @@ class BuiltPlant:
     native_forced: Any
     setup_time: float
     mode: str
+    native_loop: Any = None
 
 
 class RunState:
@@ -82,6 +84,7 @@ class RunState:
         # a sampled controller on a plant without a hold control: its force joins the input piece
         self.hold_in_piece = fb is not None and fb.sampled and spec.fb == "none"
         self.L, self.f1, self.native, self.native_forced = plant.L, plant.f1, plant.native, plant.native_forced
+        self.native_loop = plant.native_loop
         self.setup_time, self.mode = plant.setup_time, plant.mode
         self.calls = 0
         self.steps: Optional[int] = 0

@@ -13,7 +13,8 @@ machine), and prints the ratio (``docs/bench.md#native``):
   that of ``simulate``, both errors measured against the reference at ``rtol = 1e-13``.
 
 Targets: unforced headline <= 2x, forced sine rows <= 2x, Samples and dense rows
-<= 3x, loose-tolerance headline <= 3x, the exported C loop (``prefriction.export``, the same
+<= 3x, loose-tolerance headline <= 3x, 10 kHz PID loops (``controllers.simulate_loop`` and a
+sampled ``simulate(..., feedback=)``) <= 3x, the exported C loop (``prefriction.export``, the same
 native driver) <= 2x the numba loop.
 """
 
@@ -122,24 +123,35 @@ def _forced_rows(rounds: int) -> list[NativeRow]:
                       kind: int = kind, scale: np.ndarray = scale, up: np.ndarray = up) -> tuple:
             return nr.forced_run(model, mp, kind, up, ts, us, np.zeros(3), 1.0, 1.0, rtol, rtol * scale, tds)
 
-        exact = reference(1e-13)[0]
         kw = {} if dense is None else {"dense": dense}
-        res = pf.simulate(system, 0.0, t_end=1.0, rtol=1e-8, **kw)
-        sim_err = _error(res.reversals.t, res.reversals.x, res.reversals.F, exact)
-        chosen, ref_err = _LADDER[-1], math.inf
-        for rtol in _LADDER:  # the loosest reference at least as accurate as simulate
-            rev = reference(rtol)[0]
-            err = _error(rev[0], rev[1], rev[2], exact)
-            if err <= sim_err:
-                chosen, ref_err = rtol, err
-                break
-        sim_s, ref_s = _interleaved(lambda: pf.simulate(system, 0.0, t_end=1.0, rtol=1e-8, **kw),
-                                    lambda: reference(chosen), rounds)
-        _, same_s = _interleaved(lambda: None, lambda: reference(1e-8), rounds)
-        erk_s, _ = _interleaved(lambda: pf.simulate(system, 0.0, t_end=1.0, rtol=1e-8, method="erk", **kw),
-                                lambda: None, max(2, rounds // 5))
-        rows.append(NativeRow(name, f"numba({chosen:.0e})", sim_s, ref_s, sim_err, ref_err, target, same_s, erk_s))
+
+        def sim(method: str = "native", system: Any = system, kw: dict = kw) -> Any:
+            return pf.simulate(system, 0.0, t_end=1.0, rtol=1e-8, method=method, **kw)
+
+        rows.append(_matched_row(name, sim, reference, target, rounds))
     return rows
+
+
+def _matched_row(name: str, sim: Callable[..., Any], reference: Callable[[float], tuple], target: float,
+                 rounds: int) -> NativeRow:
+    """The row of a simulate run ``sim(method)`` against the numba ``reference(rtol)`` at matched error:
+    the loosest reference rtol of :data:`_LADDER` whose reversals are at least as accurate as
+    simulate's against the reference at rtol 1e-13; also the reference at simulate's own rtol 1e-8
+    and CasADi's path (``method="erk"``)."""
+    exact = reference(1e-13)[0]
+    res = sim()
+    sim_err = _error(res.reversals.t, res.reversals.x, res.reversals.F, exact)
+    chosen, ref_err = _LADDER[-1], math.inf
+    for rtol in _LADDER:  # the loosest reference at least as accurate as simulate
+        rev = reference(rtol)[0]
+        err = _error(rev[0], rev[1], rev[2], exact)
+        if err <= sim_err:
+            chosen, ref_err = rtol, err
+            break
+    sim_s, ref_s = _interleaved(sim, lambda: reference(chosen), rounds)
+    _, same_s = _interleaved(lambda: None, lambda: reference(1e-8), rounds)
+    erk_s, _ = _interleaved(lambda: sim("erk"), lambda: None, max(2, rounds // 5))
+    return NativeRow(name, f"numba({chosen:.0e})", sim_s, ref_s, sim_err, ref_err, target, same_s, erk_s)
 
 
 def _feedback_rows(rounds: int) -> list[NativeRow]:
@@ -166,21 +178,7 @@ def _feedback_rows(rounds: int) -> list[NativeRow]:
     def sim(method: str = "native") -> Any:
         return pf.simulate(system, 0.0, t_end=1.0, rtol=1e-8, feedback=fb, method=method)
 
-    exact = reference(1e-13)[0]
-    res = sim()
-    sim_err = _error(res.reversals.t, res.reversals.x, res.reversals.F, exact)
-    chosen, ref_err = _LADDER[-1], math.inf
-    for rtol in _LADDER:  # the loosest reference at least as accurate as simulate
-        rev = reference(rtol)[0]
-        err = _error(rev[0], rev[1], rev[2], exact)
-        if err <= sim_err:
-            chosen, ref_err = rtol, err
-            break
-    sim_s, ref_s = _interleaved(sim, lambda: reference(chosen), rounds)
-    _, same_s = _interleaved(lambda: None, lambda: reference(1e-8), rounds)
-    erk_s, _ = _interleaved(lambda: sim("erk"), lambda: None, max(2, rounds // 5))
-    return [NativeRow("Dahl in a continuous PID loop, sine reference", f"numba({chosen:.0e})", sim_s, ref_s, sim_err,
-                      ref_err, 2.0, same_s, erk_s)]
+    return [_matched_row("Dahl in a continuous PID loop, sine reference", sim, reference, 2.0, rounds)]
 
 
 def _loop_rows(rounds: int) -> list[NativeRow]:
@@ -227,8 +225,29 @@ def _loop_rows(rounds: int) -> list[NativeRow]:
         rows.append(NativeRow(name + " (per sample)", f"numba({chosen:.0e})", sim_s / n, ref_s / n, sim_err, ref_err,
                               3.0, erk_s=erk_s / n))
         if kind == nr.DAHL:
+            rows.append(_sampled_feedback_row(stage, Cd, ref, t_end, stroke, exact, chosen, ref_err, reference, rounds))
             rows.append(_exported_row(stage, r, Ts, stroke, exact, chosen, ref_err, reference, rounds))
     return rows
+
+
+def _sampled_feedback_row(stage: Any, Cd: Any, ref: Any, t_end: float, stroke: float, exact: np.ndarray,
+                          chosen: float, ref_err: float, reference: Callable, rounds: int) -> NativeRow:
+    """``simulate(..., feedback=LinearFeedback(..., Ts=))``: the same discrete PID loop as the
+    row before it (the native sampled loop), per sample, next to the same numba loop; the CasADi
+    path (``method="erk"``, one CasADi call per period) is timed too."""
+    import prefriction as pf
+
+    fb = pf.LinearFeedback(A=Cd.A, B=Cd.B, C=Cd.C, D=Cd.D, Ts=Cd.dt, reference=ref)
+
+    def sim(method: str = "native") -> Any:
+        return pf.simulate(stage, 0.0, t_end=t_end, rtol=1e-8, feedback=fb, method=method)
+
+    err = float(np.max(np.abs(sim().x - exact))) / stroke
+    sim_s, ref_s = _interleaved(sim, lambda: reference(chosen), max(3, rounds // 5))
+    erk_s, _ = _interleaved(lambda: sim("erk"), lambda: None, 2)
+    n = exact.size - 1
+    return NativeRow("sampled feedback= around Dahl (per sample)", f"numba({chosen:.0e})", sim_s / n,
+                     ref_s / n, err, ref_err, 3.0, erk_s=erk_s / n)
 
 
 def _exported_row(stage: Any, r: np.ndarray, Ts: float, stroke: float, exact: np.ndarray, chosen: float,

@@ -123,19 +123,23 @@ _WHY = {
 
 
 def run_blocks(drv: LoopDriver, LL: LoopLayout, S: np.ndarray, Wall: np.ndarray, n_s: int, par: np.ndarray,
-               q: np.ndarray, cfg: np.ndarray, block: int) -> tuple[np.ndarray, tuple, int, int]:
-    """All ``n_s`` sample periods: the records (``n_s`` rows), the reversals as four columns
-    ``(t~, x~, F~, W~)``, the C calls and the accepted steps. ``SolverError`` if a period fails."""
+               q: np.ndarray, cfg: np.ndarray, block: int,
+               stop_at: float = math.inf) -> tuple[np.ndarray, tuple, int, int, np.ndarray]:
+    """The sample periods up to ``n_s``, or up to the block in which ``stop_at`` reversals were
+    reached: the records of the periods run (``n_s`` rows unless stopped), the reversals as five
+    columns ``(t~, x~, F~, W~, events)`` (events: the model events of the half-cycle ending at the
+    reversal), the C calls, the accepted steps and the driver's run state after the last period
+    (entry 4: the model events since the last reversal). ``SolverError`` if a period fails."""
     S = np.ascontiguousarray(S, dtype=float).copy()
     fst = np.zeros(drv.width)
     fst[12] = fst[13] = math.nan
     recs = np.empty((n_s, LL.nrec))
     rev = np.empty(5 * CAPACITY)
-    cols: list = [[], [], [], []]
+    cols: list = [[], [], [], [], []]
     cnt = np.zeros(4, np.int64)
-    calls = k = 0
+    calls = k = n_rev = 0
     Wall = np.ascontiguousarray(Wall, dtype=float)
-    while k < n_s:
+    while k < n_s and n_rev < stop_at:
         nb = min(block, n_s - k)
         cnt[0] = 0
         code = drv.call(q, cfg, par, Wall[k:k + nb], nb, S, fst, recs[k:k + nb], rev, CAPACITY, cnt)
@@ -143,8 +147,9 @@ def run_blocks(drv: LoopDriver, LL: LoopLayout, S: np.ndarray, Wall: np.ndarray,
         n = int(cnt[0])
         if n:
             R = rev.reshape(5, CAPACITY)
-            for col, row in zip(cols, R[:4]):
+            for col, row in zip(cols, R):
                 col.append(row[:n].copy())
+            n_rev += n
         done = int(cnt[3])
         if code != 0:
             t = Wall[k + done, LL.inp["t0"]] * cfg[3]
@@ -153,5 +158,4 @@ def run_blocks(drv: LoopDriver, LL: LoopLayout, S: np.ndarray, Wall: np.ndarray,
                               f"stable controller.")
         k += done
     columns = tuple(np.concatenate(c) if c else np.zeros(0) for c in cols)
-    return recs, columns, calls, int(cnt[2])
-
+    return recs[:k], columns, calls, int(cnt[2]), fst

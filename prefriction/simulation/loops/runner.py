@@ -28,10 +28,11 @@ from prefriction.simulation.per_thread import PerThread
 from prefriction.simulation.plant import Layout, PlantSpec
 from prefriction.simulation.result import RunStats, SimulationResult
 from prefriction.simulation.lazy_table import reversal_table
-from prefriction.simulation.simulate import _CAL
+from prefriction.simulation.plant import EPS_CAL as _CAL
 from prefriction.units import Scales
 
 from .compiled_loop import MAX_DELAY, NSTOP, LoopLayout, LoopSpec, NoCompensation, loop_function
+from .loop_inputs import loop_params, padded as _padded, sample_inputs
 from .native_loop import loop_driver, run_blocks
 from .records import collect, failure, finish_in_python, initial_state
 
@@ -164,12 +165,6 @@ class Compensation:
     velocity: np.ndarray
 
 
-def _padded(M: np.ndarray, n: int, shape: tuple[int, int]) -> np.ndarray:
-    out = np.zeros(shape)
-    out[: M.shape[0], : M.shape[1]] = M
-    return out
-
-
 def run_sampled(
     system: Oscillator, fb: LinearFeedback, t_end: float, *, x0: float, v0: float, F0: float,
     rtol: float, jit: bool, u_max: Optional[float] = None, k_aw: Optional[np.ndarray] = None,
@@ -240,38 +235,18 @@ def run_sampled(
         LL, comp_fun = LoopLayout(spec), comp.function()
         par = np.zeros(LL.npar)
     # run-time parameters: the plant's constants, the controller (SI, padded), limit, scales
-    par[:] = 0.0
-    P0 = par[LL.p_plant]
-    pl = L.param
-    P0[pl["eps"]], P0[pl["snap"]] = eps, rtol
-    P0[pl["tunit"]], P0[pl["xunit"]], P0[pl["Fc"]] = sc.t, sc.x, sc.F
-    P0[L.q] = model.runtime_params_for(sc)
-    A = _padded(fb.A, n, (n, n))
-    par[LL.p_A] = A.T.ravel()  # column-major, as ca.reshape reads it
-    par[LL.p_B] = _padded(fb.B, n, (n, 1))[:, 0]
-    par[LL.p_C] = _padded(fb.C, n, (1, n))[0]
+    P0 = loop_params(par, LL, L, model, sc, fb, eps, rtol, applied_force_scale(system, fb, x0, t_end) / Fc)
     if k_aw is not None:
         par[LL.p_kaw.start: LL.p_kaw.start + len(k_aw)] = k_aw
-    par[LL.param["D"]] = fb.D[0, 0]
     par[LL.param["umax"]] = 1e300 if u_max is None else u_max
-    par[LL.param["Ts"]] = fb.Ts
-    par[LL.param["force_scale"]] = applied_force_scale(system, fb, x0, t_end) / Fc
     par[LL.param["quant"]] = measurement.quantization
+    par[LL.p_delay] = 0.0
     par[LL.p_delay.start + measurement.delay] = 1.0
     if compensation is not None:
         par[LL.p_comp] = compensation.params
     # per-sample inputs
-    Wall = np.zeros((n_s + block, LL.nw))
+    Wall = sample_inputs(LL, fb, sc, tk, t_end_n, Ts_n, block)
     ii = LL.inp
-    Wall[:, ii["t0"]] = t_end_n
-    Wall[:, ii["t1"]] = t_end_n
-    Wall[:n_s, ii["t0"]] = tk
-    Wall[: n_s - 1, ii["t1"]] = tk[1:]
-    Wall[: n_s - 1, ii["active"]] = 1.0
-    Wall[:n_s, ii["r"]] = np.asarray(fb.reference(tk * sc.t), dtype=float)
-    Wall[: n_s - 1, ii["rn"]] = Wall[1:n_s, ii["r"]]
-    # the last sample's force is the controller's there: the reference goes on one period (not frozen)
-    Wall[n_s - 1, ii["rn"]] = float(np.asarray(fb.reference(np.array([(tk[-1] + Ts_n) * sc.t])), dtype=float)[0])
     if compensation is not None:
         Wall[:n_s, ii["vr"]] = compensation.velocity[:n_s]
         Wall[: n_s - 1, ii["vrn"]] = compensation.velocity[1:n_s]
@@ -292,8 +267,9 @@ def run_sampled(
     k = n_s if drv is not None else 0
     if drv is not None:  # every period in C, NATIVE_BLOCK per call
         cfg = np.array([rtol * _CAL, eps, rtol, sc.t, 1.0 / sc.F, par[LL.param["force_scale"]], 0.0, 1.0, 0.0])
-        recs, rev, blocks, steps = run_blocks(drv, LL, S, Wall, n_s, par, np.ascontiguousarray(P0[L.q]), cfg,
-                                              NATIVE_BLOCK)
+        recs, rev, blocks, steps, _ = run_blocks(drv, LL, S, Wall, n_s, par, np.ascontiguousarray(P0[L.q]), cfg,
+                                                 NATIVE_BLOCK)
+        rev = rev[:4]  # t~, x~, F~, W~
         inside = time.perf_counter() - start
     else:
         recs = np.empty((n_s, LL.nrec))

@@ -16,7 +16,8 @@
 #endif
 
 /* nblk sample periods from the loop state S (in and out) and the native run state fst (in and
- * out: carries the step size). Wb: nblk rows of PF_LNW inputs; R: nblk records of PF_LNREC;
+ * out: carries the step size and the model events since the last reversal). Wb: nblk rows of PF_LNW
+ * inputs; R: nblk records of PF_LNREC;
  * rev: reversals (5 rows of stride cap). cnt[0] reversals written (in and out), cnt[2] accepted
  * steps (added to), cnt[3] periods done (out). Returns 0, a code of pf_forced (> 1), or 6 if a
  * period had more reversals than there was room for. */
@@ -50,8 +51,7 @@ int pf_loop(const double* q, const double* cfg, const double* par, const double*
       fst[0] = w[PF_LI_T0];
       fst[1] = S[0];
       fst[2] = S[1];
-      fst[3] = S[PF_LS_S];
-      fst[4] = 0.0;
+      fst[3] = S[PF_LS_S]; /* fst[4], the model events since the last reversal, carries over */
       fst[5] = S[PF_LS_S + 1];
       fst[6] = S[PF_LS_S + 2];
       fst[7] = 0.0;

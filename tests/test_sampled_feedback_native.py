@@ -1,0 +1,152 @@
+"""``simulate(..., feedback=LinearFeedback(..., Ts=))`` on the native sampled loop.
+
+A sampled controller around an oscillator without input force runs in C (the loop driver of
+``controllers.simulate_loop``, ``native/loop.c``). References: the CasADi path
+(``method="erk"``, one CasADi call per period) to the tolerance on Dahl, LuGre and Maxwell-slip;
+and an independent closed loop written here: python-control's discrete-time controller
+(``StateSpace.dynamics`` / ``output`` of ``PID.c2d``) around ``solve_ivp`` (DOP853, rtol 1e-12)
+of the Dahl equations ``x' = v, v' = (u - F) / m, F' = sigma (v - |v| F / Fc)``, the force held
+over each sample period.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+import prefriction as pf
+from prefriction import controllers
+from prefriction.signals import Samples, Sine, Step, ZeroOrderHold
+from prefriction.simulation.compiled import jit_available
+
+pytestmark = pytest.mark.skipif(not jit_available(), reason="the native loop needs a C compiler")
+
+TS, T_END, STROKE = 1e-4, 0.04, 5e-6  # s, s, m
+REF = Sine(0.5 * STROKE, 50.0, phase=-math.pi / 2, offset=0.5 * STROKE)
+MODELS = {
+    "dahl": pf.Dahl(sigma=1e6, Fc=1.0),
+    "lugre": pf.LuGre(sigma0=1e6, sigma1=300.0, sigma2=0.4, Fc=1.0, Fs=1.5, vs=1e-3),
+    "maxwell_slip": pf.MaxwellSlip([4e5, 3e5, 3e5], [0.3, 0.3, 0.4]),
+}
+
+
+def _feedback(stage: pf.Oscillator, reference=REF) -> tuple[pf.LinearFeedback, object]:
+    """The 10 kHz discrete PID (ZOH of the 150 Hz design) as a sampled LinearFeedback, and ``c2d``'s system."""
+    Cd = controllers.design_pid(stage, wn=2 * np.pi * 150.0, zeta=0.7).c2d(TS)
+    return pf.LinearFeedback(A=Cd.A, B=Cd.B, C=Cd.C, D=Cd.D, Ts=TS, reference=reference), Cd
+
+
+def _agree(a: pf.SimulationResult, b: pf.SimulationResult) -> None:
+    """Native ``a`` and CasADi ``b``: same samples, reversals and events to the tolerance (rtol 1e-8)."""
+    assert a.stats.steps is not None and b.stats.steps is None  # the native loop counts its steps; CasADi does not
+    assert a.status == b.status and len(a.t) == len(b.t) > 10
+    np.testing.assert_allclose(a.t, b.t, rtol=1e-13, atol=0)  # (CasADi: the break times to round-off)
+    assert np.max(np.abs(a.x - b.x)) <= 1e-8 * STROKE
+    assert np.max(np.abs(a.u - b.u)) <= 1e-7 * np.max(np.abs(b.u))
+    assert np.max(np.abs(a.xc - b.xc)) <= 1e-8 * np.max(np.abs(b.xc))
+    assert len(a.reversals) == len(b.reversals) >= 2
+    np.testing.assert_allclose(a.reversals.t, b.reversals.t, rtol=0, atol=1e-8 * T_END)
+    np.testing.assert_allclose(a.reversals.x, b.reversals.x, rtol=0, atol=1e-8 * STROKE)
+    np.testing.assert_array_equal(a.events, b.events)
+    assert a.stats.events == b.stats.events
+
+
+@pytest.mark.parametrize("name", sorted(MODELS))
+def test_native_and_erk_agree(name: str) -> None:
+    """10 kHz PID loop tracking a 5 um sine on each model: native loop and CasADi agree to 1e-8."""
+    stage = pf.Oscillator(MODELS[name], 1.0)
+    fb, _ = _feedback(stage)
+    a = pf.simulate(stage, 0.0, t_end=T_END, feedback=fb)
+    b = pf.simulate(stage, 0.0, t_end=T_END, feedback=fb, method="erk")
+    _agree(a, b)
+    if name == "maxwell_slip":
+        assert a.stats.events > 0  # the elements' stick/slip switches are counted across periods
+
+
+def test_reversal_stop_keeps_the_samples_up_to_it() -> None:
+    """``reversals=2``: both paths stop at the second reversal with the samples up to it."""
+    stage = pf.Oscillator(MODELS["lugre"], 1.0)
+    fb, _ = _feedback(stage)
+    a = pf.simulate(stage, 0.0, t_end=T_END, reversals=2, feedback=fb)
+    b = pf.simulate(stage, 0.0, t_end=T_END, reversals=2, feedback=fb, method="erk")
+    _agree(a, b)
+    assert a.status == 1 and len(a.reversals) == 2 and a.t[-1] <= a.reversals.t[-1] < a.t[-1] + TS
+
+
+def test_start_from_rest_with_a_step_reference_agrees() -> None:
+    """The mass at rest, a 2 um step of the reference at 5 ms: it leaves rest at a sample instant."""
+    stage = pf.Oscillator(MODELS["dahl"], 1.0)
+    fb, _ = _feedback(stage, Step(5e-3, 0.0, 2e-6))
+    a = pf.simulate(stage, 0.0, t_end=T_END, feedback=fb)
+    b = pf.simulate(stage, 0.0, t_end=T_END, feedback=fb, method="erk")
+    assert np.all(a.x[a.t < 5e-3] == 0.0)
+    assert np.max(np.abs(a.x - b.x)) <= 1e-8 * STROKE
+    np.testing.assert_allclose(a.u, b.u, rtol=0, atol=1e-7 * np.max(np.abs(b.u)))
+    assert len(a.reversals) == len(b.reversals)
+    np.testing.assert_allclose(a.reversals.t, b.reversals.t, rtol=0, atol=1e-8 * T_END)
+
+
+@pytest.mark.parametrize("kind", ["zero_order_hold", "samples_and_step"])
+def test_input_force_linear_over_each_period_runs_native(kind: str) -> None:
+    """A disturbance force whose breaks are sample instants (a zero-order hold of one value per
+    2 periods; samples every 4 periods plus a step) joins the held force in C: native and erk
+    agree, including the work of the forces per half-cycle."""
+    rng = np.random.default_rng(3)
+    tu = np.arange(0.0, T_END + 1e-9, 2 * TS)
+    if kind == "zero_order_hold":
+        u = ZeroOrderHold(tu, 0.2 * rng.standard_normal(tu.size))
+    else:
+        u = Samples(tu[::2], 0.2 * rng.standard_normal(tu[::2].size)) + Step(150 * TS, 0.0, 0.3)
+    stage = pf.Oscillator(MODELS["dahl"], 1.0, u)
+    fb, _ = _feedback(pf.Oscillator(MODELS["dahl"], 1.0))
+    a = pf.simulate(stage, 0.0, t_end=T_END, feedback=fb)
+    b = pf.simulate(stage, 0.0, t_end=T_END, feedback=fb, method="erk")
+    _agree(a, b)
+    np.testing.assert_allclose(a.work_input, b.work_input, rtol=0, atol=1e-7 * np.max(np.abs(b.work_input)))
+
+
+def test_input_force_with_a_break_inside_a_period_stays_on_casadi() -> None:
+    """A step half-way between two sample instants is not linear over that period: CasADi's path."""
+    stage = pf.Oscillator(MODELS["dahl"], 1.0, Step(100.5 * TS, 0.0, 0.3))
+    fb, _ = _feedback(pf.Oscillator(MODELS["dahl"], 1.0))
+    assert pf.simulate(stage, 0.0, t_end=0.02, feedback=fb).stats.steps is None
+
+
+def test_dahl_loop_against_python_control_and_solve_ivp() -> None:
+    """The native loop against python-control's discrete PID around ``solve_ivp`` of the Dahl
+    equations (gamma = 1), the force held over each period: positions, forces and reversal times."""
+    sigma, Fc, m = 1e6, 1.0, 1.0
+    stage = pf.Oscillator(pf.Dahl(sigma=sigma, Fc=Fc), m)
+    fb, Cd = _feedback(stage)
+    res = pf.simulate(stage, 0.0, t_end=T_END, feedback=fb, rtol=1e-10)
+
+    n_s = len(res.t)
+    tk = np.arange(n_s) * TS
+    y, xc = np.zeros(3), np.zeros(Cd.nstates)
+    xs, us, rev = np.zeros(n_s), np.zeros(n_s), []
+
+    def vzero(t, s, u):
+        return s[1]
+
+    for k in range(n_s):
+        e = float(REF(tk[k])) - y[0]
+        us[k] = float(Cd.output(tk[k], xc, [e])[0])
+        xs[k] = y[0]
+        xc = np.asarray(Cd.dynamics(tk[k], xc, [e]), dtype=float)
+        if k == n_s - 1:
+            break
+        if us[k] == 0.0 and not np.any(y):  # at rest without force: v = 0 identically (no events)
+            continue
+        sol = solve_ivp(lambda t, s, u: [s[1], (u - s[2]) / m, sigma * (s[1] - abs(s[1]) * s[2] / Fc)],
+                        (tk[k], tk[k + 1]), y, method="DOP853", rtol=1e-12, atol=1e-20, events=vzero,
+                        args=(us[k],))
+        rev += [t for t in sol.t_events[0] if t > tk[k]]
+        y = sol.y[:, -1]
+    np.testing.assert_allclose(res.t, tk, rtol=1e-12, atol=0)
+    assert np.max(np.abs(res.x - xs)) <= 1e-7 * STROKE
+    assert np.max(np.abs(res.u - us)) <= 1e-6 * np.max(np.abs(us))
+    assert len(res.reversals) == len(rev) >= 2
+    np.testing.assert_allclose(res.reversals.t, rev, rtol=0, atol=1e-8 * T_END)
