@@ -379,7 +379,7 @@ def _solve_record(model: FrictionModel, data: Motion, space: ParameterSpace, the
                 weight=weight, restart=restart, progress=progress)
     w = out.w
     polished = ""
-    if out.success:
+    if out.success and not model.n_flags:  # flags (in-branch events) are not carried from segment to segment
         w, polished = _polish(prob, w, single, lo, hi)
     r, _g, res = prob.residuals(w)
     Jred = prob.reduced_jacobian(w)
