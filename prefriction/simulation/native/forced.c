@@ -67,6 +67,7 @@ typedef struct {
   long nbrk, kb;
   double tunit, invFc;
   double F_last; /* the friction force of the last pf_ff */
+  const double* line; /* an added line (t_l, a, b) [s, N, N/s]: a + b (t - t_l) (a sampled loop's held force), or 0 */
 #if PF_NC
   /* the controller (normalised units, as plant.py): An (row-major), Bn, Cn, Dn, umax, kaw, then
    * the error scales 1/|Cn_i| (1 where Cn_i = 0); the reference's numbers and pieces */
@@ -85,6 +86,7 @@ static double pf_u(pf_fctx* f, double t) {
   c->arg[2] = f->pcs + f->kb * PF_NPCA;
   c->res[0] = &u;
   pf_input(c->arg, c->res, c->iw, c->w, 0);
+  if (f->line) u += f->line[1] + f->line[2] * (tsi - f->line[0]);
   return u * f->invFc;
 #else
   (void)f; (void)t;
@@ -282,7 +284,7 @@ static double pf_branch_energy(pf_fctx* f, const double* Y) {
 static int pf_forced_run(const double* q, const double* th, const double* brk, long nbrk, const double* pcs,
                          const double* cfg, double* st, double t_end, long n_max, double* rev, const double* td,
                          long nd, double* out, long* cnt, const double* fbp, const double* thr, const double* pcr,
-                         int stiff_ok) {
+                         int stiff_ok, const double* line) {
   pf_fctx f;
   pf_step P;
   double Y[PF_NF], Y0[PF_NF], Ys[PF_NF], f0[PF_NF], e[PF_NF], U[7][PF_NF], g0[PF_NEA], g1[PF_NEA], sc[PF_NF];
@@ -315,6 +317,7 @@ static int pf_forced_run(const double* q, const double* th, const double* brk, l
   (void)fbp; (void)thr; (void)pcr;
 #endif
   f.rest = rest;
+  f.line = line;
   f.c.q = q;
   f.c.snap = cfg[2];
   f.c.s = st[3];
@@ -687,14 +690,14 @@ static int pf_forced_run(const double* q, const double* th, const double* brk, l
 int pf_forced(const double* q, const double* th, const double* brk, long nbrk, const double* pcs,
               const double* cfg, double* st, double t_end, long n_max, double* rev, const double* td, long nd,
               double* out, long* cnt) {
-  return pf_forced_run(q, th, brk, nbrk, pcs, cfg, st, t_end, n_max, rev, td, nd, out, cnt, 0, 0, 0, 0);
+  return pf_forced_run(q, th, brk, nbrk, pcs, cfg, st, t_end, n_max, rev, td, nd, out, cnt, 0, 0, 0, 0, 0);
 }
 
 /* pf_forced that stops with PF_F_STIFF on a stiff stretch (the caller continues on an implicit method) */
 int pf_forced_stiff(const double* q, const double* th, const double* brk, long nbrk, const double* pcs,
                     const double* cfg, double* st, double t_end, long n_max, double* rev, const double* td, long nd,
                     double* out, long* cnt) {
-  return pf_forced_run(q, th, brk, nbrk, pcs, cfg, st, t_end, n_max, rev, td, nd, out, cnt, 0, 0, 0, 1);
+  return pf_forced_run(q, th, brk, nbrk, pcs, cfg, st, t_end, n_max, rev, td, nd, out, cnt, 0, 0, 0, 1, 0);
 }
 
 #if PF_NC
@@ -704,6 +707,6 @@ int pf_forced_stiff(const double* q, const double* th, const double* brk, long n
 int pf_forced_fb(const double* q, const double* th, const double* brk, long nbrk, const double* pcs,
                  const double* cfg, double* st, double t_end, long n_max, double* rev, const double* td, long nd,
                  double* out, long* cnt, const double* fbp, const double* thr, const double* pcr) {
-  return pf_forced_run(q, th, brk, nbrk, pcs, cfg, st, t_end, n_max, rev, td, nd, out, cnt, fbp, thr, pcr, 0);
+  return pf_forced_run(q, th, brk, nbrk, pcs, cfg, st, t_end, n_max, rev, td, nd, out, cnt, fbp, thr, pcr, 0, 0);
 }
 #endif
