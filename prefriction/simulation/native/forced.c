@@ -456,6 +456,11 @@ static int pf_forced_run(const double* q, const double* th, const double* brk, l
         F0 = pf_ff(&f, t, Y, f0); fsal = 1;
         continue;
       }
+      if (clipped) { /* the end within round-off (a break just before it): the run is there */
+        t = t_lim;
+        h = hs;
+        continue;
+      }
       code = nonfinite ? PF_F_NONFINITE : PF_F_STEP_UNDERFLOW;
       break;
     }
