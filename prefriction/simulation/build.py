@@ -4,9 +4,9 @@ The compact unforced model runs on the native driver where it exists
 (:mod:`prefriction.simulation.native.library`, ``docs/simulator.md#native``), forced and dense
 open-loop runs on the forced native driver (:mod:`prefriction.simulation.native.forced`), a
 continuous controller on the same driver (:mod:`prefriction.simulation.native.closed`), a sampled
-controller on the native sampled loop where the input force is none or linear over each sample
-period (:mod:`prefriction.simulation.loops.feedback_loop`), and everything else (a sampled
-controller with another input force, ``method="erk"``, ``jit=False``) on CasADi's integrator
+controller on the native sampled loop under any input force
+(:mod:`prefriction.simulation.loops.feedback_loop`), and everything else (``method="erk"``,
+``jit=False``, no C compiler) on CasADi's integrator
 (:mod:`prefriction.simulation.integrator`). Each is built once per model structure and process
 and reused (numbers and tolerances are run-time inputs).
 """

@@ -122,8 +122,8 @@ def simulate(
     method : str, default "native"
         One of :data:`METHODS`. ``"native"``: the C driver (the model's and the input's
         generated code driven by a Runge-Kutta 5(4) in C, one C call per run or block;
-        ``docs/simulator.md#native``) where it applies (a C compiler; a sampled controller where
-        the input force is none or linear over each sample period), else CasADi's integrator. ``"erk"``: CasADi's integrator (adaptive
+        ``docs/simulator.md#native``) where it applies (a C compiler; a sampled controller under
+        any input force), else CasADi's integrator. ``"erk"``: CasADi's integrator (adaptive
         explicit Runge-Kutta 5(4) with events; ``"rosenbrock"`` works with the same events but
         is 5-10 times slower on these non-stiff problems; ``cvodes``/``idas`` events and
         ``collocation`` fail: docs/simulator.md, why only erk). Both agree to the tolerance.

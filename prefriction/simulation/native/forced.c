@@ -658,9 +658,9 @@ static int pf_forced_run(const double* q, const double* th, const double* brk, l
     if (clipped) {
       t = t_lim;
       h = fmax(h * fac, hs);
-      if (f.kb < nbrk && t >= brk[f.kb]) { /* a break: the next piece, the right-hand side anew */
+      if (f.kb < nbrk && t >= brk[f.kb]) { /* a break: the next piece, the right-hand side anew (if the run goes on) */
         ++f.kb;
-        F0 = pf_ff(&f, t, Y, f0);
+        if (t < t_end) F0 = pf_ff(&f, t, Y, f0);
       }
     } else {
       t += h;
