@@ -18,7 +18,7 @@ from scipy.integrate import solve_ivp
 
 import prefriction as pf
 from prefriction import controllers
-from prefriction.signals import Sine, Step
+from prefriction.signals import Chirp, PointToPoint, Ramp, Samples, Sine, Step, Traced, ZeroOrderHold
 from prefriction.simulation.compiled import jit_available
 
 pytestmark = pytest.mark.skipif(not jit_available(), reason="the native loop needs a C compiler")
@@ -61,6 +61,41 @@ def test_native_and_erk_agree(name: str, kind: str) -> None:
     np.testing.assert_allclose(a.reversals.t, b.reversals.t, rtol=0, atol=1e-8 * T_END)
     np.testing.assert_allclose(a.reversals.x, b.reversals.x, rtol=0, atol=1e-8 * STROKE)
     np.testing.assert_allclose(a.work_input, b.work_input, rtol=0, atol=1e-7 * np.max(np.abs(b.work_input)))
+
+
+_TU = np.linspace(0.0, 0.02, 57)  # sample times off the loop's grid
+
+
+def _traced(t):
+    import casadi as ca
+
+    return 0.5 * (ca.cos(180.0 * t) if isinstance(t, (ca.SX, ca.MX)) else np.cos(180.0 * t))
+
+
+EVERY_KIND = {
+    "chirp": Chirp(0.4, 30.0, 250.0, 0.02),
+    "ramp": Ramp(0.00517, 0.00733, -0.3),
+    "samples": Samples(_TU, 0.3 * np.sin(2 * np.pi * 90 * _TU)),
+    "zoh": ZeroOrderHold(_TU[::3], 0.3 * np.sin(2 * np.pi * 70 * _TU[::3])),
+    "point_to_point": PointToPoint(0.6, 6.0, 20000.0) + Sine(0.2, 120.0) + (-0.1),
+    "traced": Traced(_traced),
+    "sum": Sine(0.2, 100.0) + Samples(_TU, 0.1 * np.sin(2 * np.pi * 230 * _TU)),
+}
+
+
+@pytest.mark.parametrize("kind", sorted(EVERY_KIND))
+def test_every_input_kind_runs_native_and_agrees(kind: str) -> None:
+    """Every other signal kind as the disturbance of the Dahl loop (breaks off the sample grid):
+    native and CasADi's loop agree to 1e-8 of the largest |x| and of the run's length."""
+    stage = pf.Oscillator(MODELS["dahl"], 1.0, EVERY_KIND[kind])
+    fb, _ = _feedback()
+    a = pf.simulate(stage, 0.0, t_end=0.02, feedback=fb, rtol=1e-8)
+    b = pf.simulate(stage, 0.0, t_end=0.02, feedback=fb, rtol=1e-8, method="erk")
+    assert a.stats.steps is not None and b.stats.steps is None
+    assert np.max(np.abs(a.x - b.x)) <= 1e-8 * np.max(np.abs(b.x))
+    assert np.max(np.abs(a.u - b.u)) <= 1e-7 * np.max(np.abs(b.u))
+    assert len(a.reversals) == len(b.reversals) >= 1
+    np.testing.assert_allclose(a.reversals.t, b.reversals.t, rtol=0, atol=1e-8 * 0.02)
 
 
 def test_dahl_under_a_sine_disturbance_against_python_control_and_solve_ivp() -> None:
