@@ -92,7 +92,8 @@ def run_feedback_loop(run: "RunState", xc0: np.ndarray, t_end: float,
     cfg = np.array([run.eps_native, run.eps, run.snap, sc.t, 1.0 / sc.F, run.force_scale, 0.0,
                     1.0 if drv.linear else 0.0, 0.0])
     recs, cols, calls, steps, fst = run_blocks(drv, LL, S, Wall, n_s, par, np.ascontiguousarray(P0[L.q]), cfg,
-                                               NATIVE_BLOCK, n_target, input_tables(run, run.spec.u_sig, t_end))
+                                               NATIVE_BLOCK, n_target,
+                                               input_tables(run, run.spec.u_sig, t_end) if run.system.forced else None)
     run.calls += calls
     run.steps = (run.steps or 0) + steps
     stopped = len(cols[0]) >= n_target

@@ -111,7 +111,7 @@ def loop_source(spec: LoopSpec, extra: tuple[ca.Function, ...] = ()) -> str:
     LL = LoopLayout(spec)
     u_sig = spec.plant.u_sig
     ix, inp, rec = LL.state, LL.inp, LL.rec
-    defs = {"PF_FORCED": 1, "PF_NPC": u_sig.n_piece, "PF_NTH": u_sig.n_params, "PF_LNS": LL.nS, "PF_LNW": LL.nw, "PF_LNREC": LL.nrec,
+    defs = {"PF_FORCED": 1, "PF_NPC": u_sig.n_piece, "PF_LNS": LL.nS, "PF_LNW": LL.nw, "PF_LNREC": LL.nrec,
             "PF_LI_T0": inp["t0"], "PF_LI_T1": inp["t1"], "PF_LI_ACTIVE": inp["active"], "PF_LI_TL": inp["tl"],
             "PF_LI_DA": inp["da"], "PF_LI_DB": inp["db"], "PF_LS_S": ix["s"], "PF_LR_F": rec["F"],
             "PF_LR_U": rec["u"], "PF_LR_MOVED": rec["moved"], "PF_LR_Y": rec["y"], "PF_LR_COMP": rec["comp"]}

@@ -11,7 +11,7 @@
  * indices (loops/native_loop.py): PF_LNS (loop state), PF_LNW (inputs per sample), PF_LNREC
  * (record), PF_LI_T0, PF_LI_T1, PF_LI_ACTIVE, PF_LI_TL, PF_LI_DA, PF_LI_DB (inputs), PF_LS_S
  * (index of s in the loop state; rest, W and Amax follow it), PF_LR_F, PF_LR_U, PF_LR_MOVED,
- * PF_LR_Y, PF_LR_COMP (record), PF_NTH (the input's numbers).
+ * PF_LR_Y, PF_LR_COMP (record).
  */
 
 #ifndef PF_LOOP_ROOM
@@ -20,8 +20,9 @@
 
 /* nblk sample periods from the loop state S (in and out) and the native run state fst (in and
  * out: carries the step size, the model events since the last reversal and the input's current
- * piece) under the input (th, brk, nbrk, pcs: as pf_forced). Wb: nblk rows of PF_LNW inputs; R:
- * nblk records of PF_LNREC;
+ * piece) under the input (th, brk, nbrk, pcs: as pf_forced; pcs null: none, the held line is then
+ * the piece of the piecewise-linear structure). Wb: nblk rows of PF_LNW inputs; R: nblk records
+ * of PF_LNREC;
  * rev: reversals (5 rows of stride cap). cnt[0] reversals written (in and out), cnt[2] accepted
  * steps (added to), cnt[3] periods done (out). Returns 0, a code of pf_forced (> 1), or 6 if a
  * period had more reversals than there was room for. */
@@ -67,7 +68,9 @@ int pf_loop_input(const double* q, const double* th, const double* brk, long nbr
       line[1] = w[PF_LI_DA] + out[1];
       line[2] = w[PF_LI_DB];
       cnt[1] = 0;
-      code = pf_forced_run(q, th, brk, nbrk, pcs, cfg, fst, t1, cap, rev, &dummy, 0, &dummy, cnt, 0, 0, 0, 0, line);
+      if (!pcs) fst[10] = 0.0; /* the line is the only piece */
+      code = pcs ? pf_forced_run(q, th, brk, nbrk, pcs, cfg, fst, t1, cap, rev, &dummy, 0, &dummy, cnt, 0, 0, 0, 0, line)
+                 : pf_forced_run(q, &dummy, &dummy, 0, line, cfg, fst, t1, cap, rev, &dummy, 0, &dummy, cnt, 0, 0, 0, 0, 0);
       if (code > 1) { cnt[3] = j; return code; }
       if (code == 0 && fst[0] < t1) { cnt[3] = j; return 6; }
       if (resting && fst[5] > 0.5 && cnt[0] == n_before) rec[PF_LR_MOVED] = 0.0; /* rested through the period */
@@ -86,10 +89,9 @@ int pf_loop_input(const double* q, const double* th, const double* brk, long nbr
   return 0;
 }
 
-/* pf_loop_input without an input of its own (all its numbers zero: the loop of a zero input's
- * structure, as controllers.simulate_loop and the exported plant build it) */
+/* pf_loop_input without an input of its own: the held line is the input's piece (the loop of a
+ * piecewise-linear input's structure, as controllers.simulate_loop and the exported plant build it) */
 int pf_loop(const double* q, const double* cfg, const double* par, const double* Wb, long nblk, double* S,
             double* fst, double* R, double* rev, long cap, long* cnt) {
-  static const double zero[PF_NPCA + PF_NTH + 1] = {0.0};
-  return pf_loop_input(q, zero, zero, 0, zero, cfg, par, Wb, nblk, S, fst, R, rev, cap, cnt);
+  return pf_loop_input(q, 0, 0, 0, 0, cfg, par, Wb, nblk, S, fst, R, rev, cap, cnt);
 }
