@@ -84,7 +84,9 @@ def _structure_bound(model: FrictionModel, name: str, value: float) -> tuple[str
 
 def _relations(model: FrictionModel) -> list[tuple[str, str]]:
     """``(low, high)`` entry names with ``value[high] >= value[low]`` required by the model's
-    constructor: ``Fs >= Fc`` of LuGre and GMS (each term of a sum under its qualified names)."""
+    constructor: ``Fs >= Fc`` of LuGre, ElastoPlastic and GMS (each term of a sum under its qualified
+    names)."""
+    from prefriction.models.elasto_plastic import ElastoPlastic
     from prefriction.models.gms import GMS
     from prefriction.models.lugre import LuGre
     from prefriction.models.parallel import Parallel
@@ -96,7 +98,7 @@ def _relations(model: FrictionModel) -> list[tuple[str, str]]:
             local = {e.local: e.name for e in entries if e.part == i}
             out += [(local[a], local[b]) for a, b in _relations(m)]
         return out
-    return [("Fc", "Fs")] if isinstance(model, (LuGre, GMS)) else []
+    return [("Fc", "Fs")] if isinstance(model, (LuGre, ElastoPlastic, GMS)) else []
 
 
 class ParameterSpace:
