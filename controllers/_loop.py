@@ -254,7 +254,7 @@ def simulate_loop(
                 "a force limit u_max needs an oscillator without its own input force (system.u = None), "
                 f"got system.u = {system.u!r}"
             )
-        if system.forced:  # a disturbance force: prefriction.simulate (in C where it is linear over each period)
+        if system.forced:  # a disturbance force: prefriction.simulate (its native sampled loop)
             sim = prefriction.simulate(system, v0, x0=x0, F0=F0, t_end=t_end, rtol=rtol, feedback=fb, jit=jit)
         else:
             comp = None

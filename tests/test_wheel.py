@@ -63,3 +63,25 @@ def test_installed_wheel_finds_and_runs_a_figure_script(wheel, tmp_path) -> None
     assert out.returncode == 0, out.stderr
     assert Path(out.stdout.strip().splitlines()[0]).is_relative_to(site)
     assert list(tmp_path.glob("*.png"))
+
+
+def test_wheel_holds_every_c_source_the_package_reads(wheel) -> None:
+    """The C sources the drivers compile at run time are package data: a wheel without one breaks
+    its import (``prefriction/along/native.c`` is read when ``prefriction.along`` is imported)."""
+    _, names, _ = wheel
+    package = ROOT / "prefriction"
+    sources = [Path(d, f).relative_to(ROOT).as_posix() for d, _, files in os.walk(package) for f in files
+               if f.endswith(".c")]  # os.walk follows no link: the controllers link holds no C
+    assert sources and not [s for s in sources if s not in names]
+
+
+def test_installed_wheel_imports_every_subpackage_and_runs_friction_along(wheel, tmp_path) -> None:
+    _, _, site = wheel
+    code = ("import numpy as np, prefriction as pf; from prefriction import controllers, identify, export, optimal; "
+            "t = np.linspace(0.0, 1.0, 201); r = pf.friction_along(pf.Dahl(1e4, 1.0), t, 1e-4 * np.sin(6.0 * t)); "
+            "print(abs(r.F[-1]) <= 1.0)")
+    env = {**os.environ, "PYTHONPATH": str(site), "MPLBACKEND": "Agg"}
+    out = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env, capture_output=True, text=True,
+                         timeout=300)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip().splitlines()[-1] == "True"

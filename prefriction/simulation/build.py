@@ -4,9 +4,9 @@ The compact unforced model runs on the native driver where it exists
 (:mod:`prefriction.simulation.native.library`, ``docs/simulator.md#native``), forced and dense
 open-loop runs on the forced native driver (:mod:`prefriction.simulation.native.forced`), a
 continuous controller on the same driver (:mod:`prefriction.simulation.native.closed`), a sampled
-controller on the native sampled loop where the input force is none or linear over each sample
-period (:mod:`prefriction.simulation.loops.feedback_loop`), and everything else (a sampled
-controller with another input force, ``method="erk"``, ``jit=False``) on CasADi's integrator
+controller on the native sampled loop under any input force
+(:mod:`prefriction.simulation.loops.feedback_loop`), and everything else (``method="erk"``,
+``jit=False``, no C compiler) on CasADi's integrator
 (:mod:`prefriction.simulation.integrator`). Each is built once per model structure and process
 and reused (numbers and tolerances are run-time inputs).
 """
@@ -33,9 +33,8 @@ def build_plant(model: FrictionModel, spec: PlantSpec, fb: Optional[LinearFeedba
                 native: bool = True, held_input: bool = False) -> BuiltPlant:
     """Build (or reuse) the plant of ``spec`` for the friction ``model``, on the native drivers
     where they apply (``native`` and ``jit``, no controller ``fb`` for the forced one), else on
-    CasADi's integrator (compiled if ``jit``); ``held_input``: the oscillator's input force is
-    none or linear over each sample period (a sampled controller ``fb`` then runs on the native
-    sampled loop). The model's sizes are checked first, once per structure (:func:`~prefriction.models.sizes.check_sizes`), for
+    CasADi's integrator (compiled if ``jit``); ``held_input``: a sampled controller ``fb`` runs on the
+    native sampled loop (its held force added to the oscillator's input, any kind). The model's sizes are checked first, once per structure (:func:`~prefriction.models.sizes.check_sizes`), for
     every driver alike."""
     check_sizes(model)
     L = Layout(spec)  # the same for any number of outputs per call

@@ -49,7 +49,6 @@ from prefriction.simulation.plant import EPS_CAL, PlantSpec
 from prefriction.simulation.force_scale import MAX_AMPLITUDE, MIN_AMPLITUDE, applied_force_scale, check_amplitude
 from prefriction.simulation.budget import check_input_budget
 from prefriction.simulation.build import build_plant
-from prefriction.simulation.loops.feedback_loop import input_fits_periods
 from prefriction._validation import check_count, check_finite, check_positive
 from prefriction.models import Oscillator, check_oscillator
 from prefriction.simulation.lazy_table import reversal_table
@@ -123,8 +122,8 @@ def simulate(
     method : str, default "native"
         One of :data:`METHODS`. ``"native"``: the C driver (the model's and the input's
         generated code driven by a Runge-Kutta 5(4) in C, one C call per run or block;
-        ``docs/simulator.md#native``) where it applies (a C compiler; a sampled controller where
-        the input force is none or linear over each sample period), else CasADi's integrator. ``"erk"``: CasADi's integrator (adaptive
+        ``docs/simulator.md#native``) where it applies (a C compiler; a sampled controller under
+        any input force), else CasADi's integrator. ``"erk"``: CasADi's integrator (adaptive
         explicit Runge-Kutta 5(4) with events; ``"rosenbrock"`` works with the same events but
         is 5-10 times slower on these non-stiff problems; ``cvodes``/``idas`` events and
         ``collocation`` fail: docs/simulator.md, why only erk). Both agree to the tolerance.
@@ -226,8 +225,8 @@ def simulate(
         breaks.append(np.asarray(feedback.reference.breaks()) / sc.t)
     breaks = _sample_times(np.unique(np.concatenate(breaks)) if breaks else np.zeros(0))
     t_end_n = t_end_si / sc.t
-    held = fb_kind == "sampled" and input_fits_periods(system, feedback.Ts, t_end_si)
-    plant = build_plant(system.friction, spec, feedback, jit, native=method == "native", held_input=held)
+    plant = build_plant(system.friction, spec, feedback, jit, native=method == "native",
+                        held_input=fb_kind == "sampled")
     # error control on states scaled by amplitude * eps (the plant's run-time tolerance)
     eps = min(rtol, atol) * _CAL * math.sqrt(plant.L.n_active / plant.L.nx)
     run = Run(system, spec, feedback, eps, plant, sc=sc)

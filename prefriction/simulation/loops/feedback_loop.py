@@ -3,29 +3,28 @@ on the native sampled loop (``native/loop.c``, the driver of ``controllers.simul
 
 The controller ``xc[k+1] = A xc[k] + B e[k]``, ``u[k] = C xc[k] + D e[k]``, ``e[k] = r(k Ts) -
 x(k Ts)`` is the loop's law without force limit, measurement effects or compensator
-(:func:`~prefriction.simulation.loops.compiled_loop.control_law`); the held force is the input
-piece of the forced native driver over each period, every reversal located inside it, the step
-size carried over from period to period; :data:`NATIVE_BLOCK` periods per C call. It applies to
-an oscillator without an input force of its own, or with one that is linear over every sample
-period (a piecewise-linear kind, :class:`~prefriction.signals.Samples`,
-:class:`~prefriction.signals.ZeroOrderHold`, steps and ramps, whose break times all lie on the
-sample instants ``k Ts``: :func:`input_fits_periods`); its line over each period joins the held
-force. A run that asks for ``reversals`` stops after the block in which they came and keeps the
-samples up to the last reversal, as the CasADi loop of
+(:func:`~prefriction.simulation.loops.compiled_loop.control_law`); its output is held over each
+period, every reversal located inside it, the step size carried over from period to period;
+:data:`NATIVE_BLOCK` periods per C call. The oscillator's own input force, of any
+:mod:`prefriction.signals` kind, is generated as C as for a forced run
+(:func:`~prefriction.simulation.native.forced.input_function`) and added to the held force, the
+integration broken at its break times inside a period. A run that asks for ``reversals`` stops
+after the block in which they came and keeps the samples up to the last reversal, as the CasADi
+loop of
 :func:`prefriction.simulation.drive.sampled_loop` does.
 """
 
 from __future__ import annotations
 
+import dataclasses
 from typing import TYPE_CHECKING, Optional
 
 import numpy as np
 
 from prefriction._memory import check_memory
-from prefriction.models import Oscillator
-from prefriction.signals import compiled_form
 from prefriction.signals.compiled import linear_pieces
 from prefriction.simulation.feedback import sample_count
+from prefriction.simulation.native.forced import input_tables
 from prefriction.simulation.samples import SampleBuffer
 
 from .compiled_loop import LoopLayout, LoopSpec
@@ -36,7 +35,7 @@ if TYPE_CHECKING:
     from prefriction.simulation.plant import PlantSpec
     from prefriction.simulation.run_state import RunState
 
-__all__ = ["MIN_ORDER", "NATIVE_BLOCK", "feedback_loop_driver", "input_fits_periods", "run_feedback_loop"]
+__all__ = ["MIN_ORDER", "NATIVE_BLOCK", "feedback_loop_driver", "run_feedback_loop"]
 
 NATIVE_BLOCK = 4096
 """Sample periods per C call (bounds the records' buffers and the overshoot of a ``reversals`` stop)."""
@@ -45,26 +44,14 @@ MIN_ORDER = 2
 ``controllers.simulate_loop``)."""
 
 
-def input_fits_periods(system: Oscillator, Ts: float, t_end: float) -> bool:
-    """True if the input force of ``system`` is linear over every sample period ``[k Ts, (k+1) Ts]``
-    [s] up to ``t_end`` [s]: none, or a piecewise-linear kind whose break times are sample
-    instants (to round-off, ``1e-12 max(t_end, Ts)``)."""
-    if not system.forced:
-        return True
-    if compiled_form(system.u).key != ("PiecewiseLinear",):
-        return False
-    b = np.asarray(system.u.breaks(), dtype=float)
-    b = b[(b > 0.0) & (b < t_end)]
-    return bool(np.all(np.abs(b - Ts * np.round(b / Ts)) <= 1e-12 * max(t_end, Ts)))
-
-
 def _spec(spec: "PlantSpec", n_c: int) -> LoopSpec:
-    return LoopSpec(spec, max(n_c, MIN_ORDER), NATIVE_BLOCK)
+    """The loop of ``spec``'s plant with its input (``spec.u_sig``) and the held force added in C."""
+    return LoopSpec(dataclasses.replace(spec, fb="none"), max(n_c, MIN_ORDER), NATIVE_BLOCK)
 
 
 def feedback_loop_driver(spec: "PlantSpec", n_c: int) -> tuple[Optional[LoopDriver], float]:
     """The native loop of a sampled controller of ``n_c`` states around the open-loop plant
-    ``spec`` (a piecewise-linear input, the held force in its piece) and the setup time [s]; ``(None, 0)``
+    ``spec`` (its input force, the held force added) and the setup time [s]; ``(None, 0)``
     where it cannot be used (:func:`~prefriction.simulation.loops.native_loop.loop_driver`)."""
     return loop_driver(_spec(spec, n_c))
 
@@ -100,15 +87,13 @@ def run_feedback_loop(run: "RunState", xc0: np.ndarray, t_end: float,
     tk = np.minimum(np.arange(n_s) * Ts_n, t_end)
     par = np.zeros(LL.npar)
     P0 = loop_params(par, LL, L, run.model, sc, fb, run.eps, run.snap, run.force_scale)
-    Wall = sample_inputs(LL, fb, sc, tk, t_end, Ts_n, 0)
-    if run.system.forced:  # the input's line over each period [k Ts, (k+1) Ts] (SI)
-        ii, ta = LL.inp, tk * sc.t
-        Wall[:, ii["tl"]] = ta
-        Wall[:, ii["da"]], Wall[:, ii["db"]] = linear_pieces(run.spec.u_sig, ta, np.append(ta[1:], ta[-1] + fb.Ts))
+    Wall = sample_inputs(LL, fb, sc, tk, t_end, Ts_n, 0)  # no line of the input: it is pf_input's
     S = _loop_state(run, LL, xc0, n)
-    cfg = np.array([run.eps_native, run.eps, run.snap, sc.t, 1.0 / sc.F, run.force_scale, 0.0, 1.0, 0.0])
+    cfg = np.array([run.eps_native, run.eps, run.snap, sc.t, 1.0 / sc.F, run.force_scale, 0.0,
+                    1.0 if drv.linear else 0.0, 0.0])
     recs, cols, calls, steps, fst = run_blocks(drv, LL, S, Wall, n_s, par, np.ascontiguousarray(P0[L.q]), cfg,
-                                               NATIVE_BLOCK, n_target)
+                                               NATIVE_BLOCK, n_target,
+                                               input_tables(run, run.spec.u_sig, t_end) if run.system.forced else None)
     run.calls += calls
     run.steps = (run.steps or 0) + steps
     stopped = len(cols[0]) >= n_target
@@ -127,4 +112,16 @@ def run_feedback_loop(run: "RunState", xc0: np.ndarray, t_end: float,
     buf = SampleBuffer(n, len(recs))
     buf.extend(tk[:len(recs)], recs[:, ix["x"]], recs[:, ix["v"]], recs[:, LL.rec["F"]], 0.0,
                recs[:, ix["xc0"]: ix["xc0"] + n])
-    return buf, recs[:, LL.rec["u"]].copy()
+    return buf, recs[:, LL.rec["u"]] + _input_after(run, tk[:len(recs)] * sc.t, fb.Ts)
+
+
+def _input_after(run: "RunState", t: np.ndarray, Ts: float) -> np.ndarray:
+    """The oscillator's input force [N] applied from each sample instant ``t`` [s] on (as
+    :func:`prefriction.simulation.drive.sampled_loop` records it): a piecewise-linear input's
+    value at the start of its piece over ``[t, t + Ts]``, else the input at ``t``; zero without one."""
+    if not run.system.forced:
+        return np.zeros(len(t))
+    sig = run.spec.u_sig
+    if sig.key == ("PiecewiseLinear",):
+        return linear_pieces(sig, t, t + Ts)[0]
+    return np.asarray(run.system.u(t), dtype=float) * np.ones(len(t))

@@ -1,13 +1,14 @@
 """The sampled-data loop on the native driver: one C call per block of sample periods.
 
 :func:`loop_driver` builds (once per loop structure: model, controller order, compensator) the
-library of the model's generated code, the piecewise-linear input, the controller's law at a
+library of the model's generated code, the input force of the plant's structure (generated as
+for a forced run: :func:`~prefriction.simulation.native.forced.input_function`), the controller's law at a
 sample instant (``pf_ctrl``, from :func:`prefriction.simulation.loops.compiled_loop.control_law`)
 and ``native/loop.c`` on ``native/forced.c``; :func:`run_blocks` runs the periods of
 :func:`prefriction.simulation.loops.runner.run_sampled` on it, block by block, with the loop
 state, inputs and records of :class:`~prefriction.simulation.loops.compiled_loop.LoopLayout`
 (``docs/controllers.md#compiled-loop``). Any number of reversals per period; the step size is
-carried over from period to period.
+carried over from period to period; the input's break times are honoured inside a period.
 """
 
 from __future__ import annotations
@@ -25,7 +26,6 @@ import numpy as np
 
 from prefriction.errors import SolverError
 from prefriction.models.sizes import check_sizes
-from prefriction.signals import Constant, compiled_form
 from prefriction.simulation import library_store as store
 from prefriction.simulation.compiled import CompileInfo, jit_available, library
 from .compiled_loop import LoopLayout, LoopSpec, control_law
@@ -44,7 +44,8 @@ CAPACITY = 1 << 14  # reversal slots per C call (the loop returns to empty them 
 
 
 class LoopDriver:
-    """The ``pf_loop`` entry point of one loop structure's library (loop.c)."""
+    """The ``pf_loop`` and ``pf_loop_input`` entry points of one loop structure's library (loop.c);
+    ``linear``: the input's structure is piecewise linear."""
 
     def __init__(self, lib: ctypes.CDLL, spec: LoopSpec, info: CompileInfo) -> None:
         self.lib, self.info = lib, info
@@ -54,6 +55,10 @@ class LoopDriver:
         self.call = lib.pf_loop
         self.call.restype = ctypes.c_int
         self.call.argtypes = [_D, _D, _D, _D, ctypes.c_long, _D, _D, _D, _D, ctypes.c_long, _L]
+        self.call_input = lib.pf_loop_input
+        self.call_input.restype = ctypes.c_int
+        self.call_input.argtypes = [_D, _D, _D, ctypes.c_long, _D] + self.call.argtypes[1:]
+        self.linear = spec.plant.u_key == ("PiecewiseLinear",)
 
 
 def _control_function(spec: LoopSpec, LL: LoopLayout) -> ca.Function:
@@ -81,7 +86,7 @@ def loop_driver(spec: LoopSpec) -> tuple[Optional[LoopDriver], float]:
     model = spec.plant.model
     if not jit_available() or model.has_free_branch:
         return None, 0.0
-    key: Hashable = (spec.plant.model_key, spec.n_c, spec.comp)
+    key: Hashable = (spec.plant.model_key, spec.n_c, spec.comp, spec.plant.u_key)
     with _LOCK:
         if key in _CACHE:
             return _CACHE[key], 0.0
@@ -92,7 +97,7 @@ def loop_driver(spec: LoopSpec) -> tuple[Optional[LoopDriver], float]:
         if spec.comp.n_state or spec.comp.n_param:
             name += "_" + spec.comp.function().name()
         handle, info = library(name, source, "sampled loops in C",
-                               functools.partial(store.load_verified, symbols=("pf_run", "pf_forced", "pf_loop")),
+                               functools.partial(store.load_verified, symbols=("pf_run", "pf_forced", "pf_loop", "pf_loop_input")),
                                "the CasADi block Function")
         driver = None if handle is None else LoopDriver(handle, spec, info)
         _CACHE[key] = driver
@@ -101,11 +106,12 @@ def loop_driver(spec: LoopSpec) -> tuple[Optional[LoopDriver], float]:
 
 def loop_source(spec: LoopSpec, extra: tuple[ca.Function, ...] = ()) -> str:
     """The C source of the native loop of ``spec``: the layout's sizes, the model's generated code
-    with the input, ``pf_ctrl`` and the ``extra`` Functions, ``driver.c``, ``forced.c`` and ``loop.c``."""
+    with the input of the plant's structure (``spec.plant.u_sig``), ``pf_ctrl`` and the ``extra``
+    Functions, ``driver.c``, ``forced.c`` and ``loop.c``."""
     LL = LoopLayout(spec)
-    u_sig = compiled_form(Constant(0.0))
+    u_sig = spec.plant.u_sig
     ix, inp, rec = LL.state, LL.inp, LL.rec
-    defs = {"PF_FORCED": 1, "PF_NPC": 3, "PF_LNS": LL.nS, "PF_LNW": LL.nw, "PF_LNREC": LL.nrec,
+    defs = {"PF_FORCED": 1, "PF_NPC": u_sig.n_piece, "PF_LNS": LL.nS, "PF_LNW": LL.nw, "PF_LNREC": LL.nrec,
             "PF_LI_T0": inp["t0"], "PF_LI_T1": inp["t1"], "PF_LI_ACTIVE": inp["active"], "PF_LI_TL": inp["tl"],
             "PF_LI_DA": inp["da"], "PF_LI_DB": inp["db"], "PF_LS_S": ix["s"], "PF_LR_F": rec["F"],
             "PF_LR_U": rec["u"], "PF_LR_MOVED": rec["moved"], "PF_LR_Y": rec["y"], "PF_LR_COMP": rec["comp"]}
@@ -123,13 +129,16 @@ _WHY = {
 
 
 def run_blocks(drv: LoopDriver, LL: LoopLayout, S: np.ndarray, Wall: np.ndarray, n_s: int, par: np.ndarray,
-               q: np.ndarray, cfg: np.ndarray, block: int,
-               stop_at: float = math.inf) -> tuple[np.ndarray, tuple, int, int, np.ndarray]:
+               q: np.ndarray, cfg: np.ndarray, block: int, stop_at: float = math.inf,
+               inputs: Optional[tuple[np.ndarray, np.ndarray, int, np.ndarray]] = None,
+               ) -> tuple[np.ndarray, tuple, int, int, np.ndarray]:
     """The sample periods up to ``n_s``, or up to the block in which ``stop_at`` reversals were
     reached: the records of the periods run (``n_s`` rows unless stopped), the reversals as five
     columns ``(t~, x~, F~, W~, events)`` (events: the model events of the half-cycle ending at the
     reversal), the C calls, the accepted steps and the driver's run state after the last period
-    (entry 4: the model events since the last reversal). ``SolverError`` if a period fails."""
+    (entry 4: the model events since the last reversal). ``inputs``: the oscillator's own input as
+    ``(theta, breaks, n_breaks, pieces)`` (:func:`~prefriction.simulation.native.forced.input_tables`; None:
+    no input of its own). ``SolverError`` if a period fails."""
     S = np.ascontiguousarray(S, dtype=float).copy()
     fst = np.zeros(drv.width)
     fst[12] = fst[13] = math.nan
@@ -142,7 +151,11 @@ def run_blocks(drv: LoopDriver, LL: LoopLayout, S: np.ndarray, Wall: np.ndarray,
     while k < n_s and n_rev < stop_at:
         nb = min(block, n_s - k)
         cnt[0] = 0
-        code = drv.call(q, cfg, par, Wall[k:k + nb], nb, S, fst, recs[k:k + nb], rev, CAPACITY, cnt)
+        args = (cfg, par, Wall[k:k + nb], nb, S, fst, recs[k:k + nb], rev, CAPACITY, cnt)
+        if inputs is None:
+            code = drv.call(q, *args)
+        else:
+            code = drv.call_input(q, *inputs, *args)
         calls += 1
         n = int(cnt[0])
         if n:

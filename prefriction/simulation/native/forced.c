@@ -67,6 +67,7 @@ typedef struct {
   long nbrk, kb;
   double tunit, invFc;
   double F_last; /* the friction force of the last pf_ff */
+  const double* line; /* an added line (t_l, a, b) [s, N, N/s]: a + b (t - t_l) (a sampled loop's held force), or 0 */
 #if PF_NC
   /* the controller (normalised units, as plant.py): An (row-major), Bn, Cn, Dn, umax, kaw, then
    * the error scales 1/|Cn_i| (1 where Cn_i = 0); the reference's numbers and pieces */
@@ -85,6 +86,7 @@ static double pf_u(pf_fctx* f, double t) {
   c->arg[2] = f->pcs + f->kb * PF_NPCA;
   c->res[0] = &u;
   pf_input(c->arg, c->res, c->iw, c->w, 0);
+  if (f->line) u += f->line[1] + f->line[2] * (tsi - f->line[0]);
   return u * f->invFc;
 #else
   (void)f; (void)t;
@@ -282,7 +284,7 @@ static double pf_branch_energy(pf_fctx* f, const double* Y) {
 static int pf_forced_run(const double* q, const double* th, const double* brk, long nbrk, const double* pcs,
                          const double* cfg, double* st, double t_end, long n_max, double* rev, const double* td,
                          long nd, double* out, long* cnt, const double* fbp, const double* thr, const double* pcr,
-                         int stiff_ok) {
+                         int stiff_ok, const double* line) {
   pf_fctx f;
   pf_step P;
   double Y[PF_NF], Y0[PF_NF], Ys[PF_NF], f0[PF_NF], e[PF_NF], U[7][PF_NF], g0[PF_NEA], g1[PF_NEA], sc[PF_NF];
@@ -315,6 +317,7 @@ static int pf_forced_run(const double* q, const double* th, const double* brk, l
   (void)fbp; (void)thr; (void)pcr;
 #endif
   f.rest = rest;
+  f.line = line;
   f.c.q = q;
   f.c.snap = cfg[2];
   f.c.s = st[3];
@@ -451,6 +454,11 @@ static int pf_forced_run(const double* q, const double* th, const double* brk, l
       if (clipped && t_lim < t_end) { /* a break within round-off: the next piece */
         t = t_lim; ++f.kb; fsal = 0; h = hs;
         F0 = pf_ff(&f, t, Y, f0); fsal = 1;
+        continue;
+      }
+      if (clipped) { /* the end within round-off (a break just before it): the run is there */
+        t = t_lim;
+        h = hs;
         continue;
       }
       code = nonfinite ? PF_F_NONFINITE : PF_F_STEP_UNDERFLOW;
@@ -650,9 +658,9 @@ static int pf_forced_run(const double* q, const double* th, const double* brk, l
     if (clipped) {
       t = t_lim;
       h = fmax(h * fac, hs);
-      if (f.kb < nbrk && t >= brk[f.kb]) { /* a break: the next piece, the right-hand side anew */
+      if (f.kb < nbrk && t >= brk[f.kb]) { /* a break: the next piece, the right-hand side anew (if the run goes on) */
         ++f.kb;
-        F0 = pf_ff(&f, t, Y, f0);
+        if (t < t_end) F0 = pf_ff(&f, t, Y, f0);
       }
     } else {
       t += h;
@@ -687,14 +695,14 @@ static int pf_forced_run(const double* q, const double* th, const double* brk, l
 int pf_forced(const double* q, const double* th, const double* brk, long nbrk, const double* pcs,
               const double* cfg, double* st, double t_end, long n_max, double* rev, const double* td, long nd,
               double* out, long* cnt) {
-  return pf_forced_run(q, th, brk, nbrk, pcs, cfg, st, t_end, n_max, rev, td, nd, out, cnt, 0, 0, 0, 0);
+  return pf_forced_run(q, th, brk, nbrk, pcs, cfg, st, t_end, n_max, rev, td, nd, out, cnt, 0, 0, 0, 0, 0);
 }
 
 /* pf_forced that stops with PF_F_STIFF on a stiff stretch (the caller continues on an implicit method) */
 int pf_forced_stiff(const double* q, const double* th, const double* brk, long nbrk, const double* pcs,
                     const double* cfg, double* st, double t_end, long n_max, double* rev, const double* td, long nd,
                     double* out, long* cnt) {
-  return pf_forced_run(q, th, brk, nbrk, pcs, cfg, st, t_end, n_max, rev, td, nd, out, cnt, 0, 0, 0, 1);
+  return pf_forced_run(q, th, brk, nbrk, pcs, cfg, st, t_end, n_max, rev, td, nd, out, cnt, 0, 0, 0, 1, 0);
 }
 
 #if PF_NC
@@ -704,6 +712,6 @@ int pf_forced_stiff(const double* q, const double* th, const double* brk, long n
 int pf_forced_fb(const double* q, const double* th, const double* brk, long nbrk, const double* pcs,
                  const double* cfg, double* st, double t_end, long n_max, double* rev, const double* td, long nd,
                  double* out, long* cnt, const double* fbp, const double* thr, const double* pcr) {
-  return pf_forced_run(q, th, brk, nbrk, pcs, cfg, st, t_end, n_max, rev, td, nd, out, cnt, fbp, thr, pcr, 0);
+  return pf_forced_run(q, th, brk, nbrk, pcs, cfg, st, t_end, n_max, rev, td, nd, out, cnt, fbp, thr, pcr, 0, 0);
 }
 #endif

@@ -40,7 +40,8 @@ from prefriction.simulation.stiff_forced import advance_stiff_forced
 if TYPE_CHECKING:
     from prefriction.simulation.run_state import RunState
 
-__all__ = ["FORCED_SOURCE", "ForcedDriver", "SAMPLE_BLOCK", "forced_driver", "input_function", "run_forced"]
+__all__ = ["FORCED_SOURCE", "ForcedDriver", "SAMPLE_BLOCK", "forced_driver", "input_function", "input_tables",
+           "run_forced"]
 
 FHEAD = 14  # run-state entries before z and m (forced.c: st[])
 SAMPLE_BLOCK = 1 << 14  # requested times per C call (4 x 128 kB of output)
@@ -138,6 +139,15 @@ def _pieces(run: "RunState", sig: Any, t_end: float) -> tuple[np.ndarray, np.nda
     else:
         table = np.array([sig.piece(a, b) for a, b in zip(ta.tolist(), tb.tolist())], dtype=float)
     return np.ascontiguousarray(brk, dtype=float), np.ascontiguousarray(table.ravel())
+
+
+def input_tables(run: "RunState", u_sig: Any, t_end: float) -> tuple[np.ndarray, np.ndarray, int, np.ndarray]:
+    """The numbers of the input ``u_sig`` (the compiled form of the run's input) in the arguments
+    of ``pf_forced``: its parameters ``theta``, the break times below the normalised ``t_end``
+    (at least one entry), their count and the per-interval numbers (:func:`_pieces`)."""
+    th = np.ascontiguousarray(u_sig.params(), dtype=float)
+    brk, pcs = _pieces(run, u_sig, t_end)
+    return (th if th.size else np.zeros(1)), (brk if brk.size else np.zeros(1)), int(brk.size), pcs
 
 
 def run_forced(run: "RunState", t_end: float, n_target: float, times: Optional[np.ndarray],
