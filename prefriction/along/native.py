@@ -13,8 +13,6 @@ from __future__ import annotations
 
 import ctypes
 import functools
-import os
-import tempfile
 import threading
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Hashable, NamedTuple, Optional
@@ -26,7 +24,7 @@ from prefriction.along.emit import straight_line
 from prefriction.along.motion import MAX_SAMPLES
 from prefriction.along.step import counted_interval_function
 from prefriction.models.base import FrictionModel
-from prefriction.simulation.compiled import jit_available, library
+from prefriction.simulation.compiled import generated_source, jit_available, library
 from prefriction.simulation import library_store as store
 
 if TYPE_CHECKING:
@@ -77,12 +75,7 @@ def _copy_macro(name: str, n: int) -> str:
 
 def _generated(funs: list[ca.Function]) -> str:
     """The steps by CasADi's code generator, each called from an inline function of the pass's signature."""
-    with tempfile.TemporaryDirectory(prefix="prefriction-") as tmp:
-        cg = ca.CodeGenerator("pf_along.c", {"with_header": False})
-        for fun in funs:
-            cg.add(fun)
-        cg.generate(tmp + os.sep)
-        code = (Path(tmp) / "pf_along.c").read_text()
+    code = generated_source("pf_along", funs)
     for fun in funs:
         code += (f"PF_INLINE void {fun.name()}_in{_SIGNATURE} {{\n"
                  f"  const casadi_real* arg[{fun.sz_arg() + 1}] = {{X, &dxn, &dtn, &sp, &s, &ve, q}};\n"

@@ -38,7 +38,7 @@ import casadi as ca
 from prefriction import _safe_files as safe
 from prefriction.simulation import library_store as store
 
-__all__ = ["CompileInfo", "cache_dir", "compile_timeout", "compiled", "compiled_seconds", "jit_available", "library",
+__all__ = ["CompileInfo", "cache_dir", "compile_timeout", "compiled", "compiled_seconds", "generated_source", "jit_available", "library",
            "no_jit"]
 
 _SPENT = [0.0]  # wall time spent generating and compiling code in this process [s]
@@ -179,16 +179,29 @@ def compiled(fun: ca.Function, what: str = "") -> tuple[ca.Function, CompileInfo
     if no_jit():
         return fun, CompileInfo("interpreted", 0.0, reason="PREFRICTION_NO_JIT is set")
     name = fun.name()
-    with tempfile.TemporaryDirectory(prefix="prefriction-") as tmp:
-        src = Path(tmp) / f"{name}.c"
-        try:
-            cg = ca.CodeGenerator(src.name, {"with_header": False})
-            cg.add(fun)
-            cg.generate(tmp + os.sep)
-        except RuntimeError as exc:  # the Function cannot be code-generated
-            return fun, CompileInfo("interpreted", 0.0, reason=f"code generation failed: {exc}")
-        ext, info = library(name, src.read_text(), what or "plant", lambda lib, key: store.load(fun, lib, key))
+    try:
+        source = generated_source(name, [fun])
+    except RuntimeError as exc:  # the Function cannot be code-generated
+        return fun, CompileInfo("interpreted", 0.0, reason=f"code generation failed: {exc}")
+    ext, info = library(name, source, what or "plant", lambda lib, key: store.load(fun, lib, key))
     return (fun if ext is None else ext), info
+
+
+def generated_source(name: str, funs: list[ca.Function]) -> str:
+    """C source of the CasADi Functions ``funs`` by CasADi's code generator (no header), written as
+    ``<name>.c`` in a private temporary directory and read back.
+
+    Raises
+    ------
+    RuntimeError
+        CasADi's, for a Function that cannot be code-generated.
+    """
+    with tempfile.TemporaryDirectory(prefix="prefriction-") as tmp:
+        cg = ca.CodeGenerator(f"{name}.c", {"with_header": False})
+        for fun in funs:
+            cg.add(fun)
+        cg.generate(tmp + os.sep)
+        return (Path(tmp) / f"{name}.c").read_text()
 
 
 def library(name: str, source: str, what: str, load: Callable[[Path, str], tuple[Optional[Any], str]],

@@ -29,14 +29,12 @@ every number a run-time input.
 
 from __future__ import annotations
 
-import os
-import tempfile
 import warnings
-from pathlib import Path
 
 import casadi as ca
 
 from prefriction.models.base import FrictionModel
+from prefriction.simulation.compiled import generated_source
 from prefriction.simulation.plant import EPS_DIED, _event_indices, _select, has_potential, model_event
 
 __all__ = ["model_functions", "model_source"]
@@ -82,12 +80,7 @@ def model_source(model: FrictionModel, extra: tuple[ca.Function, ...] = ()) -> s
     """C source of :func:`model_functions` and the ``extra`` Functions (e.g. the input force of
     :mod:`~prefriction.simulation.native.forced`) with the driver's size definitions (``PF_NZ``, ...)."""
     funs = model_functions(model) + list(extra)
-    with tempfile.TemporaryDirectory(prefix="prefriction-") as tmp:
-        cg = ca.CodeGenerator("pf_model.c", {"with_header": False})
-        for f in funs:
-            cg.add(f)
-        cg.generate(tmp + os.sep)
-        code = (Path(tmp) / "pf_model.c").read_text()
+    code = generated_source("pf_model", funs)
     sizes = {
         "PF_NZ": model.n_states,
         "PF_NM": model.n_flags,
