@@ -17,18 +17,14 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import prefriction as pf
-from prefriction import controllers
 from prefriction.signals import Chirp, PointToPoint, Ramp, Samples, Sine, Step, Traced, ZeroOrderHold
 from prefriction.simulation.compiled import jit_available
 
+from _sampled_loop import MODELS, REF, STROKE, TS, agree, feedback
+
 pytestmark = pytest.mark.skipif(not jit_available(), reason="the native loop needs a C compiler")
 
-TS, T_END, STROKE = 1e-4, 0.03, 5e-6  # s, s, m
-REF = Sine(0.5 * STROKE, 50.0, phase=-math.pi / 2, offset=0.5 * STROKE)
-MODELS = {
-    "dahl": pf.Dahl(sigma=1e6, Fc=1.0),
-    "lugre": pf.LuGre(sigma0=1e6, sigma1=300.0, sigma2=0.4, Fc=1.0, Fs=1.5, vs=1e-3),
-}
+T_END = 0.03  # s
 INPUTS = {
     "sine": Sine(0.3, 70.0),
     "step_between_samples": Step(100.37 * TS, 0.0, 0.3),
@@ -37,12 +33,11 @@ INPUTS = {
 
 def _feedback() -> tuple[pf.LinearFeedback, object]:
     """The 10 kHz discrete PID (python-control's ZOH of the 150 Hz design) as a sampled feedback."""
-    Cd = controllers.design_pid(pf.Oscillator(MODELS["dahl"], 1.0), wn=2 * np.pi * 150.0, zeta=0.7).c2d(TS)
-    return pf.LinearFeedback(A=Cd.A, B=Cd.B, C=Cd.C, D=Cd.D, Ts=TS, reference=REF), Cd
+    return feedback(pf.Oscillator(MODELS["dahl"], 1.0))
 
 
 @pytest.mark.parametrize("kind", sorted(INPUTS))
-@pytest.mark.parametrize("name", sorted(MODELS))
+@pytest.mark.parametrize("name", ["dahl", "lugre"])
 def test_native_and_erk_agree(name: str, kind: str) -> None:
     """Native loop and CasADi's loop, each at rtol 1e-8: samples, applied force, controller states
     and reversals agree to 1e-8 of the stroke and of the run's length."""
@@ -50,16 +45,9 @@ def test_native_and_erk_agree(name: str, kind: str) -> None:
     fb, _ = _feedback()
     a = pf.simulate(stage, 0.0, t_end=T_END, feedback=fb, rtol=1e-8)
     b = pf.simulate(stage, 0.0, t_end=T_END, feedback=fb, rtol=1e-8, method="erk")
-    assert a.stats.steps is not None and b.stats.steps is None  # native (counts steps), CasADi
+    agree(a, b, T_END)
     assert a.stats.calls <= 2 < b.stats.calls  # one C call per block of periods, one CasADi call per period
-    assert a.status == b.status and len(a.t) == len(b.t) == round(T_END / TS) + 1
-    np.testing.assert_allclose(a.t, b.t, rtol=1e-13, atol=0)
-    assert np.max(np.abs(a.x - b.x)) <= 1e-8 * STROKE
-    assert np.max(np.abs(a.u - b.u)) <= 1e-7 * np.max(np.abs(b.u))
-    assert np.max(np.abs(a.xc - b.xc)) <= 1e-8 * np.max(np.abs(b.xc))
-    assert len(a.reversals) == len(b.reversals) >= 2
-    np.testing.assert_allclose(a.reversals.t, b.reversals.t, rtol=0, atol=1e-8 * T_END)
-    np.testing.assert_allclose(a.reversals.x, b.reversals.x, rtol=0, atol=1e-8 * STROKE)
+    assert len(a.t) == round(T_END / TS) + 1
     np.testing.assert_allclose(a.work_input, b.work_input, rtol=0, atol=1e-7 * np.max(np.abs(b.work_input)))
 
 

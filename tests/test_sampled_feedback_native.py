@@ -11,45 +11,24 @@ over each sample period.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
 import prefriction as pf
-from prefriction import controllers
-from prefriction.signals import Samples, Sine, Step, ZeroOrderHold
+from prefriction.signals import Samples, Step, ZeroOrderHold
 from prefriction.simulation.compiled import jit_available
+
+from _sampled_loop import MODELS, REF, STROKE, TS, agree, feedback
 
 pytestmark = pytest.mark.skipif(not jit_available(), reason="the native loop needs a C compiler")
 
-TS, T_END, STROKE = 1e-4, 0.04, 5e-6  # s, s, m
-REF = Sine(0.5 * STROKE, 50.0, phase=-math.pi / 2, offset=0.5 * STROKE)
-MODELS = {
-    "dahl": pf.Dahl(sigma=1e6, Fc=1.0),
-    "lugre": pf.LuGre(sigma0=1e6, sigma1=300.0, sigma2=0.4, Fc=1.0, Fs=1.5, vs=1e-3),
-    "maxwell_slip": pf.MaxwellSlip([4e5, 3e5, 3e5], [0.3, 0.3, 0.4]),
-}
-
-
-def _feedback(stage: pf.Oscillator, reference=REF) -> tuple[pf.LinearFeedback, object]:
-    """The 10 kHz discrete PID (ZOH of the 150 Hz design) as a sampled LinearFeedback, and ``c2d``'s system."""
-    Cd = controllers.design_pid(stage, wn=2 * np.pi * 150.0, zeta=0.7).c2d(TS)
-    return pf.LinearFeedback(A=Cd.A, B=Cd.B, C=Cd.C, D=Cd.D, Ts=TS, reference=reference), Cd
+T_END = 0.04  # s
 
 
 def _agree(a: pf.SimulationResult, b: pf.SimulationResult) -> None:
     """Native ``a`` and CasADi ``b``: same samples, reversals and events to the tolerance (rtol 1e-8)."""
-    assert a.stats.steps is not None and b.stats.steps is None  # the native loop counts its steps; CasADi does not
-    assert a.status == b.status and len(a.t) == len(b.t) > 10
-    np.testing.assert_allclose(a.t, b.t, rtol=1e-13, atol=0)  # (CasADi: the break times to round-off)
-    assert np.max(np.abs(a.x - b.x)) <= 1e-8 * STROKE
-    assert np.max(np.abs(a.u - b.u)) <= 1e-7 * np.max(np.abs(b.u))
-    assert np.max(np.abs(a.xc - b.xc)) <= 1e-8 * np.max(np.abs(b.xc))
-    assert len(a.reversals) == len(b.reversals) >= 2
-    np.testing.assert_allclose(a.reversals.t, b.reversals.t, rtol=0, atol=1e-8 * T_END)
-    np.testing.assert_allclose(a.reversals.x, b.reversals.x, rtol=0, atol=1e-8 * STROKE)
+    agree(a, b, T_END)
     np.testing.assert_array_equal(a.events, b.events)
     assert a.stats.events == b.stats.events
 
@@ -58,7 +37,7 @@ def _agree(a: pf.SimulationResult, b: pf.SimulationResult) -> None:
 def test_native_and_erk_agree(name: str) -> None:
     """10 kHz PID loop tracking a 5 um sine on each model: native loop and CasADi agree to 1e-8."""
     stage = pf.Oscillator(MODELS[name], 1.0)
-    fb, _ = _feedback(stage)
+    fb, _ = feedback(stage)
     a = pf.simulate(stage, 0.0, t_end=T_END, feedback=fb)
     b = pf.simulate(stage, 0.0, t_end=T_END, feedback=fb, method="erk")
     _agree(a, b)
@@ -69,7 +48,7 @@ def test_native_and_erk_agree(name: str) -> None:
 def test_reversal_stop_keeps_the_samples_up_to_it() -> None:
     """``reversals=2``: both paths stop at the second reversal with the samples up to it."""
     stage = pf.Oscillator(MODELS["lugre"], 1.0)
-    fb, _ = _feedback(stage)
+    fb, _ = feedback(stage)
     a = pf.simulate(stage, 0.0, t_end=T_END, reversals=2, feedback=fb)
     b = pf.simulate(stage, 0.0, t_end=T_END, reversals=2, feedback=fb, method="erk")
     _agree(a, b)
@@ -79,7 +58,7 @@ def test_reversal_stop_keeps_the_samples_up_to_it() -> None:
 def test_start_from_rest_with_a_step_reference_agrees() -> None:
     """The mass at rest, a 2 um step of the reference at 5 ms: it leaves rest at a sample instant."""
     stage = pf.Oscillator(MODELS["dahl"], 1.0)
-    fb, _ = _feedback(stage, Step(5e-3, 0.0, 2e-6))
+    fb, _ = feedback(stage, Step(5e-3, 0.0, 2e-6))
     a = pf.simulate(stage, 0.0, t_end=T_END, feedback=fb)
     b = pf.simulate(stage, 0.0, t_end=T_END, feedback=fb, method="erk")
     assert np.all(a.x[a.t < 5e-3] == 0.0)
@@ -101,7 +80,7 @@ def test_input_force_linear_over_each_period_runs_native(kind: str) -> None:
     else:
         u = Samples(tu[::2], 0.2 * rng.standard_normal(tu[::2].size)) + Step(150 * TS, 0.0, 0.3)
     stage = pf.Oscillator(MODELS["dahl"], 1.0, u)
-    fb, _ = _feedback(pf.Oscillator(MODELS["dahl"], 1.0))
+    fb, _ = feedback(pf.Oscillator(MODELS["dahl"], 1.0))
     a = pf.simulate(stage, 0.0, t_end=T_END, feedback=fb)
     b = pf.simulate(stage, 0.0, t_end=T_END, feedback=fb, method="erk")
     _agree(a, b)
@@ -112,7 +91,7 @@ def test_input_force_with_a_break_inside_a_period_runs_native() -> None:
     """A step half-way between two sample instants: the native loop breaks the period at it and
     agrees with CasADi's loop."""
     stage = pf.Oscillator(MODELS["dahl"], 1.0, Step(100.5 * TS, 0.0, 0.3))
-    fb, _ = _feedback(pf.Oscillator(MODELS["dahl"], 1.0))
+    fb, _ = feedback(pf.Oscillator(MODELS["dahl"], 1.0))
     _agree(pf.simulate(stage, 0.0, t_end=T_END, feedback=fb), pf.simulate(stage, 0.0, t_end=T_END, feedback=fb,
                                                                           method="erk"))
 
@@ -122,7 +101,7 @@ def test_dahl_loop_against_python_control_and_solve_ivp() -> None:
     equations (gamma = 1), the force held over each period: positions, forces and reversal times."""
     sigma, Fc, m = 1e6, 1.0, 1.0
     stage = pf.Oscillator(pf.Dahl(sigma=sigma, Fc=Fc), m)
-    fb, Cd = _feedback(stage)
+    fb, Cd = feedback(stage)
     res = pf.simulate(stage, 0.0, t_end=T_END, feedback=fb, rtol=1e-10)
 
     n_s = len(res.t)
