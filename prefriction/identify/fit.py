@@ -265,6 +265,14 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
                               offset0=offset_start)
 
     space = space_of(model, start.mass, start.offset)
+    from prefriction.identify.element_start import element_start
+
+    elements = element_start(model, data, list(space.free), start.mass, start.offset, offset)
+    if elements is not None:  # Maxwell-slip, GMS: the grid search of the force balance, said in FitResult.start
+        model = elements.model
+        start = dataclasses.replace(start, mass=elements.mass, offset=elements.offset,
+                                    steps=start.steps + (elements.line,))
+        space = space_of(model, start.mass, start.offset)
     first_steps = start.steps
     try:
         sol, error = fit_motion(model, data, space, n_sub=substeps, max_iter=max_iter, tol=tol,
