@@ -18,8 +18,10 @@ along the filtered motion by :func:`prefriction.friction_along`). A GMS element 
 Maxwell-slip element up to ``alpha_i S(v)``: its stiffnesses come from the same grid and its
 Coulomb force from the slip forces, ``Fc = sum W_i / sum alpha_i``.
 
-The start replaces the user's only where its inverse-model residual is smaller than that of the
-user's start, and :attr:`prefriction.identify.FitResult.start` says what replaced what.
+:func:`prefriction.identify.fit` starts from it only where its shooting segments follow the record
+more closely than those of the user's start (:func:`prefriction.identify.shooting.start_error`;
+the inverse model's own residual is biased by the filter and would replace even the truth), and
+:attr:`prefriction.identify.FitResult.start` says what replaced what.
 """
 
 from __future__ import annotations
@@ -101,8 +103,8 @@ def element_start(model: FrictionModel, data: Motion, free: list[str], mass0: fl
     Returns
     -------
     ElementStart or None
-        ``None`` for another model, a free decay, too many elements for the grid, a record too
-        short for the filter, or when the user's start explains the force balance as well.
+        ``None`` for another model, a free decay, too many elements for the grid, or a record too
+        short for the filter.
     """
     from prefriction.identify.derivatives import derivatives
 
@@ -132,19 +134,15 @@ def element_start(model: FrictionModel, data: Motion, free: list[str], mass0: fl
     if new is None:
         return None
     new, mass, off, how = _refine(new, data, d, free, mass, off, offset, mass_free)
-    user = _inverse_rss(model, d, data, mass_known if mass0 is None else mass0, offset0)
     ours = _inverse_rss(new, d, data, mass_known if mass is None else mass, off)
-    if not ours < user:
-        return None
     changed = [f"{name} {a:.4g} -> {b:.4g}" for name, a, b in _changes(model, new, free)]
     if mass_free and mass0 is not None:
         changed.append(f"mass {mass0:.4g} -> {mass:.4g} kg")
     if offset and "offset" in free:
         changed.append(f"offset {offset0:.4g} -> {off:.4g} N")
     line = (f"element start (the force balance u = m a + F_off + sum k_i p(x; d_i) along the filtered motion, "
-            f"{n} of {GRID} slip deflections by grid search, linear least squares; {how}): inverse-model "
-            f"residual {math.sqrt(ours):.4g} N rms against {math.sqrt(user):.4g} N of the given start, so it "
-            f"replaces it: " + ", ".join(changed))
+            f"{n} of {GRID} slip deflections by grid search, linear least squares; {how}; inverse-model "
+            f"residual {math.sqrt(ours):.4g} N rms): " + ", ".join(changed))
     return ElementStart(new, mass if mass_free else mass0, float(off), line)
 
 
@@ -181,7 +179,8 @@ def _grid(d: Any, data: Motion, n: int, mass_free: bool, mass: float,
 
 def _assign(model: FrictionModel, kind: str, k: np.ndarray, widths: np.ndarray,
             free: list[str]) -> FrictionModel | None:
-    """The user's model with the elements found, in the order of the user's slip deflections."""
+    """The user's model with the elements found: Maxwell-slip's in the order of the start's slip
+    deflections, GMS's in the order of their fractions ``alpha_i`` (held) by their slip forces."""
     from prefriction.identify.parameters import _build, _entries
 
     entries = [e for e in _entries(model) if e.field not in ("mass", "offset")]
@@ -194,9 +193,9 @@ def _assign(model: FrictionModel, kind: str, k: np.ndarray, widths: np.ndarray,
                 if name in free:
                     values[name] = float(value)
     else:
-        kk, alpha = np.asarray(model.k, float), np.asarray(model.alpha, float)
-        order = np.argsort(alpha / kk)
-        for slot, i in zip(order, np.argsort(widths)):
+        alpha = np.asarray(model.alpha, float)
+        # element i slips at alpha_i S: the slip forces found go to the elements in the order of alpha
+        for slot, i in zip(np.argsort(alpha, kind="stable"), np.argsort(k * widths, kind="stable")):
             if f"k[{slot}]" in free:
                 values[f"k[{slot}]"] = float(k[i])
         Fc = float(np.sum(k * widths) / np.sum(alpha))

@@ -39,7 +39,7 @@ from prefriction.identify.parameters import ParameterSpace
 from prefriction.identify.reversals import locate_reversals
 from prefriction.models.base import FrictionModel
 
-__all__ = ["LONG", "SEGMENT", "MotionSolution", "fit_motion"]
+__all__ = ["LONG", "SEGMENT", "MotionSolution", "fit_motion", "start_error"]
 
 SEGMENT = 50
 """Samples per shooting segment."""
@@ -145,9 +145,9 @@ class _Problem:
     multiple-shooting iterate and make the residuals discontinuous."""
 
     def __init__(self, model: FrictionModel, space: ParameterSpace, data: Motion, lay: _Layout, n_sub: int,
-                 mass_free: bool, mass: float, xs: float) -> None:
+                 mass_free: bool, mass: float, xs: float, native: bool | None = None) -> None:
         self.lay, self.nth, self.ny = lay, space.n_free, 2 + model.n_states
-        self.native = native_steps(model, len(data))
+        self.native = native_steps(model, len(data)) if native is None else native
         self.plain, self.sens = _mapped(model, space, lay.K, n_sub, mass_free, lay.J, self.native)
         self.fixed, self.mass, self.xs = space.fixed_values(), mass, xs
         self.samples = lay.samples()
@@ -342,6 +342,29 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
     sol = _solve_record(model, data, space, theta0, n_sub, max_iter, tol, reversals, progress,
                         0.01 if not steps or "did not" in steps[0] else 10.0)
     return dataclasses.replace(sol, steps=tuple(steps))
+
+
+def start_error(model: FrictionModel, data: Motion, space: ParameterSpace) -> float:
+    """Mean square position error [m^2] of the shooting segments at ``space``'s start values.
+
+    Each segment of :data:`SEGMENT` samples starts at the smoothed data (position, velocity) with
+    the model state carried from the segment before (as the fit's first iterate) and runs open
+    loop: how closely the start model follows the record, in the record's units whatever the
+    model (interpreted steps: no compilation). ``inf`` if the motion is not finite.
+    """
+    theta0 = space.theta0
+    vals = space.values(theta0)
+    mass_free = "mass" in space.start and "mass" in space.free
+    mass = vals["mass"] if mass_free else float(data.mass)
+    xsm, v, a = derivatives(data.t, data.x, _NODE_WINDOW)
+    n_sub = _substeps(model, data, mass, float(np.max(np.abs(v))), None)
+    lay = _layout(data, min(SEGMENT, len(data) - 1), _directions(data.t, data.x, v, None),
+                  np.array([model.Fc / model.sigma, model.Fc / math.sqrt(mass * model.sigma)]))
+    prob = _Problem(model, space, data, lay, n_sub, mass_free, mass, 1.0, native=False)
+    single = segment_functions(model, space, lay.K, n_sub, mass_free, False)[0]
+    w0, prob.first_flags = _start(model, data, theta0, lay, xsm, v, a, mass, vals.get("offset", 0.0), 0.5)
+    r, _g = prob.plain_eval(prob.carry_states(w0, single))
+    return float(np.mean(r * r)) if np.all(np.isfinite(r)) else math.inf
 
 
 def _busiest_window(data: Motion) -> int:
