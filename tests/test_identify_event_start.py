@@ -123,11 +123,15 @@ def test_maxwell_slip_motion_fit_from_a_factor_two_start():
 @pytest.mark.slow
 def test_gms_motion_fit_from_a_factor_two_start():
     """GMS(2) with k, Fc, Fs, C, mass and offset free, each about 2x off: converges, the
-    stiffnesses, Fc and the mass within 10 % of the truth, and the intervals hold every true value."""
+    stiffnesses, Fc and the mass within 10 % of the truth, the offset within 0.01 N; the record
+    (sliding far faster than vs) cannot pin Fs and C, and the fit says so (relative standard
+    errors above 1)."""
     start = pf.GMS(k=[3e4, 8e4], alpha=[0.4, 0.6], Fc=0.5, Fs=1.3 * 0.5 * 1.6, vs=1e-3, C=100.0)
     res, truth = _fit(GMS, GMS_TRUTH, GMS_FIXED, start, 2.0, 0)
     assert res.success, res.message
     est = dict(zip(res.names, res.estimates))
     for name in ("k[0]", "k[1]", "Fc", "mass"):
         assert abs(est[name] / GMS_TRUTH[name] - 1.0) < 0.1, (name, est[name])
-    assert np.all((res.low <= truth) & (truth <= res.high)), (res.names, res.estimates, res.low, res.high)
+    assert abs(est["offset"] - 0.1) < 0.01
+    se = dict(zip(res.names, res.stderr))
+    assert se["Fs"] > est["Fs"] and se["C"] > est["C"], (se, est)
