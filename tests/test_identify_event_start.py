@@ -135,3 +135,37 @@ def test_gms_motion_fit_from_a_factor_two_start():
     assert abs(est["offset"] - 0.1) < 0.01
     se = dict(zip(res.names, res.stderr))
     assert se["Fs"] > est["Fs"] and se["C"] > est["C"], (se, est)
+
+
+def test_single_shooting_chain_carries_the_flags_of_a_gms_slip():
+    """The chain the polish and the intervals use (every node started from the end of the
+    segment before, flags included) reproduces the scipy reference of a GMS whose elements slip
+    below their limit while the Stribeck force rises (vs of the order of the speeds); with the
+    flags cleared at the nodes (a node's state deciding its mode) those elements restart sticking
+    and the chain leaves the reference."""
+    from prefriction.identify import shooting as sh
+    from prefriction.identify.parameters import ParameterSpace
+    from prefriction.identify.synthetic_events import event_motion
+
+    model = pf.GMS(k=[6e4, 4e4], alpha=[0.4, 0.6], Fc=1.0, Fs=1.3, vs=1e-2, C=50.0)
+    T = math.sqrt(MASS / model.sigma)
+    t = np.arange(301) * 0.1 * T
+    u = 0.05 + 1.6 * np.sin(2 * np.pi * t / (10 * T)) + 0.3 * np.sin(2 * np.pi * t / (3.3 * T))
+    run = event_motion(model, MASS, t, u, offset=0.1)
+    assert run.events.size >= 6
+    data = identify.Motion(t, run.x, u, MASS)
+    space = ParameterSpace(model, None, GMS_FIXED, None, offset=1.0, offset0=0.1)
+    X, V = model.Fc / model.sigma, model.Fc / math.sqrt(MASS * model.sigma)
+    xsm, v, a = sh.derivatives(t, run.x, 7)
+    lay = sh._layout(data, 50, sh._directions(t, run.x, v, None), np.array([X, V]))
+    prob = sh._Problem(model, space, data, lay, 4, False, MASS, 1.0)
+    single = sh.segment_functions(model, space, lay.K, 4, False)[0]
+    w0, _flags = sh._start(model, data, space.theta0, lay, xsm, v, a, MASS, 0.1, 0.5)
+    w0[space.n_free:space.n_free + prob.ny] = 0.0           # the virgin state at rest, as the reference
+    prob.first_flags = [0.0] * model.n_flags
+    w = prob.carry_states(w0, single, everything=True)
+    r, g = prob.plain_eval(w)
+    assert np.max(np.abs(r)) < 1e-5 * X and np.max(np.abs(g)) == 0.0
+    prob.clear_flags()
+    r_cleared, _g = prob.plain_eval(w)
+    assert np.max(np.abs(r_cleared)) > 1e-2 * X
