@@ -125,7 +125,7 @@ def solve(full: Callable, plain: Callable, w0: np.ndarray, lo: np.ndarray, hi: n
     progress : callable, optional
         Called with one line per outer iteration.
     inner_tol : float, default 1e-8
-        ``xtol`` and ``ftol`` of the inner solves before the last.
+        ``ftol`` of the inner solves before the last (their ``xtol`` is ``1e-8``).
     final_tol : float, default 0.0
         The last inner solve uses ``max(tol, final_tol)``: a problem that is only piecewise smooth
         never meets a tight ``ftol`` (its trust region shrinks on the kinks until ``max_nfev``).
@@ -172,7 +172,7 @@ def solve(full: Callable, plain: Callable, w0: np.ndarray, lo: np.ndarray, hi: n
         final = outer > 1 and gmax_prev <= 10.0 * gtol
         sol = least_squares(fun, w, jac=jac, bounds=(lower, upper), method="trf",
                             tr_solver="exact" if dense else "lsmr",
-                            x_scale="jac", xtol=max(tol, final_tol) if final else max(tol, inner_tol),
+                            x_scale="jac", xtol=max(tol, final_tol) if final else max(tol, 1e-8),
                             ftol=max(tol, final_tol) if final else inner_tol,
                             gtol=1e-12, max_nfev=max(min(budget, _INNER) * 2, 2))
         stalled = np.array_equal(sol.x, w) or sol.nfev <= 1

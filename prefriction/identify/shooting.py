@@ -55,7 +55,7 @@ NATIVE_FROM = 1_000
 """Records of a model with in-branch events of at least this many samples run the compiled steps
 (compiling once per structure takes 10 to 30 s and makes every evaluation about 7 times faster)."""
 INNER_TOL_EVENTS = 1e-5
-"""``xtol`` and ``ftol`` of the inner solves before the last of a model with in-branch events
+"""``ftol`` of the inner solves before the last of a model with in-branch events
 (:func:`prefriction.identify.constrained_lsq.solve`): its motion is only piecewise smooth in the
 parameters (an event that moves from one sub-step to the next changes the error of its location),
 and tighter inner solves creep on those kinks."""
