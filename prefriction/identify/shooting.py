@@ -400,7 +400,10 @@ def _solve_record(model: FrictionModel, data: Motion, space: ParameterSpace, the
     mass = space.values(theta0)["mass"] if mass_free else float(data.mass)
     xsm, v, a = derivatives(data.t, data.x, _NODE_WINDOW)
     directions = _directions(data.t, data.x, v, reversals)
+    requested = n_sub
     n_sub = _substeps(model, data, mass, float(np.max(np.abs(v))), n_sub)
+    if requested is None and native_steps(model, len(data)):  # compiled per count: powers of 2 only
+        n_sub = min(64, 2 ** math.ceil(math.log2(n_sub)))
     X, V = model.Fc / model.sigma, model.Fc / math.sqrt(mass * model.sigma)
     offset0 = space.values(theta0).get("offset", 0.0)
     lay = _layout(data, min(SEGMENT, len(data) - 1), directions, np.array([X, V]))
