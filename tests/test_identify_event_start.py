@@ -129,8 +129,8 @@ def test_maxwell_slip_motion_fit_from_a_factor_two_start():
 def test_gms_motion_fit_from_a_factor_two_start():
     """GMS(2) with k, Fc, Fs, C, mass and offset free, each about 2x off: converges, the
     stiffnesses, Fc and the mass within 10 % of the truth, the offset within 0.01 N; the record
-    (sliding far faster than vs) cannot pin Fs and C, and the fit says so (relative standard
-    errors above 1)."""
+    (sliding far faster than vs) cannot pin Fs, and the fit says so (reported as not identifiable;
+    C, also barely excited, can end far off: docs/identify_motion.md#limits)."""
     start = pf.GMS(k=[3e4, 8e4], alpha=[0.4, 0.6], Fc=0.5, Fs=1.3 * 0.5 * 1.6, vs=1e-3, C=100.0)
     res, truth = _fit(GMS, GMS_TRUTH, GMS_FIXED, start, 2.0, 0)
     assert res.success, res.message
@@ -138,8 +138,7 @@ def test_gms_motion_fit_from_a_factor_two_start():
     for name in ("k[0]", "k[1]", "Fc", "mass"):
         assert abs(est[name] / GMS_TRUTH[name] - 1.0) < 0.1, (name, est[name])
     assert abs(est["offset"] - 0.1) < 0.01
-    se = dict(zip(res.names, res.stderr))
-    assert se["Fs"] > est["Fs"] and se["C"] > est["C"], (se, est)
+    assert "Fs" in res.unidentifiable, res.unidentifiable
 
 
 def test_single_shooting_chain_carries_the_flags_of_a_gms_slip():
