@@ -3,7 +3,7 @@
 A record taken under feedback (the EMPS stage under its PD loop) is simulated the way it was
 measured: at each sample ``k`` the loop reads the simulated position ``x_k``, computes
 
-    u_k = Kp (r_k - x_k) - Kd sum_j c_j (x_{k-j} - x_{k-j-1}) / dt + e_k,   |u_k| <= u_max      (1)
+    u_k = Kp (r_k - x_k) + Ki dt sum_{j<=k} (r_j - x_j) - Kd sum_j c_j (x_{k-j} - x_{k-j-1}) / dt + e_k   (1)
 
 (``r`` the recorded reference, ``c_j`` the velocity filter's taps, ``e`` an optional recorded
 additive force, e.g. EMPS's pulses), or any linear law on the error ``r - x``
@@ -15,13 +15,31 @@ cut at the reversals). The feedback keeps the simulation on the record, so it ca
 however long the record (unlike the open-loop Motion fit, which integrates the recorded force
 through the mass).
 
-The parameters (model, mass, offset) minimise ``sum (x_k - x_meas_k)^2 / w_x^2 +
-(u_k - u_meas_k)^2 / w_u^2`` by ``scipy.optimize.least_squares`` (trust-region reflective) with
-the exact Jacobian from forward sensitivities carried along the record (CasADi ``mapaccum``:
-time and memory linear in the samples). The channel weights ``w`` are the residual standard
-deviations of the start model, updated once after a first fit. Uncertainty: the Gauss-Newton
-statistics with Newey-West standard errors (:mod:`prefriction.identify.hac`) on the per-sample
-scores, since closed-loop residuals are strongly correlated in time.
+The fit has two stages, each a ``scipy.optimize.least_squares`` (trust-region reflective) with
+the exact Jacobian from forward sensitivities carried along the record (CasADi ``mapaccum``: time
+and memory linear in the samples; in-branch events located inside the sub-steps, their time's
+derivative carried, :mod:`prefriction.identify.motion_step`):
+
+1. *the loop*: the parameters (model, mass, offset) minimise ``sum (x_k - x_meas_k)^2 / w_x^2 +
+   (u_k - u_meas_k)^2 / w_u^2`` with the loop above, the channel weights ``w`` the residual
+   standard deviations of the start model, updated once after a first fit. The loop holds the
+   simulation on the record from rough starts, but its controller reads the simulated positions,
+   while the real one read the encoder: on a stiff loop its rounding error is in the recorded
+   force and biases these estimates by several standard errors;
+2. *the recorded force*: the stage driven by the recorded force ``u_meas`` (what the controller
+   computed from the encoder; it is known exactly), fitted to the positions with the initial
+   position profiled out (a replay from ``x0 + c`` is the replay from ``x0`` plus ``c``),
+   from stage 1's estimates with continuation over the record's length (an eighth, a quarter, a
+   half, all of it), then, if that fails, from the start values. It is the output-error
+   estimator of a deterministic plant with a known input, consistent under the encoder's error;
+   it is kept when it converges and its position residuals are no larger than stage 1's (a
+   record whose force does not carry its motion, e.g. a model that misses some of the
+   physics, keeps stage 1 with a ``ConvergenceWarning``).
+
+Uncertainty: Newey-West standard errors (:mod:`prefriction.identify.hac`) on the per-sample
+scores; with the encoder declared (``Motion(quantum=, x_noise=)``) stage 2 adds the covariance
+of the rounding error that samples at the same place on the grid share
+(:mod:`prefriction.identify.encoder`).
 """
 
 from __future__ import annotations
@@ -243,12 +261,23 @@ def fit_closed_loop(model: FrictionModel, data: Motion, loop: DigitalLoop, refer
         Solver tolerance.
     identifiability_limit : float, default 0.5
         Relative standard error above which a parameter is reported as not identifiable.
+    recorded : bool, default True
+        Run stage 2 (the stage driven by the recorded force) after the loop fit; ``False`` keeps
+        the loop fit's estimates.
 
     Returns
     -------
     FitResult
-        Estimates with Newey-West 95 % intervals; ``fitted`` the simulated positions, ``residuals``
-        the position residuals [m]; ``nuisance["force"]`` the simulated forces.
+        Estimates with 95 % intervals (Newey-West, plus the encoder's rounding covariance when
+        ``data.quantum`` is declared); ``fitted`` the simulated positions, ``residuals`` the
+        position residuals [m]; ``nuisance["force"]`` the simulated forces (the recorded ones
+        after stage 2); ``notes`` say which stage gave the estimates.
+
+    Warns
+    -----
+    ConvergenceWarning
+        If stage 2 was not kept (the estimates are the loop fit's), or the solver stopped
+        without converging.
 
     Raises
     ------
