@@ -162,6 +162,22 @@ class _Simulator:
         return O[0], O[1], O[2:2 + nth].T, O[2 + nth:2 + 2 * nth].T
 
 
+STEP_SHIFT = 0.1
+"""Most change of an estimate, in its standard errors, that halving the Runge-Kutta sub-steps may
+cause before the recorded-force stage refits with twice as many."""
+
+
+def _step_shift(J: np.ndarray, r: np.ndarray, r_fine: np.ndarray) -> float:
+    """Largest change of an estimate, in its (white-residual) standard errors, from the residuals
+    ``r`` to ``r_fine`` at the same parameters: the Gauss-Newton step ``(J^T J)^-1 J^T (r_fine - r)``
+    (both centred: the initial position is profiled out)."""
+    d = (r_fine - r_fine.mean()) - (r - r.mean())
+    H = np.linalg.pinv(J.T @ J)
+    step = H @ (J.T @ d)
+    se = np.sqrt(np.clip(np.diag(H), 1e-300, None)) * max(float(np.std(r)), 1e-300)
+    return float(np.max(np.abs(step) / se))
+
+
 def _series(name: str, value: Any, n: int, unit: str) -> np.ndarray:
     """A finite 1-D array of ``n`` samples, or a ValueError naming it."""
     arr = np.asarray(value, dtype=float)
@@ -374,6 +390,19 @@ def fit_closed_loop(model: FrictionModel, data: Motion, loop: DigitalLoop, refer
             if sol_o.status > 0 and rms_o <= rms_l + 1e-9 * float(np.ptp(xm)):   # (a round-off's slack)
                 theta, sol, ch, fns, route, both = sol_o.x, sol_o, ch_o, fns_o, "recorded", False
                 steps.append(f"the stage driven by the recorded force, from {origin}: {sol.message}")
+                k_sub = n_sub
+                while k_sub < 64:   # sub-steps fine enough that halving them moves no estimate
+                    fine = _Simulator(model, free_loop, space, data.t.size, 2 * k_sub, data.mass is None)
+                    run = lambda t_: fine.run(t_, x0, r, um, mass)   # noqa: E731
+                    J = fns[1](theta)
+                    shift = _step_shift(J, fns[0](theta), (run(theta)[0] - xm) / w[0])
+                    if shift <= STEP_SHIFT:
+                        break
+                    k_sub *= 2
+                    sol, ch, fns = solve(run, theta, w, False, True)
+                    theta = sol.x
+                    steps.append(f"{k_sub} sub-steps per sample (halving the step moved an estimate by {shift:.2g} "
+                                 f"standard errors): {sol.message}")
                 break
             why += (f"; from {origin}: " + (sol_o.message if not sol_o.status > 0 else
                                            f"position residuals of rms {rms_o:.3g} m, more than the loop's "
