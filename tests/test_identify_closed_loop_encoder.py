@@ -112,3 +112,12 @@ def test_step_shift_is_the_gauss_newton_step_in_standard_errors():
     se = np.sqrt(np.diag(np.linalg.inv(J.T @ J))) * np.std(r)
     # residuals that move by J delta (plus a constant: the profiled initial position) move the estimates by delta
     assert _step_shift(J, r, r + J @ delta + 3.0) == pytest.approx(np.max(np.abs(delta) / se), rel=1e-9)
+
+
+@pytest.mark.slow  # ten records and fits, about 40 s
+def test_coverage_with_a_50_nm_encoder():
+    from prefriction.identify._coverage import coverage_table
+
+    (row,) = coverage_table(("loop-fit-pid-50nm",), runs=10, seed=1)
+    assert row.failures == 0 and row.within == row.runs, row
+    assert row.pooled >= 0.9, row.held   # 30 intervals: P(below 90 % | 95 % coverage) about 6 %
