@@ -121,3 +121,21 @@ def test_coverage_with_a_50_nm_encoder():
     (row,) = coverage_table(("loop-fit-pid-50nm",), runs=10, seed=1)
     assert row.failures == 0 and row.within == row.runs, row
     assert row.pooled >= 0.9, row.held   # 30 intervals: P(below 90 % | 95 % coverage) about 6 %
+
+
+def test_grid_of_undeclared_encoder_positions_is_found():
+    from prefriction.identify.encoder import grid_step
+
+    x = 1e-8 * np.round(np.sin(np.linspace(0.0, 6.0, 2000)) * 300.0) + 3.7e-7
+    assert grid_step(x) == pytest.approx(1e-8, rel=1e-9)
+    assert grid_step(x + 1e-10 * np.random.default_rng(0).standard_normal(x.size)) == 0.0   # not on a grid
+    assert grid_step(np.sin(np.linspace(0.0, 6.0, 2000)) * 1e-6) == 0.0                     # smooth positions
+
+
+def test_undeclared_encoder_warns_and_names_the_step():
+    n = 800
+    rec = closed_loop_event_record(pf.Dahl(sigma=2e6, Fc=3.0), M, DT, reference(n), offset=0.2, quantum=1e-8,
+                                   noise=2e-9, rng=np.random.default_rng(0), **GAINS)
+    with pytest.warns(identify.NoisyPositionsWarning, match=r"grid of 1e-08 m"):
+        identify.fit_closed_loop(pf.Dahl(sigma=2e6, Fc=3.0), identify.Motion(rec.t, rec.x, rec.u, M), LOOP,
+                                 reference(n), fixed=["gamma"])

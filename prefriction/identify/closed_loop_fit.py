@@ -55,11 +55,12 @@ import numpy as np
 from prefriction._validation import check_count, check_positive
 from prefriction.identify.data import Motion
 from prefriction.identify.digital_loop import DigitalLoop
-from prefriction.identify.encoder import rounding_covariance, widened
+from prefriction.identify.encoder import grid_step, rounding_covariance, widened
 from prefriction.identify.hac import sandwich
 from prefriction.identify.options import check_solver
 from prefriction.identify.result import FitResult
-from prefriction.identify.statistics import ConvergenceWarning, IdentifiabilityWarning, at_bounds, gauss_newton
+from prefriction.identify.statistics import (ConvergenceWarning, IdentifiabilityWarning, NoisyPositionsWarning, at_bounds,
+                                             gauss_newton)
 from prefriction.models.base import FrictionModel
 
 __all__ = ["fit_closed_loop", "simulate_closed_loop"]
@@ -420,6 +421,11 @@ def fit_closed_loop(model: FrictionModel, data: Motion, loop: DigitalLoop, refer
     stats = gauss_newton(J, rr, names, est, space.scale, limit=identifiability_limit)
     stats, lag = sandwich(J, rr, stats, est, space.scale, channels=2 if both else 1, names=names,
                           limit=identifiability_limit)
+    if route == "recorded" and data.quantum == 0.0 and (q := grid_step(xm)) > 0.0:
+        warnings.warn(f"the positions lie on a grid of {q:.3g} m (an encoder) that data does not declare: the "
+                      f"intervals leave out the rounding error that samples at the same place on the grid share; "
+                      f"declare it, Motion(..., quantum={q:.3g}, x_noise=...) (docs/identify_closed_loop.md)",
+                      NoisyPositionsWarning, stacklevel=2)
     if route == "recorded" and data.quantum > 0.0:   # the rounding error shared by samples on the same grid place
         W = np.linalg.pinv(J.T @ J) @ J.T * (space.scale[:, None] / w[0])
         stats = widened(stats, rounding_covariance(W, rx + xm, float(data.x_noise), float(data.quantum)), est)

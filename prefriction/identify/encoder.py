@@ -30,10 +30,28 @@ from scipy.stats import t as student_t
 
 from prefriction.identify.statistics import Statistics
 
-__all__ = ["rounding_covariance", "widened"]
+__all__ = ["grid_step", "rounding_covariance", "widened"]
 
 HARMONICS = 64
 """Most harmonics of (E2) kept; those whose amplitude is below 1e-3 of the first are dropped."""
+
+
+def grid_step(x: np.ndarray) -> float:
+    """The step [m] of the grid the positions ``x`` lie on (an encoder's, undeclared), or 0.
+
+    The smallest non-zero increment, if every position is ``x[0]`` plus a whole number of it
+    (within 1e-6 of a step) and the range holds at most 1e7 of it.
+    """
+    x = np.asarray(x, dtype=float)
+    steps = np.abs(np.diff(x))
+    steps = steps[steps > 0.0]
+    if steps.size == 0:
+        return 0.0
+    q = float(np.min(steps))
+    k = (x - x[0]) / q
+    if np.ptp(k) > 1e7 or np.max(np.abs(k - np.round(k))) > 1e-6:
+        return 0.0
+    return q
 
 
 def rounding_covariance(W: np.ndarray, path: np.ndarray, x_noise: float, quantum: float) -> np.ndarray:
