@@ -59,8 +59,8 @@ from prefriction.identify.encoder import grid_step, rounding_covariance, widened
 from prefriction.identify.hac import sandwich
 from prefriction.identify.options import check_solver
 from prefriction.identify.result import FitResult
-from prefriction.identify.statistics import (ConvergenceWarning, IdentifiabilityWarning, NoisyPositionsWarning, at_bounds,
-                                             gauss_newton)
+from prefriction.identify.statistics import (ConvergenceWarning, IdentifiabilityWarning, NoisyPositionsWarning,
+                                             at_bounds, gauss_newton)
 from prefriction.models.base import FrictionModel
 
 __all__ = ["fit_closed_loop", "simulate_closed_loop"]
@@ -380,7 +380,7 @@ def fit_closed_loop(model: FrictionModel, data: Motion, loop: DigitalLoop, refer
             for n in sorted({min(max(n_all // 2 ** j, 200), n_all) for j in range(3, -1, -1)}):
                 # continuation over the record's length: a replay drifts more the longer it runs from a start
                 opened = _Simulator(model, free_loop, space, n, n_sub, data.mass is None)
-                out = solve(lambda t_: opened.run(t_, x0, r[:n], um[:n], mass), th, w, False, True)
+                out = solve(lambda t_, o=opened, n=n: o.run(t_, x0, r[:n], um[:n], mass), th, w, False, True)
                 th = out[0].x
             return out
 
@@ -394,7 +394,7 @@ def fit_closed_loop(model: FrictionModel, data: Motion, loop: DigitalLoop, refer
                 k_sub = n_sub
                 while k_sub < 64:   # sub-steps fine enough that halving them moves no estimate
                     fine = _Simulator(model, free_loop, space, data.t.size, 2 * k_sub, data.mass is None)
-                    run = lambda t_: fine.run(t_, x0, r, um, mass)   # noqa: E731
+                    run = lambda t_, f=fine: f.run(t_, x0, r, um, mass)   # noqa: E731
                     J = fns[1](theta)
                     shift = _step_shift(J, fns[0](theta), (run(theta)[0] - xm) / w[0])
                     if shift <= STEP_SHIFT:
@@ -447,8 +447,9 @@ def fit_closed_loop(model: FrictionModel, data: Motion, loop: DigitalLoop, refer
     kept = {"loop": f"the loop simulated on its own positions, fitted to positions{' and forces' if both else ''}"
                     f" with channel weights {w[0]:.3g} m and {w[1]:.3g} N",
             "recorded": "the stage driven by the recorded force, fitted to positions"}[route]
-    notes = ("route: closed-loop output error", *steps, f"estimates and intervals: {kept} (the residual sd shown is "
-             f"of the positions; forces: rms {np.sqrt(np.mean(ru ** 2)):.4g} N)", f"Newey-West standard errors, lag {lag}")
+    notes = ("route: closed-loop output error", *steps,
+             f"estimates and intervals: {kept} (the residual sd shown is of the positions; forces: rms "
+             f"{np.sqrt(np.mean(ru ** 2)):.4g} N)", f"Newey-West standard errors, lag {lag}")
     return FitResult(space.build(vals), fitted_mass, tuple(names), tuple(space.units[n] for n in names), est,
                      stats.stderr, low, high, stats.correlation, xm - x_sim, x_sim, data, stats,
                      {"force": u_sim, "force_rms": float(np.sqrt(np.mean(ru ** 2)))},
