@@ -139,3 +139,26 @@ def test_undeclared_encoder_warns_and_names_the_step():
     with pytest.warns(identify.NoisyPositionsWarning, match=r"grid of 1e-08 m"):
         identify.fit_closed_loop(pf.Dahl(sigma=2e6, Fc=3.0), identify.Motion(rec.t, rec.x, rec.u, M), LOOP,
                                  reference(n), fixed=["gamma"])
+
+
+@pytest.mark.parametrize("model", [pf.Dahl(sigma=2e6, Fc=3.0, gamma=0.5),
+                                   pf.MaxwellSlip(stiffness=[1e6, 6e5], slip_force=[1.0, 2.0])])
+def test_loop_sensitivities_through_events_match_central_differences(model):
+    from prefriction.identify.closed_loop_fit import _Simulator
+    from prefriction.identify.parameters import ParameterSpace
+
+    n = 300
+    r = reference(n)
+    space = ParameterSpace(model, None, None, None, offset=1.0)
+    sim = _Simulator(model, LOOP, space, n, 4, False)
+    theta = space.theta0.copy()
+    theta[space.free.index("offset")] = 0.2
+    _, u, _, du = sim.run(theta, 0.0, r, np.zeros(n), M)
+    for j in range(space.n_free):
+        h = 1e-6 * max(abs(theta[j]), 1.0)
+        up, dn = theta.copy(), theta.copy()
+        up[j] += h
+        dn[j] -= h
+        fd = (sim.run(up, 0.0, r, np.zeros(n), M)[1] - sim.run(dn, 0.0, r, np.zeros(n), M)[1]) / (2.0 * h)
+        noise = 100.0 * np.finfo(float).eps * np.max(np.abs(u)) / h   # the differences' round-off
+        assert np.max(np.abs(du[:, j] - fd)) <= 1e-4 * np.max(np.abs(fd)) + noise, space.free[j]
