@@ -13,6 +13,7 @@ from prefriction.errors import SolverError
 from prefriction.identify.data import ForceDisplacement, ForceVelocity, Motion
 from prefriction.identify.options import check_solver
 from prefriction.identify.parameters import ParameterSpace, name_list
+from prefriction.identify.pinned import unpinned_message as _unpinned_message
 from prefriction.identify.result import FitResult
 from prefriction.identify.validation import model_name
 from prefriction.identify.statistics import (BoundWarning, ConvergenceWarning, IdentifiabilityWarning,
@@ -234,7 +235,7 @@ def _fit_prescribed(model: FrictionModel, data: ForceDisplacement, free: Any, fi
                          extra=sol.extra_covariance)
     nuisance = {"initial force F0 [N]": float(sol.prediction[0])}
     return _finish(space, values, est, stats, -sol.residuals, sol.prediction, data, None, nuisance, sol.message,
-                   sol.success, level=6)
+                   sol.success, level=6, limit=limit)
 
 
 def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bounds: Any, mass0: Any, offset0: Any,
@@ -271,8 +272,10 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
                                 reversals=reversals), None
     except SolverError as err:
         sol, error = None, err
+    retried = False
     if sol is None or not sol.success:  # second start from the data alone (motion_start.data_start)
         second = data_start(model, space.free, start)
+        retried = second is not None
         first = str(error) if sol is None else sol.message
         if second is not None:
             try:
@@ -296,18 +299,61 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
         if extra:
             raise SolverError(f"{error}{extra}") from error
         raise error
+    values, est, stats = _motion_statistics(space, sol, limit)
+    if sol.success and not retried and (found := _unpinned(space, values, est, stats, limit)):
+        second = data_start(model, space.free, start)  # an estimate the bound holds, not the data: retry
+        why = "; ".join(w for _, w in found)
+        if second is None:
+            start = dataclasses.replace(start, steps=start.steps + (
+                f"the fit from these start values ended with {why}; no second start from the data (no static "
+                f"estimates, or they change nothing)",))
+        else:
+            try:
+                space2 = space_of(second[0], second[1], second[2])
+                sol2 = fit_motion(second[0], data, space2, n_sub=substeps, max_iter=max_iter, tol=tol,
+                                  reversals=reversals)
+            except (SolverError, ValueError) as err2:
+                sol2, said = None, f"failed ({str(err2)[:200]})"
+            else:
+                said = "converged" if sol2.success else "did not converge"
+            if sol2 is not None and sol2.success:
+                v2, e2, s2 = _motion_statistics(space2, sol2, limit)
+                if not _unpinned(space2, v2, e2, s2, limit):
+                    sol, space, values, est, stats = sol2, space2, v2, e2, s2
+                    said += ", its result kept"
+                else:
+                    said += " on a bound the data do not pin down either, the first fit's result kept"
+            elif sol2 is not None:
+                said += ", the first fit's result kept"
+            start = dataclasses.replace(start, steps=start.steps + (
+                f"the fit from these start values ended with {why}; second start from {second[3]}: {said}",))
     message = sol.message
     if not sol.success:
         advice = _route_advice(data)
         message = f"{message}; {advice}" if advice else message
+    mass = values["mass"] if data.mass is None else data.mass
+    return _finish(space, values, est, stats, -sol.residuals, sol.prediction, data, mass, sol.nuisance, message,
+                   sol.success, start=start.steps + sol.steps, limit=limit)
+
+
+def _motion_statistics(space: ParameterSpace, sol: Any, limit: float) -> tuple[dict, np.ndarray, Any]:
+    """Values by name, the free estimates and their statistics of a Motion solution."""
     values = space.values(sol.w[: space.n_free])
     est = np.array([values[n] for n in space.free])
     J, scale = space.physical_jacobian(sol.jacobian)
-    stats = gauss_newton(J, sol.residuals, space.free, est, scale, constraints=sol.constraints, limit=limit,
-                         covariance="hac")
-    mass = values["mass"] if data.mass is None else data.mass
-    return _finish(space, values, est, stats, -sol.residuals, sol.prediction, data, mass, sol.nuisance, message,
-                   sol.success, start=start.steps + sol.steps)
+    return values, est, gauss_newton(J, sol.residuals, space.free, est, scale, constraints=sol.constraints,
+                                     limit=limit, covariance="hac")
+
+
+def _unpinned(space: ParameterSpace, values: dict, est: np.ndarray, stats: Any,
+              limit: float) -> tuple[tuple[str, str], ...]:
+    """The estimates on a bound the data do not pin down (:func:`prefriction.identify.pinned.unpinned`)."""
+    from prefriction.identify.pinned import unpinned
+
+    lower, upper = space.limits(values)
+    start = np.array([abs(space.start[n]) for n in space.free])
+    return unpinned(space.free, est, stats.stderr, stats.low, stats.high, start, lower, upper, space.why_low,
+                    space.why_high, limit)
 
 
 def _route_advice(data: Motion) -> str:
@@ -324,8 +370,13 @@ def _route_advice(data: Motion) -> str:
 
 def _finish(space: ParameterSpace, values: dict, est: np.ndarray, stats: Any, residuals: np.ndarray,
             fitted: np.ndarray, data: Any, mass: float | None, nuisance: dict, message: str,
-            success: bool = True, level: int = 4, start: tuple[str, ...] = ()) -> FitResult:
+            success: bool = True, level: int = 4, start: tuple[str, ...] = (), limit: float = 0.5) -> FitResult:
     fitted_model = space.build(values)
+    found = _unpinned(space, values, est, stats, limit) if success else ()
+    if found:  # on a bound the data do not pin down: not a success (docs/identify.md#bounds)
+        tried = "" if not any("second start from" in line for line in start) else \
+            " (a second start from the data was tried, see FitResult.start)"
+        message, success = f"{_unpinned_message(found, tried)}; solver: {message}", False
     for name, why in stats.unidentifiable:
         warnings.warn(f"the data cannot identify {name}: {why}; its interval is meaningless. Fix it (fixed=[{name!r}]) "
                       f"or record data that excite it (docs/identify.md#identifiability)",
@@ -339,7 +390,10 @@ def _finish(space: ParameterSpace, values: dict, est: np.ndarray, stats: Any, re
             todo = "fit the other structure (structures='both')" if "structure" in flag else "widen the bound"
             warnings.warn(f"{name} = {value:.6g} ends {flag}: the data may want a value beyond it; {todo} "
                           f"(docs/identify.md#bounds)", BoundWarning, stacklevel=level)
-    if not success:
+    if found:
+        warnings.warn(f"the fit of {model_name(fitted_model)} is not a success: {message}", ConvergenceWarning,
+                      stacklevel=level)
+    elif not success:
         warnings.warn(f"the fit of {model_name(fitted_model)} did not converge: {message}; the estimates are where "
                       f"the solver stopped (raise max_iter, or give better start values)", ConvergenceWarning,
                       stacklevel=level)
