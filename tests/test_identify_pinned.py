@@ -10,6 +10,7 @@ small-amplitude record cannot separate follows from the expansion of that branch
 
 from __future__ import annotations
 
+import importlib
 import math
 import sys
 import warnings
@@ -67,21 +68,52 @@ def test_unpinned_tells_an_unpinned_bound_from_a_pinned_one():
 
 
 @pytest.mark.slow
-def test_noisy_dahl_fit_on_the_gamma_bound_is_not_called_a_success():
-    """The noisy Dahl (gamma 0.6 + offset) record of seed 0 from 1.5x: the solver stops at
-    gamma = 0 with a standard error of about 4 (about 25 s on a loaded machine: slow). The result
-    says it is no success, names gamma and what helps; FitResult.unidentifiable names it too."""
+def test_noisy_dahl_fit_on_the_gamma_bound_is_not_called_a_success(monkeypatch):
+    """The noisy Dahl (gamma 0.6 + offset) record of seed 0 from 1.5x, without the continuation
+    in gamma: the solver stops at gamma = 0 with a standard error of about 4 (about 25 s on a
+    loaded machine: slow). The result says it is no success, names gamma and what helps;
+    FitResult.unidentifiable names it too."""
+    fit_module = importlib.import_module("prefriction.identify.fit")
+    monkeypatch.setattr(fit_module, "_gamma_continuation", lambda *a, **k: (None, "continuation off (test)"))
     with pytest.warns(ConvergenceWarning, match="cannot pin down gamma"):
-        res, truth = _noisy_gamma_fit(0)
+        res, _truth = _noisy_gamma_fit(0)
     gamma = res.names.index("gamma")
-    if res.success:   # a second start that landed: then it must be a real one
-        assert res.low[gamma] <= truth[gamma] <= res.high[gamma]
-        return
+    assert not res.success
     assert res.estimates[gamma] < 1e-6
     assert "cannot pin down gamma" in res.message and "fixed=['gamma']" in res.message
     assert "longer record" in res.message
     assert "gamma" in res.unidentifiable
     assert "NOT CONVERGED" in res.summary() and "not identifiable: gamma" in res.summary()
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed, factor", [(0, 1.5), (5, 2.0)])
+def test_continuation_in_gamma_lands_the_noisy_fits_that_ended_on_the_bound(seed, factor):
+    """The same records with the pipeline as shipped: seed 0 from 1.5x (and seed 5 from a random
+    start within 2x, which ended on gamma = 0 too) is refitted with gamma held at its start, then
+    freed, and lands within 5 % of every parameter (the issue's success criterion) with intervals
+    that hold the truth (about 20-60 s each: slow)."""
+    model, _fixed = MODELS["dahl"]
+    t, u = _drive(model, 300)
+    data = event_record(model, 1.0, t, u, offset=0.1, noise=0.01 * model.Fc / model.sigma,
+                        rng=np.random.default_rng(seed))
+    if factor == 1.5:
+        start, off0 = _start("dahl", 1.5), None
+    else:
+        rng = np.random.default_rng([seed, 7, 200])
+        f = [math.exp(rng.uniform(-math.log(2.0), math.log(2.0))) for _ in range(3)]
+        start = pf.Dahl(1e5 * f[1], 1.0 * f[2], min(0.6 * f[0], 0.95))
+        off0 = 0.1 + rng.uniform(-math.log(2.0), math.log(2.0))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = identify.fit(start, data, offset=True, offset0=off0)
+    truth = dict(sigma=model.sigma, Fc=model.Fc, gamma=model.gamma, offset=0.1)
+    assert res.success, res.message
+    assert any(line.startswith("continuation in gamma") and "its result kept" in line for line in res.start)
+    for n, v in truth.items():
+        assert abs(res.estimate(n) - v) <= 0.05 * (model.Fc if n == "offset" else v), (n, res.estimate(n))
+        lo, hi = res.interval(n)
+        assert lo <= v <= hi, (n, lo, v, hi)
 
 
 def _noisy_gamma_fit(seed: int):
