@@ -273,16 +273,6 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
                                 reversals=reversals), None
     except SolverError as err:
         sol, error = None, err
-    gamma = gamma_entry(model)
-    if gamma in space.free and _doubtful(space, sol, limit, gamma):  # continuation in Dahl's gamma
-        cont, line = _gamma_continuation(model, data, space, gamma, free, fixed, bounds, space_of, substeps,
-                                         max_iter, tol, reversals, limit)
-        kept = cont is not None and (sol is None or _doubtful(space, sol, limit, gamma)
-                                     or _rss(cont[0]) <= _rss(sol))
-        start = dataclasses.replace(start, steps=start.steps + (
-            line + ("" if cont is None else ": its result kept" if kept else ": the first fit's result kept"),))
-        if kept:
-            sol, space, error = cont[0], cont[1], None
     retried = False
     if sol is None or not sol.success:  # second start from the data alone (motion_start.data_start)
         second = data_start(model, space.free, start)
@@ -305,6 +295,16 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
                     + ("" if keep else ", the first fit's result kept"),))
                 if keep:
                     sol, space, error = sol2, space2, None
+    gamma = gamma_entry(model)
+    if gamma in space.free and _doubtful(space, sol, limit, gamma):  # continuation in Dahl's gamma
+        cont, line = _gamma_continuation(model, data, space_of(model, start.mass, start.offset), gamma, free, fixed,
+                                         bounds, space_of, substeps, max_iter, tol, reversals, limit)
+        kept = cont is not None and (sol is None or _doubtful(space, sol, limit, gamma)
+                                     or _rss(cont[0]) <= _rss(sol))
+        start = dataclasses.replace(start, steps=start.steps + (
+            line + ("" if cont is None else ": its result kept" if kept else ": the first fit's result kept"),))
+        if kept:
+            sol, space, error = cont[0], cont[1], None
     if sol is None:
         extra = "".join(f"; {x}" for x in (_route_advice(data), *start.steps[len(first_steps):]) if x)
         if extra:
