@@ -84,6 +84,7 @@ def test_noisy_dahl_fit_on_the_gamma_bound_is_not_called_a_success(monkeypatch):
     assert "longer record" in res.message
     assert "gamma" in res.unidentifiable
     assert "NOT CONVERGED" in res.summary() and "not identifiable: gamma" in res.summary()
+    assert "cannot pin down gamma" in res.report()
 
 
 @pytest.mark.slow
@@ -147,6 +148,7 @@ def test_small_amplitude_record_does_not_pin_gamma_and_the_result_says_so():
     assert "gamma" in res.unidentifiable and "sigma" not in res.unidentifiable, res.unidentifiable
     assert "cannot identify gamma" in said
     assert "not identifiable: gamma" in res.summary()
+    assert "NOT IDENTIFIABLE from these data: gamma" in res.report()
     assert not res.success
     sigma = res.names.index("sigma")
     assert abs(res.estimates[sigma] - model.sigma) < 0.03 * model.sigma
