@@ -369,7 +369,7 @@ def _gamma_continuation(model: FrictionModel, data: Motion, space: ParameterSpac
     coefficient, mass and offset settle where the data put them; freed from there, ``gamma``
     starts in the valley of the truth instead of running to a bound (measured on the noisy
     300-sample Dahl ``gamma = 0.6`` records of ``tests/test_identify_pinned.py``: the fits that
-    ended at ``gamma = 0`` or at an unidentifiable ``gamma`` land within 2 % of every parameter).
+    ended at ``gamma = 0`` or at an unidentifiable ``gamma`` land within 4 % of every parameter).
 
     Returns
     -------
