@@ -34,6 +34,7 @@ from typing import Any, Sequence
 import casadi as ca
 import numpy as np
 
+from prefriction._blas_threads import with_one_blas_thread
 from prefriction._validation import check_count, check_positive
 from prefriction.identify.data import Motion
 from prefriction.identify.digital_loop import DigitalLoop
@@ -199,6 +200,7 @@ def simulate_closed_loop(model: FrictionModel, loop: DigitalLoop, t: Any, r: Any
     return x, u
 
 
+@with_one_blas_thread
 def fit_closed_loop(model: FrictionModel, data: Motion, loop: DigitalLoop, reference: Any, *, offset: bool = True,
                     extra: Any = None, free: Sequence[str] | None = None, fixed: Sequence[str] | None = None,
                     bounds: dict | None = None, mass0: float | None = None, offset0: float = 0.0,

@@ -33,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from prefriction._blas_threads import with_one_blas_thread
 from prefriction.identify.data import ForceDisplacement, Motion
 from prefriction.identify.hac import sandwich
 from prefriction.identify.options import check_solver
@@ -154,6 +155,7 @@ def inverse_start(model: FrictionModel | StaticFriction, data: Motion, deriv: De
     return space.build(vals), est["mass"], est["offset"]
 
 
+@with_one_blas_thread
 def fit_inverse(model: FrictionModel | StaticFriction, data: Motion, *, offset: bool = True,
                 directional: bool = False, free: Any = None, fixed: Any = None, bounds: dict | None = None,
                 mass0: float | None = None, offset0: float = 0.0, deriv: Derivatives | None = None,
