@@ -34,7 +34,7 @@ from typing import Any, Sequence
 import casadi as ca
 import numpy as np
 
-from prefriction._blas_threads import with_one_blas_thread
+from prefriction._blas_threads import one_blas_thread
 from prefriction._validation import check_count, check_positive
 from prefriction.identify.data import Motion
 from prefriction.identify.digital_loop import DigitalLoop
@@ -200,7 +200,6 @@ def simulate_closed_loop(model: FrictionModel, loop: DigitalLoop, t: Any, r: Any
     return x, u
 
 
-@with_one_blas_thread
 def fit_closed_loop(model: FrictionModel, data: Motion, loop: DigitalLoop, reference: Any, *, offset: bool = True,
                     extra: Any = None, free: Sequence[str] | None = None, fixed: Sequence[str] | None = None,
                     bounds: dict | None = None, mass0: float | None = None, offset0: float = 0.0,
@@ -305,8 +304,9 @@ def fit_closed_loop(model: FrictionModel, data: Motion, loop: DigitalLoop, refer
             _, _, dx, du = channels(th)
             return np.vstack((dx / w[0], du / w[1])) if forces else dx / w[0]
 
-        sol = least_squares(res, theta, jac=jac, bounds=(lo, hi), method="trf", x_scale=1.0, xtol=tol, ftol=tol,
-                            gtol=tol, max_nfev=max_iter)
+        with one_blas_thread():
+            sol = least_squares(res, theta, jac=jac, bounds=(lo, hi), method="trf", x_scale=1.0, xtol=tol, ftol=tol,
+                                gtol=tol, max_nfev=max_iter)
         theta = sol.x
         rx, ru, _, _ = channels(theta)
         w = [max(float(np.std(rx)), 1e-15), max(float(np.std(ru)), 1e-12)]

@@ -33,6 +33,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.optimize import least_squares
 
+from prefriction._blas_threads import with_one_blas_thread
 from prefriction.identify.kkt import STEPS, polish
 
 __all__ = ["LsqOutcome", "solve"]
@@ -91,6 +92,7 @@ class _Cache:
         return self.value
 
 
+@with_one_blas_thread
 def solve(full: Callable, plain: Callable, w0: np.ndarray, lo: np.ndarray, hi: np.ndarray, *, max_iter: int,
           tol: float, gtol: float = 1e-9, weight: float = _MU0,
           restart: Callable[[np.ndarray], np.ndarray] | None = None,

@@ -8,7 +8,6 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from prefriction._blas_threads import with_one_blas_thread
 from prefriction._validation import check_bool, check_count, check_finite, check_positive
 from prefriction.errors import SolverError
 from prefriction.identify.data import ForceDisplacement, ForceVelocity, Motion
@@ -22,7 +21,6 @@ from prefriction.models.base import FrictionModel
 
 __all__ = ["fit"]
 
-@with_one_blas_thread
 def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequence[str] | None = None,
         fixed: Sequence[str] | None = None, bounds: dict[str, tuple[float, float]] | None = None,
         offset: bool = False, structures: str = "given", mass0: float | None = None, offset0: float | None = None,
