@@ -30,6 +30,7 @@ import casadi as ca
 import numpy as np
 import scipy.sparse as sp
 
+from prefriction._blas_threads import with_one_blas_thread
 from prefriction.errors import SolverError
 from prefriction.identify.constrained_lsq import solve
 from prefriction.identify.data import Motion
@@ -83,10 +84,16 @@ class _Layout:
     s: np.ndarray
     scl: np.ndarray
     n: int
+    free: np.ndarray
 
     @property
     def J(self) -> int:
         return int(self.nodes.size)
+
+    @property
+    def starts(self) -> np.ndarray:
+        """Nodes that start a piece of the chain (the first node and every node inside a hover)."""
+        return np.flatnonzero(self.free)
 
     def samples(self) -> np.ndarray:
         """Index of the data sample of every output column (``-1``: the end of a segment or padding)."""
@@ -97,7 +104,9 @@ class _Layout:
         return idx.ravel()
 
 
-def _layout(data: Motion, K: int, directions: np.ndarray, scl: np.ndarray) -> _Layout:
+def _layout(data: Motion, K: int, directions: np.ndarray, scl: np.ndarray, speed: np.ndarray | None = None) -> _Layout:
+    """Segments of ``K`` samples; with the smoothed speed of the data, the nodes inside hovers
+    (:func:`_hover_nodes`) start pieces of the chain."""
     n = len(data)
     J = max(1, math.ceil((n - 1) / K))
     nodes = np.arange(J) * K
@@ -109,7 +118,34 @@ def _layout(data: Motion, K: int, directions: np.ndarray, scl: np.ndarray) -> _L
     u1 = u0.copy() if data.hold == "zoh" else np.zeros(total)
     if data.hold == "linear":
         u1[: n - 1] = data.u[1:]
-    return _Layout(K, nodes, u0, u1, dt, directions[nodes], scl, n)
+    free = _hover_nodes(speed, nodes, K) if speed is not None else np.zeros(J, dtype=bool)
+    free[0] = True
+    return _Layout(K, nodes, u0, u1, dt, directions[nodes], scl, n, free)
+
+
+HOVER = 0.02
+"""A segment *hovers* when the smoothed speed of the data stays below this fraction of the
+record's top speed over all its samples (a stage held about its set point)."""
+
+
+def _hover_nodes(speed: np.ndarray, nodes: np.ndarray, K: int) -> np.ndarray:
+    """Nodes between two hovering segments (:data:`HOVER`).
+
+    A stage held about its set point near the friction limit reverses a dozen times per segment
+    under the noise its loop feeds back (the bristle of LuGre at ``z ~ 0.95``: the state's rate
+    is ``v (1 - z)`` one way and ``v (1 + z)`` the other), so a segment's end state is a
+    piecewise-smooth function of its start with kinks on the scale of ``1e-3`` of the node
+    scales; continuity defects of that size cannot be closed by Gauss-Newton steps. Such a node
+    carries no continuity constraint: it starts a new piece of the chain with its own free state
+    (a nuisance variable of the statistics), and the moves between the hovers stay chained."""
+    top = float(np.max(speed, initial=0.0))
+    if not top > 0.0:
+        return np.zeros(nodes.size, dtype=bool)
+    seg = np.array([float(np.max(speed[k:k + K + 1])) for k in nodes])
+    hover = seg <= HOVER * top
+    free = np.zeros(nodes.size, dtype=bool)
+    free[1:] = hover[1:] & hover[:-1]
+    return free
 
 
 def _mapped(model: FrictionModel, space: ParameterSpace, K: int, n_sub: int, mass_free: bool,
@@ -139,7 +175,8 @@ class _Problem:
         self.samples = lay.samples()
         self.rows = np.flatnonzero(self.samples >= 0)
         self.x = data.x[self.samples[self.rows]]
-        self.gw = np.ones((lay.J - 1) * self.ny)
+        self.keep = np.repeat(~lay.free[1:], self.ny)   # continuity rows (none into a piece's start)
+        self.gw = np.ones(int(self.keep.sum()))
         s = lay.s
         self.args = dict(s0=s, s_to=np.r_[s[1:], s[-1]], scale=space.scale, fixed=self.fixed, mass=mass,
                          U0=lay.U0[None, :], U1=lay.U1[None, :], DT=lay.DT[None, :], scl=lay.scl,
@@ -162,7 +199,7 @@ class _Problem:
                          scale=a["scale"], fixed=a["fixed"], mass=a["mass"], U0=a["U0"][:, cols],
                          U1=a["U1"][:, cols], DT=a["DT"][:, cols], scl=a["scl"])
             ye = np.asarray(out["Ye"]).ravel()
-            if np.all(np.isfinite(ye)):
+            if np.all(np.isfinite(ye)) and not self.lay.free[j + 1]:
                 nodes[:, j + 1] = ye if everything else np.r_[nodes[:2, j + 1], np.clip(ye[2:], -STATE_CAP, STATE_CAP)]
         w[self.nth:] = nodes.T.ravel()
         return w
@@ -174,7 +211,7 @@ class _Problem:
         _th, nodes = self.split(w)
         wt = 1.0 / np.maximum(1.0, np.abs(nodes[:, 1:]))
         wt[:2] = 1.0
-        self.gw = wt.T.ravel()
+        self.gw = wt.T.ravel()[self.keep]
 
     def split(self, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return w[: self.nth], w[self.nth:].reshape(self.lay.J, self.ny).T
@@ -188,7 +225,7 @@ class _Problem:
         out = self._call(self.plain, w)
         X = out["X"][0, self.rows]
         _th, nodes = self.split(w)
-        g = (out["Ye"][:, :-1] - nodes[:, 1:]).T.ravel() * self.gw
+        g = (out["Ye"][:, :-1] - nodes[:, 1:]).T.ravel()[self.keep] * self.gw
         return (X - self.x) / self.xs, g, out
 
     def plain_eval(self, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -208,7 +245,7 @@ class _Problem:
         nw = nth + ny * lay.J
         Jr = sp.csr_matrix((dX.ravel(), (np.repeat(np.arange(seg.size), ncol), colmap.ravel())),
                            shape=(seg.size, nw))
-        g = (out["Ye"][:, :-1] - nodes[:, 1:]).T.ravel()
+        g = (out["Ye"][:, :-1] - nodes[:, 1:]).T.ravel()[self.keep]
         dYe = out["dYe"].reshape(ny, lay.J, ncol)[:, :-1, :].transpose(1, 0, 2)   # (J-1, ny, ncol)
         rows_g = np.arange((lay.J - 1) * ny)
         jj = rows_g // ny
@@ -218,20 +255,34 @@ class _Problem:
                           shape=(rows_g.size, nw))
         A = A - sp.csr_matrix((np.ones(rows_g.size), (rows_g, nth + ny * (jj + 1) + rows_g % ny)),
                               shape=(rows_g.size, nw))
+        A = A.tocsr()[self.keep]
         return (X - self.x) / self.xs, Jr, g * self.gw, (sp.diags(self.gw) @ A).tocsr()
 
+    def columns(self) -> np.ndarray:
+        """Index in ``w`` of every column of :meth:`reduced_jacobian`: the parameters, then the
+        state of each piece's first node."""
+        starts = self.lay.starts
+        return np.r_[np.arange(self.nth), (self.nth + self.ny * starts[:, None] + np.arange(self.ny)).ravel()]
+
     def reduced_jacobian(self, w: np.ndarray) -> np.ndarray:
-        """``dr/d(theta, node_0)`` along the constraints (single-shooting Jacobian), dense ``n x ncol``."""
+        """``dr/d(theta, start nodes)`` along the constraints (the single-shooting Jacobian of each
+        piece of the chain), dense ``n x (nth + ny pieces)``."""
         out = self._call(self.sens, w)
         lay, nth, ny = self.lay, self.nth, self.ny
         ncol = nth + ny
+        starts = lay.starts
+        wide = nth + ny * starts.size
         dX = out["dX"].reshape(ncol, lay.J, lay.K + 1)
         dYe = out["dYe"].reshape(ny, lay.J, ncol)
-        M = np.zeros((ny, ncol))
-        M[:, nth:] = np.eye(ny)                                       # d node_0 / d(theta, node_0)
-        full = np.zeros((lay.J * (lay.K + 1), ncol))
+        M = np.zeros((ny, wide))
+        full = np.zeros((lay.J * (lay.K + 1), wide))
+        piece = -1
         for j in range(lay.J):
-            chain = np.zeros((ncol, ncol))
+            if lay.free[j]:                                           # d node_j / d(theta, its own state)
+                piece += 1
+                M = np.zeros((ny, wide))
+                M[:, nth + ny * piece: nth + ny * (piece + 1)] = np.eye(ny)
+            chain = np.zeros((ncol, wide))
             chain[:nth, :nth] = np.eye(nth)
             chain[nth:, :] = M
             full[j * (lay.K + 1):(j + 1) * (lay.K + 1)] = dX[:, j, :].T @ chain
@@ -280,6 +331,7 @@ def _progress(line: str) -> None:
     print(f"motion fit: {line}", file=sys.stderr, flush=True)
 
 
+@with_one_blas_thread
 def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_sub: int | None, max_iter: int,
                tol: float, reversals: Any = None, verbose: bool = False) -> MotionSolution:
     """Multiple-shooting least-squares fit of ``space``'s free parameters to ``data``.
@@ -352,7 +404,7 @@ def _solve_record(model: FrictionModel, data: Motion, space: ParameterSpace, the
     n_sub = _substeps(model, data, mass, float(np.max(np.abs(v))), n_sub)
     X, V = model.Fc / model.sigma, model.Fc / math.sqrt(mass * model.sigma)
     offset0 = space.values(theta0).get("offset", 0.0)
-    lay = _layout(data, min(SEGMENT, len(data) - 1), directions, np.array([X, V]))
+    lay = _layout(data, min(SEGMENT, len(data) - 1), directions, np.array([X, V]), np.abs(v))
     xs = max(float(np.ptp(data.x)) * 1e-3, 1e-300)
     prob = _Problem(model, space, data, lay, n_sub, mass_free, mass, xs)
     single = segment_functions(model, space, lay.K, n_sub, mass_free)[0]
@@ -388,9 +440,15 @@ def _solve_record(model: FrictionModel, data: Motion, space: ParameterSpace, the
     vel = Xv[1, prob.rows]
     nuisance = _nuisance(model, space, w, prob, data, vel, mass_free, mass)
     return MotionSolution(w, r * xs, Jred * xs, None, pred, nuisance,
-                          f"multiple shooting, {lay.J} segments of {lay.K} samples, {n_sub} RK4 sub-steps per "
+                          f"multiple shooting, {lay.J} segments of {lay.K} samples{_pieces(lay)}, {n_sub} RK4 "
+                          f"sub-steps per "
                           f"sample, scipy least_squares in an augmented Lagrangian: {out.message}{polished}",
                           out.success)
+
+
+def _pieces(lay: _Layout) -> str:
+    cut = int(lay.starts.size) - 1
+    return f" ({cut} nodes inside hovers start pieces of the chain)" if cut else ""
 
 
 POLISH_STEPS = 6
@@ -432,7 +490,8 @@ def _polish(prob: _Problem, w: np.ndarray, single: ca.Function, lo: np.ndarray,
         return w_ms, "; the single-shooting chain is not finite at the solution: not polished"
     with np.errstate(invalid="ignore"):
         margin = 1e-9 * np.maximum(1.0, np.abs(w[:nth]))
-    inside = np.r_[(w[:nth] - lo > margin) & (hi - w[:nth] > margin), np.ones(ny, dtype=bool)]
+    where = prob.columns()
+    inside = np.r_[(w[:nth] - lo > margin) & (hi - w[:nth] > margin), np.ones(where.size - nth, dtype=bool)]
     cols = np.flatnonzero(inside)
     taken, largest = 0, 0.0
     for _ in range(POLISH_STEPS):
@@ -445,7 +504,7 @@ def _polish(prob: _Problem, w: np.ndarray, single: ca.Function, lo: np.ndarray,
             break
         for frac in (1.0, 0.5):
             trial = w.copy()
-            trial[cols] += frac * d
+            trial[where[cols]] += frac * d
             trial[:nth] = np.clip(trial[:nth], lo, hi)
             trial = prob.carry_states(trial, single, everything=True)
             rt, gt = prob.plain_eval(trial)
