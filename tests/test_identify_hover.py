@@ -24,8 +24,6 @@ from prefriction.identify.motion_step import segment_functions
 from prefriction.identify.parameters import ParameterSpace, _entries
 from prefriction.identify.synthetic_loop import _interval, _rhs
 
-pytestmark = pytest.mark.slow   # scipy records and chained simulations: 10 to 20 s each on a loaded machine
-
 USER = STAGES[1]      # LuGre, 2.5 kg, 2e6 N/m, 3 N, 5 kHz, 10 nm encoder, closed loop
 EMPS_LIKE = STAGES[3]
 
@@ -52,6 +50,7 @@ def _true_run(stage, n: int, seed) -> tuple[Motion, np.ndarray]:
     return Motion(np.arange(n) * loop.dt, x, u, None, hold="zoh"), state
 
 
+@pytest.mark.slow   # a scipy record of 2,000 samples: 10 to 20 s on a loaded machine
 def test_hover_nodes_follow_the_slow_stretches_of_the_true_motion():
     """The nodes the data mark (after a segment with a run of slow samples) are those after the
     segments in which the true stage lingers near rest, and there the true stage hovers: it
@@ -80,6 +79,7 @@ def test_hover_nodes_follow_the_slow_stretches_of_the_true_motion():
     assert np.all(flips[runs == 0] == 0)                           # in the moves it does not
 
 
+@pytest.mark.slow   # chained simulations of 600 samples: about 10 s on a loaded machine
 def test_piecewise_jacobian_matches_finite_differences_of_the_chain():
     """The statistics' Jacobian with respect to the parameters and each piece's first node equals
     central differences of the residuals of the chain re-simulated from those values."""
@@ -121,6 +121,7 @@ def test_piecewise_jacobian_matches_finite_differences_of_the_chain():
         assert err < 2e-3, (c, err)                                 # central differences over the kinks of reversals
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("n", [10_000])
 def test_user_stage_long_record_fits_from_a_factor_two_start(n):
     """The hovering 2.5 kg stage at 10,000 samples from a start within a factor 2 of the truth in
@@ -136,3 +137,35 @@ def test_user_stage_long_record_fits_from_a_factor_two_start(n):
     for name, truth in USER.truth().items():
         scale = USER.friction.Fc if name == "offset" else abs(truth)
         assert abs(res.estimate(name) - truth) <= 0.05 * scale, name
+
+
+def test_border_variance_is_the_constrained_covariance_of_the_parameters():
+    """``kkt_step``'s ``border_variance``: the parameters' diagonal of ``Z (Z^T J^T J Z)^-1 Z^T``,
+    ``Z`` a basis of the constraints' null space (scipy), on a random shooting pattern with one
+    parameter held."""
+    import scipy.sparse as sp
+    from scipy.linalg import null_space
+
+    from prefriction.identify.kkt import kkt_step
+
+    rng = np.random.default_rng(8)
+    nth, ny, segments, per = 3, 2, 7, 9
+    m = nth + ny * segments
+    J = np.zeros((segments * per, m))
+    A = np.zeros(((segments - 1) * ny, m))
+    for j in range(segments):
+        J[j * per:(j + 1) * per, :nth] = rng.standard_normal((per, nth))
+        J[j * per:(j + 1) * per, nth + j * ny: nth + (j + 1) * ny] = rng.standard_normal((per, ny))
+        if j < segments - 1:
+            A[j * ny:(j + 1) * ny, :nth] = rng.standard_normal((ny, nth))
+            A[j * ny:(j + 1) * ny, nth + j * ny: nth + (j + 1) * ny] = rng.standard_normal((ny, ny))
+            A[j * ny:(j + 1) * ny, nth + (j + 1) * ny: nth + (j + 2) * ny] = -np.eye(ny)
+    free = np.ones(m, dtype=bool)
+    free[1] = False
+    info: dict = {}
+    kkt_step(sp.csr_matrix(J), sp.csr_matrix(A), rng.standard_normal(J.shape[0]), rng.standard_normal(A.shape[0]),
+             free=free, border=nth, info=info)
+    keep = np.flatnonzero(free)
+    Z = null_space(A[:, keep])
+    C = Z @ np.linalg.inv(Z.T @ J[:, keep].T @ J[:, keep] @ Z) @ Z.T
+    np.testing.assert_allclose(info["border_variance"], np.diag(C)[:nth - 1], rtol=1e-8)

@@ -198,6 +198,10 @@ def solve(full: Callable, plain: Callable, w0: np.ndarray, lo: np.ndarray, hi: n
                 return LsqOutcome(done.w, True, cache.jacobians, f"converged after {outer} multiplier updates and "
                                                                  f"{done.message} ({cache.jacobians} Jacobian "
                                                                  f"evaluations)" + "".join(f"; {x}" for x in restarts))
+            if done.steps:   # the steps taken lowered the merit and met the constraints better: go on from there
+                w = done.w
+                r, g = plain(w)
+                gmax = float(np.abs(g).max(initial=0.0))
         lam = lam + mu * g
         if gmax > 0.1 * gmax_prev:
             mu = min(10.0 * mu, 1e12)
