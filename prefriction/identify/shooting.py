@@ -130,17 +130,22 @@ HOVER_RUN = 10
 a stage held about its set point, or settling into or breaking away from a rest. A reversal
 inside a move is slow for a few samples only (measured on the 2.5 kg stage at 10,000 samples:
 2 to 7)."""
+HOVER_SEGMENTS = 3
+"""Fewest consecutive hovering segments of a *long* hover, after whose segments the chain is cut
+(:func:`_hover_nodes`); a short rest stays chained (it converges, and the chain through it
+carries information: on the 1,000-sample EMPS-like record of the first example, cutting after
+every hovering segment widened the intervals 2.5 times)."""
 
 
 def _hover_nodes(speed: np.ndarray, nodes: np.ndarray, K: int) -> np.ndarray:
-    """Nodes after a hovering segment (:data:`HOVER_RUN`).
+    """Nodes after the segments of a long hover (:data:`HOVER_RUN`, :data:`HOVER_SEGMENTS`).
 
     A stage held about its set point near the friction limit reverses a dozen times per segment
     under the noise its loop feeds back (the bristle of LuGre at ``z ~ 0.95``: the state's rate
     is ``v (1 - z)`` one way and ``v (1 + z)`` the other), so a segment's end state is a
     piecewise-smooth function of its start with kinks on the scale of ``1e-3`` of the node
-    scales, and continuity defects or Gauss-Newton steps of that size cannot be resolved. The
-    node after such a segment carries no continuity constraint: it starts a new piece of the
+    scales, and continuity defects or Gauss-Newton steps of that size cannot be resolved. In a
+    long hover the node after each of its segments carries no continuity constraint: it starts a new piece of the
     chain with its own free state (a nuisance variable of the statistics). No constraint then
     passes through a hovering segment: its kinks reach only its own residuals, where the
     positions change by a fraction of an encoder step, and each move is chained from its start."""
@@ -157,7 +162,11 @@ def _hover_nodes(speed: np.ndarray, nodes: np.ndarray, K: int) -> np.ndarray:
             lo, hi = max(a, nodes[j]), min(b, nodes[j] + K + 1)
             hover[j] |= hi - lo >= HOVER_RUN
     free = np.zeros(nodes.size, dtype=bool)
-    free[1:] = hover[:-1]
+    run = np.r_[0, hover.astype(int), 0]
+    edges = np.flatnonzero(np.diff(run))
+    for a, b in zip(edges[::2], edges[1::2]):                  # segments a..b-1 hover
+        if b - a >= HOVER_SEGMENTS:
+            free[a + 1:min(b + 1, nodes.size)] = True
     return free
 
 
@@ -371,7 +380,7 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
         part = slice(k0, k0 + WINDOW)
         head = Motion(data.t[part], data.x[part], data.u[part], data.mass, data.hold)
         given = None if reversals is None else [r for r in reversals if head.t[0] < r < head.t[-1]]
-        first = _solve_record(model, head, space, theta0, n_sub, max_iter, tol, given, progress, 0.01)
+        first = _solve(model, head, space, theta0, n_sub, max_iter, tol, given, progress, 0.01, steps)
         if first.success:
             theta0 = first.w[: space.n_free]
             vals = space.values(theta0)
@@ -381,9 +390,33 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
         else:
             steps.append(f"continuation: the fit of samples {k0} to {k0 + WINDOW - 1} did not converge "
                          f"({first.message}); the full record started from the start values")
-    sol = _solve_record(model, data, space, theta0, n_sub, max_iter, tol, reversals, progress,
-                        0.01 if not steps or "did not" in steps[0] else 10.0)
+    sol = _solve(model, data, space, theta0, n_sub, max_iter, tol, reversals, progress,
+                 0.01 if not steps or "did not" in steps[-1] else 10.0, steps)
     return dataclasses.replace(sol, steps=tuple(steps))
+
+
+def _solve(model: FrictionModel, data: Motion, space: ParameterSpace, theta0: np.ndarray, n_sub: int | None,
+           max_iter: int, tol: float, reversals: Any, progress: Any, weight: float,
+           steps: list[str]) -> MotionSolution:
+    """:func:`_solve_record` with the chain whole; if that does not converge and the record has
+    long hovers (:func:`_hover_nodes`), again from its estimates with the chain cut there (the
+    continuity through a long hover is piecewise smooth on the scale of the defects; a chain kept
+    whole where it converges keeps the information the rests carry). Notes go to ``steps``."""
+    sol = _solve_record(model, data, space, theta0, n_sub, max_iter, tol, reversals, progress, weight, False)
+    if sol.success:
+        return sol
+    _x, v, _a = derivatives(data.t, data.x, _NODE_WINDOW)
+    K = min(SEGMENT, len(data) - 1)
+    cut = int(_hover_nodes(np.abs(v), np.arange(max(1, math.ceil((len(data) - 1) / K))) * K, K).sum())
+    theta = sol.w[: space.n_free]
+    if not cut or not np.all(np.isfinite(theta)):
+        return sol
+    again = _solve_record(space.build(space.values(theta)), data, space, theta, n_sub, max_iter, tol, reversals,
+                          progress, 10.0, True)
+    steps.append(f"samples {len(data)}: the whole chain did not converge ({sol.message[-160:]}); the {cut} nodes after "
+                 f"the segments of long hovers then started pieces of the chain, from its estimates: "
+                 + ("converged" if again.success else "did not converge either, the whole chain's result kept"))
+    return again if again.success else sol
 
 
 def _busiest_window(data: Motion) -> int:
@@ -407,7 +440,7 @@ def _busiest_window(data: Motion) -> int:
 
 def _solve_record(model: FrictionModel, data: Motion, space: ParameterSpace, theta0: np.ndarray,
                   n_sub: int | None, max_iter: int, tol: float, reversals: Any, progress: Any,
-                  weight: float) -> MotionSolution:
+                  weight: float, pieces: bool = False) -> MotionSolution:
     """One multiple-shooting fit of ``data`` from the scaled parameters ``theta0``; ``model``
     (values at ``theta0``) sets the node scales and the sub-steps."""
     mass_free = "mass" in space.start and "mass" in space.free
@@ -417,7 +450,8 @@ def _solve_record(model: FrictionModel, data: Motion, space: ParameterSpace, the
     n_sub = _substeps(model, data, mass, float(np.max(np.abs(v))), n_sub)
     X, V = model.Fc / model.sigma, model.Fc / math.sqrt(mass * model.sigma)
     offset0 = space.values(theta0).get("offset", 0.0)
-    lay = _layout(data, min(SEGMENT, len(data) - 1), directions, np.array([X, V]), np.abs(v))
+    lay = _layout(data, min(SEGMENT, len(data) - 1), directions, np.array([X, V]),
+                  np.abs(v) if pieces else None)
     xs = max(float(np.ptp(data.x)) * 1e-3, 1e-300)
     prob = _Problem(model, space, data, lay, n_sub, mass_free, mass, xs)
     single = segment_functions(model, space, lay.K, n_sub, mass_free)[0]
@@ -453,9 +487,8 @@ def _solve_record(model: FrictionModel, data: Motion, space: ParameterSpace, the
     vel = Xv[1, prob.rows]
     nuisance = _nuisance(model, space, w, prob, data, vel, mass_free, mass)
     return MotionSolution(w, r * xs, Jred * xs, None, pred, nuisance,
-                          f"multiple shooting, {lay.J} segments of {lay.K} samples{_pieces(lay)}, {n_sub} RK4 "
-                          f"sub-steps per "
-                          f"sample, scipy least_squares in an augmented Lagrangian: {out.message}{polished}",
+                          f"multiple shooting, {lay.J} segments of {lay.K} samples, {n_sub} RK4 sub-steps per "
+                          f"sample{_pieces(lay)}, scipy least_squares in an augmented Lagrangian: {out.message}{polished}",
                           out.success)
 
 
