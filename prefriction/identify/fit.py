@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 import warnings
 from typing import Any, Sequence
 
@@ -19,12 +20,15 @@ from prefriction.identify.statistics import (BoundWarning, ConvergenceWarning, I
                                              NoisyPositionsWarning, ResidualWarning, at_bounds, gauss_newton)
 from prefriction.models.base import FrictionModel
 
-__all__ = ["fit"]
+__all__ = ["EVENT_MAX_ITER", "fit"]
+
+EVENT_MAX_ITER = 500
+"""Default ``max_iter`` of a Motion fit of a model with in-branch events (:func:`fit`)."""
 
 def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequence[str] | None = None,
         fixed: Sequence[str] | None = None, bounds: dict[str, tuple[float, float]] | None = None,
         offset: bool = False, structures: str = "given", mass0: float | None = None, offset0: float | None = None,
-        reversals: Sequence[float] | None = None, substeps: int | None = None, max_iter: int = 200,
+        reversals: Sequence[float] | None = None, substeps: int | None = None, max_iter: int | None = None,
         tol: float = 1e-10, identifiability_limit: float = 0.5) -> FitResult:
     """Fit a friction model's parameters to measured data.
 
@@ -87,9 +91,12 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
         Runge-Kutta sub-steps per sample interval (1 to 64); default: chosen from the data and
         the start values (1 for Maxwell-slip on force-displacement data, where one step is the
         exact stop operator).
-    max_iter : int, default 200
+    max_iter : int, optional
         Most solver iterations (Jacobian evaluations of a :class:`Motion` fit, function
-        evaluations for force-displacement data), 1 to 100 000.
+        evaluations for force-displacement data), 1 to 100 000. Default 200, and
+        :data:`EVENT_MAX_ITER` (500) for a :class:`Motion` fit of a model with in-branch events
+        (Dahl ``gamma < 1``, Maxwell-slip, GMS): its motion is only piecewise smooth in the
+        parameters and a fit from a factor-2 start takes 150 to 300 (``docs/identify_motion.md#limits``).
         A fit that stops there returns with ``success = False`` and a :class:`ConvergenceWarning`.
     tol : float, default 1e-10
         Solver tolerance (relative), ``1e-14 <= tol <= 1e-6``: looser tolerances stop before the
@@ -158,6 +165,8 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
     """
     from prefriction.identify.static_map import StaticFriction
 
+    if max_iter is None:
+        max_iter = EVENT_MAX_ITER if isinstance(data, Motion) and getattr(model, "n_events", 0) else 200
     if isinstance(model, StaticFriction) and isinstance(data, Motion):  # the inverse model (identify/inverse.py)
         from prefriction.identify.inverse import fit_inverse
 
@@ -265,6 +274,24 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
                               offset0=offset_start)
 
     space = space_of(model, start.mass, start.offset)
+    from prefriction.identify.element_start import element_start
+
+    elements = element_start(model, data, list(space.free), start.mass, start.offset, offset)
+    if elements is not None:  # Maxwell-slip, GMS: the grid search of the force balance, said in FitResult.start
+        from prefriction.identify.shooting import start_error
+
+        space_el = space_of(elements.model, elements.mass, elements.offset)
+        given, found = _start_error(start_error, model, data, space), _start_error(start_error, elements.model,
+                                                                                  data, space_el)
+        said = (f"rms error of the 50-sample shooting segments {math.sqrt(found):.4g} m against "
+                f"{math.sqrt(given):.4g} m of the given start")
+        if found < given:
+            model, space = elements.model, space_el
+            start = dataclasses.replace(start, mass=elements.mass, offset=elements.offset,
+                                        steps=start.steps + (f"{elements.line}; {said}: it replaces the given start",))
+        else:
+            start = dataclasses.replace(start, steps=start.steps + (
+                f"{elements.line.split(':')[0]} not used ({said}): the given start kept",))
     first_steps = start.steps
     try:
         sol, error = fit_motion(model, data, space, n_sub=substeps, max_iter=max_iter, tol=tol,
@@ -308,6 +335,14 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
     mass = values["mass"] if data.mass is None else data.mass
     return _finish(space, values, est, stats, -sol.residuals, sol.prediction, data, mass, sol.nuisance, message,
                    sol.success, start=start.steps + sol.steps)
+
+
+def _start_error(error: Any, model: FrictionModel, data: Motion, space: ParameterSpace) -> float:
+    """``error(model, data, space)``, ``inf`` where the start's motion cannot be simulated."""
+    try:
+        return error(model, data, space)
+    except (SolverError, ValueError, RuntimeError):
+        return math.inf
 
 
 def _route_advice(data: Motion) -> str:
