@@ -274,7 +274,7 @@ def start_model(stage: Stage, rng: np.random.Generator,
                 value = max(value, 1.0) if fr.gamma >= 1.0 else min(value, 0.95)
             new[name] = value
     if isinstance(fr, LuGre):  # Fs - Fc started at the truth's ratio (0 for Fs = Fc: no Stribeck peak)
-        new["Fs"] = new.get("Fc", fr.Fc) * fr.Fs / fr.Fc
+        new["Fs"] = new.get("Fc", fr.Fc) * (fr.Fs / fr.Fc)  # the ratio first: Fs = Fc stays exact
     start = dataclasses.replace(fr, **new)
     if "b" in stage.free:
         start = start + Viscous(stage.b * factor())
