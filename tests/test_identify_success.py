@@ -16,8 +16,8 @@ import pytest
 
 import prefriction as pf
 from prefriction import identify
-from prefriction.identify._success import (GRID, STAGES, coverage_text, pooled_text, stage_record, start_model,
-                                           success_table, table_text)
+from prefriction.identify._success import (GRID, STAGES, SuccessRow, coverage_text, distance_text, pooled_text,
+                                           stage_record, start_model, success_table, table_text)
 from prefriction.identify.motion_start import data_start, start_values, static_start
 from prefriction.identify.motion_step import segment_functions
 from prefriction.identify.parameters import ParameterSpace
@@ -119,6 +119,31 @@ def test_harness_sample_lands_within_5_percent():
     assert max(s for s, _ in rows[0].spread) <= np.log(2.0) and rows[0].returned == 3
     assert "| Dahl | 3/3 (100%)" in pooled_text(rows)
     assert set(rows[0].held) == {"sigma", "Fc", "mass"} and "| Dahl | 1 | 3 |" in coverage_text(rows)
+    assert "| Dahl | x2 | 3/3 (100%) |" in distance_text(rows)
+    assert 0.0 < rows[0].median_cpu and rows[0].max_cpu >= rows[0].median_cpu
+
+
+def _row(stage: str, label: str, seed: int, d: float, ok: int, first: int, held: dict, wall: float) -> SuccessRow:
+    return SuccessRow(stage, d, 100, 2, ok, ok, wall, 2.0 * wall, "", label, 2, held, (), 100.0 + seed, first, seed,
+                      wall / 2.0, wall)
+
+
+def test_tables_count_per_model_distance_and_record():
+    """The distance table adds successes and given-start successes over the stages and seeds of
+    a model; the coverage table counts each (stage, seed) record once, and its binomial SD at
+    95 % is sqrt(0.95 * 0.05 / intervals)."""
+    rows = [_row("A", "Dahl", 0, 1.5, 2, 1, {"sigma": 2, "Fc": 0}, 4.0),
+            _row("A", "Dahl", 1, 1.5, 1, 1, {"sigma": 2, "Fc": 2}, 8.0),
+            _row("A", "Dahl", 1, 2.0, 2, 2, {"sigma": 2, "Fc": 2}, 6.0),
+            _row("B", "LuGre", 0, 2.0, 0, 0, {"sigma0": 1, "Fs": 2}, 20.0)]
+    text = distance_text(rows)
+    assert "| Dahl | x1.5 | 3/4 (75%) | 2 | 6.0 / 16 | 3.0 / 8.0 | 101 |" in text
+    assert "| all | x2 | 2/4 (50%) | 2 |" in text
+    cov = coverage_text(rows)
+    # Dahl: record (A, 0) holds sigma 2/2, Fc 0/2; record (A, 1) holds 4/4 and 4/4 over its two rows
+    assert "| Dahl | 2 | 6 | sigma 100%, Fc 50% | 75% | 4 | 10.9% |" in cov, cov
+    assert "| LuGre | 1 | 2 | sigma0 50%, Fs 100% | 75% | 2 | 15.4% |" in cov, cov
+    assert "| all | 3 | 8 | | 75% | 6 | 8.9% |" in cov, cov
 
 
 def test_second_start_from_the_data_is_within_a_factor_two():
