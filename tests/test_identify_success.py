@@ -143,7 +143,7 @@ def test_tables_count_per_model_distance_and_record():
     # Dahl: record (A, 0) holds sigma 2/2, Fc 0/2; record (A, 1) holds 4/4 and 4/4 over its two rows
     assert "| Dahl | 2 | 6 | sigma 100%, Fc 50% | 75% | 4 | 10.9% |" in cov, cov
     assert "| LuGre | 1 | 2 | sigma0 50%, Fs 100% | 75% | 2 | 15.4% |" in cov, cov
-    assert "| all | 3 | 8 | | 75% | 6 | 8.9% |" in cov, cov
+    assert "| all | 3 | 8 | sigma 100%, Fc 50%, sigma0 50%, Fs 100% | 75% | 6 | 8.9% |" in cov, cov
 
 
 def test_second_start_from_the_data_is_within_a_factor_two():

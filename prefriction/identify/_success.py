@@ -459,9 +459,10 @@ def distance_text(rows: list[SuccessRow], key=lambda r: r.label) -> str:
     """Success rate per model (``key``) and drawn start distance, one line each: successes / fits,
     the successes of the given start alone (without the second start from the data), the median
     and largest wall and CPU time of a fit [s] and the largest peak resident set size [MB] of
-    the processes that ran them; an ``all`` line per distance."""
+    the processes that ran them; the models in alphabetical order, then an ``all`` line per
+    distance."""
     groups: dict = {}
-    for r in rows:
+    for r in sorted(rows, key=lambda r: (key(r), r.distance)):
         groups.setdefault((key(r), r.distance), []).append(r)
     for d in sorted({r.distance for r in rows}):
         groups[("all", d)] = [r for r in rows if r.distance == d]
@@ -494,7 +495,9 @@ def coverage_text(rows: list[SuccessRow], key=lambda r: r.label) -> str:
     (a stage and a seed) share it (they differ only in the start), so each record counts once: its
     weight is spread evenly over its fits that returned estimates. ``SD`` is the binomial standard
     deviation of the pooled coverage at a true 95 % over the group's intervals (records times
-    parameters), treated as independent."""
+    parameters), treated as independent; ``pooled`` is the fraction of those intervals that hold
+    the truth. Groups of several models (``all``, or a ``key`` such as the loop) list each
+    parameter over the records that have it (no list beyond eight names)."""
     records: dict = {}
     for r in rows:
         rec = records.setdefault((r.stage, r.seed), {"key": key(r), "held": {}, "returned": 0})
@@ -502,31 +505,34 @@ def coverage_text(rows: list[SuccessRow], key=lambda r: r.label) -> str:
         for p, h in r.held.items():
             rec["held"][p] = rec["held"].get(p, 0) + h
     groups: dict = {}
-    for rec in records.values():
+    for rec in sorted(records.values(), key=lambda rec: rec["key"]):
         if rec["returned"]:
             groups.setdefault(rec["key"], []).append(rec)
     lines = ["| model | records | fits with estimates | coverage per parameter (records weighted equally) | pooled "
              "| intervals | SD at 95 % |", "|---|---:|---:|---|---:|---:|---:|"]
-    total_held = total_n = 0.0
-    for name, recs in groups.items():
-        per = {p: float(np.mean([rec["held"][p] / rec["returned"] for rec in recs])) for p in recs[0]["held"]}
-        text = ", ".join(f"{p} {v:.0%}" for p, v in per.items())
-        fits = sum(rec["returned"] for rec in recs)
-        n = len(recs) * len(per)
-        total_held += sum(per.values()) * len(recs)
-        total_n += n
-        lines.append(f"| {name} | {len(recs)} | {fits} | {text} | {float(np.mean(list(per.values()))):.0%} | {n} "
-                     f"| {_sd95(n):.1%} |")
     if len(groups) > 1:
-        recs = [rec for rs in groups.values() for rec in rs]
-        lines.append(f"| all | {len(recs)} | {sum(rec['returned'] for rec in recs)} | | "
-                     f"{total_held / total_n:.0%} | {total_n:.0f} | {_sd95(int(total_n)):.1%} |")
+        groups["all"] = [rec for rs in groups.values() for rec in rs]
+    for name, recs in groups.items():
+        names = list(dict.fromkeys(p for rec in recs for p in rec["held"]))
+        per = {p: float(np.mean([rec["held"][p] / rec["returned"] for rec in recs if p in rec["held"]]))
+               for p in names}
+        text = ", ".join(f"{p} {v:.0%}" for p, v in per.items()) if len(names) <= 8 else ""
+        n = sum(len(rec["held"]) for rec in recs)
+        held = sum(h / rec["returned"] for rec in recs for h in rec["held"].values())
+        lines.append(f"| {name} | {len(recs)} | {sum(rec['returned'] for rec in recs)} | {text} | {held / n:.0%} "
+                     f"| {n} | {_sd95(n):.1%} |")
     return "\n".join(lines)
 
 
 def _sd95(n: int) -> float:
     """Binomial standard deviation of a coverage measured on ``n`` intervals at a true 95 %."""
     return math.sqrt(0.95 * 0.05 / max(n, 1))
+
+
+KEYS = {"model": lambda r: r.label,
+        "loop": lambda r: "closed loop" if " closed" in r.stage else "open loop",
+        "mass": lambda r: r.stage.split(" kg")[0].rsplit(" ", 1)[-1] + " kg"}
+"""Groupings of the tables (``--by``): the model column, the loop, the stage mass (from the stage name)."""
 
 
 def row_from_dict(d: dict) -> SuccessRow:
@@ -540,7 +546,8 @@ def _rate(ok: int, n: int) -> str:
 
 def main(argv: list[str] | None = None) -> None:
     """``python -m prefriction.identify._success [--grid] [--stages 0,3] [--fits N] [--samples N]
-    [--distances 1.25,1.5,2] [--seeds 0,1] [--jsonl FILE] [--report FILE]``: fit, print the tables
+    [--distances 1.25,1.5,2] [--seeds 0,1] [--jsonl FILE] [--report FILE] [--by model|loop|mass]``: fit,
+    print the tables
     (one progress line per fit on stderr); each seed gives every stage a new record and new
     starts; ``--jsonl`` appends each row as a JSON line, ``--report`` prints the tables of such a
     file (or files, comma-separated) without fitting."""
@@ -558,7 +565,8 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--grid", action="store_true", help="the 24 stages of GRID instead of STAGES")
     ap.add_argument("--stages", default="", help="indices into the stage list (default: all)")
     ap.add_argument("--jsonl", default="", help="append the rows to this file, one JSON line each")
-    ap.add_argument("--report", default="", help="print the tables of a --jsonl file and stop")
+    ap.add_argument("--report", default="", help="print the tables of --jsonl files (comma-separated) and stop")
+    ap.add_argument("--by", default="model", choices=sorted(KEYS), help="group the pooled tables by this")
     args = ap.parse_args(argv)
     if args.report:
         rows = []
@@ -580,8 +588,9 @@ def main(argv: list[str] | None = None) -> None:
                 with open(args.jsonl, "a", encoding="utf-8") as fh:
                     for r in new:
                         fh.write(json.dumps(dataclasses.asdict(r)) + "\n")
-    print(table_text(rows) + "\n\n" + distance_text(rows) + "\n\n" + pooled_text(rows) + "\n\n"
-          + coverage_text(rows))
+    key = KEYS[args.by]
+    print(table_text(rows) + "\n\n" + distance_text(rows, key) + "\n\n" + pooled_text(rows, key) + "\n\n"
+          + coverage_text(rows, key))
 
 
 if __name__ == "__main__":
