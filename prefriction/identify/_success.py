@@ -470,10 +470,9 @@ def distance_text(rows: list[SuccessRow], key=lambda r: r.label) -> str:
              "CPU median / max [s] | peak RSS [MB] |", "|---|---:|---:|---:|---:|---:|---:|"]
     for (name, d), rs in groups.items():
         ok, n = sum(r.successes for r in rs), sum(r.fits for r in rs)
-        wall = _median_of(rs, "median_time")
-        cpu = _median_of(rs, "median_cpu")
-        lines.append(f"| {name} | x{d:g} | {_rate(ok, n)} | {sum(r.first for r in rs)} | "
-                     f"{_sec(wall)} / {_sec(max(r.max_time for r in rs))} | {_sec(cpu)} / {_sec(max(r.max_cpu for r in rs))} | "
+        wall = f"{_sec(_median_of(rs, 'median_time'))} / {_sec(max(r.max_time for r in rs))}"
+        cpu = f"{_sec(_median_of(rs, 'median_cpu'))} / {_sec(max(r.max_cpu for r in rs))}"
+        lines.append(f"| {name} | x{d:g} | {_rate(ok, n)} | {sum(r.first for r in rs)} | {wall} | {cpu} | "
                      f"{max(r.rss_mb for r in rs):.0f} |")
     return "\n".join(lines)
 
