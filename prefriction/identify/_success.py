@@ -431,7 +431,7 @@ def pooled_text(rows: list[SuccessRow], key=lambda r: r.label) -> str:
     and the largest peak memory of the group; in brackets the successes of the given start alone
     (without the second start from the data)."""
     groups: dict = {}
-    for r in rows:
+    for r in sorted(rows, key=key):
         groups.setdefault(key(r), []).append(r)
     groups["all"] = list(rows)
     dists = sorted({r.distance for r in rows})
