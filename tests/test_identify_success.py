@@ -247,3 +247,14 @@ def test_success_rate_over_the_stages():
     distance: ``python -m prefriction.identify._success``."""
     rows = success_table((STAGES[0], STAGES[3], STAGES[4]), (2.0,), fits=1, samples=1000, seed=0)
     assert all(r.successes == r.fits for r in rows), table_text(rows)
+
+
+def test_lugre_starts_keep_Fs_at_or_above_Fc():
+    """A LuGre stage with Fs = Fc (no Stribeck peak): every drawn start is a LuGre that constructs,
+    with Fs at its start Fc (the true ratio Fs / Fc = 1 after the rounding of the product)."""
+    stage = GRID[15]                                   # Fc = Fs = 3 N: Fc0 * 3 / 3 rounds below Fc0
+    assert stage.friction.Fs == stage.friction.Fc
+    rng = np.random.default_rng(0)
+    for _ in range(300):
+        start, _, _ = start_model(stage, rng, 2.0)       # raises if Fs < Fc
+        assert start.Fs >= start.Fc and start.Fs == pytest.approx(start.Fc, rel=1e-15)

@@ -277,7 +277,8 @@ def start_model(stage: Stage, rng: np.random.Generator,
             value = getattr(fr, name) * factor()
             new[name] = max(value, 1.0) if name == "gamma" else value
     if isinstance(fr, LuGre):  # Fs - Fc started at the truth's ratio (0 for Fs = Fc: no Stribeck peak)
-        new["Fs"] = new.get("Fc", fr.Fc) * fr.Fs / fr.Fc
+        Fc0 = new.get("Fc", fr.Fc)
+        new["Fs"] = max(Fc0 * fr.Fs / fr.Fc, Fc0)  # Fs = Fc stays so after the rounding of the ratio
     start = dataclasses.replace(fr, **new)
     if "b" in stage.free:
         start = start + Viscous(stage.b * factor())
