@@ -206,7 +206,7 @@ def identify_stage(rec: Record, mass: float = MASS) -> Identified:
         fit = identify.fit(start, part, fixed=["gamma"], offset=True)
         return Identified(fit, fit.validate(held_out), pf.Oscillator(fit.model, mass=mass))
     loop = record_loop(float(rec.t[1] - rec.t[0]))
-    part = identify.Motion(rec.t[:split], rec.x[:split], rec.u[:split], mass=mass)
+    part = identify.Motion(rec.t[:split], rec.x[:split], rec.u[:split], mass=mass, x_noise=NOISE, quantum=QUANTUM)
     fit = identify.fit_closed_loop(start, part, loop, rec.r[:split], fixed=["gamma"])
     _, force = identify.simulate_closed_loop(fit.model, loop, rec.t, rec.r, mass=mass, offset=fit.estimate("offset"))
     validation = identify.Validation(rec.t[split:], rec.u[split:], force[split:], "N", "Dahl")

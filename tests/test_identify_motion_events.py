@@ -160,7 +160,7 @@ def test_dahl_gamma_below_one_intervals_hold_the_truth():
 @pytest.mark.slow
 def test_maxwell_slip_three_elements_fits_from_a_far_start():
     """Maxwell-slip(3), every stiffness and slip force 1.5x off (slip events of three elements),
-    clean record: within 2 % of the truth (about 2 minutes on a loaded machine: slow)."""
+    clean record: within 2 % of the truth (about 20 s on a loaded machine: slow)."""
     res, truth, _sec = _fit("maxwell_slip", 1.5, 300, 0.0)
     assert res.success, res.message
     np.testing.assert_allclose(res.estimates, truth, rtol=0.02)

@@ -35,7 +35,7 @@ N, SEED = 1000, 0
 
 @pytest.fixture(scope="module")
 def record() -> tuple[identify.Motion, np.ndarray]:
-    rec = closed_loop_record(STAGE, N, np.random.default_rng(SEED), rtol=1e-8)
+    rec = closed_loop_record(STAGE, N, np.random.default_rng(SEED), rtol=1e-11)   # the recorded-force fit resolves 1e-8
     return identify.Motion(rec.t, rec.x, rec.u, None), reference_moves(N, 1e-3, np.random.default_rng(SEED))
 
 
@@ -218,8 +218,6 @@ def test_bad_arguments_are_named(record):
         identify.fit_closed_loop(TRUE, data, LOOP, ref[:-1], mass0=95.0)
     with pytest.raises(ValueError, match="give mass0"):
         identify.fit_closed_loop(TRUE, data, LOOP, ref)
-    with pytest.raises(ValueError, match="event flags.*fit_inverse"):
-        identify.fit_closed_loop(pf.Dahl(sigma=1e6, Fc=10.0, gamma=0.5), data, LOOP, ref, mass0=95.0)
     with pytest.raises(ValueError, match="tol must be in"):
         identify.fit_inverse(identify.StaticFriction(Fc=1.0), data, tol=1.0)
     with pytest.raises(ValueError, match="max_iter"):

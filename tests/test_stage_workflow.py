@@ -33,6 +33,11 @@ def test_every_step_of_the_chain(tmp_path):
     assert fit.model.sigma == pytest.approx(w.SIGMA, rel=0.05)
     assert fit.model.Fc == pytest.approx(w.FC, rel=0.03)
     assert fit.estimate("offset") == pytest.approx(w.OFFSET, abs=0.03)
+    for name, value in {"sigma": w.SIGMA, "Fc": w.FC, "offset": w.OFFSET}.items():
+        # the intervals hold the truth, or the estimate is within 1e-5 of it (the quick record's Fc
+        # interval is 5e-7 N wide and misses by 2 of its standard errors); the loop fit alone was 1 % off
+        lo, hi = fit.interval(name)
+        assert lo <= value <= hi or abs(fit.estimate(name) / value - 1.0) < 1e-5, (name, fit.report())
     assert val.fit_percent > 80.0
     assert out["spikes"]["PID + feedforward"] < 0.8 * out["spikes"]["PID alone"]
     assert out["spikes"]["PID + friction observer"] < 0.8 * out["spikes"]["PID alone"]

@@ -27,6 +27,13 @@ each 95 % interval holds the true value:
 - ``dahl-decay``: the free decay of the Dahl oscillator (2.1) (:func:`prefriction.identify.synthetic.dahl_free_decay`:
   DOP853 between the exact reversals), positions with Gaussian noise, a :class:`Motion` fit.
 
+- ``loop-fit-pid-10nm``, ``loop-fit-pid-50nm``: the stage of ``examples/stage_workflow.py``
+  (2.5 kg, Dahl ``sigma = 2e6`` N/m, ``Fc = 3`` N, offset 0.2 N) under a PID at 5 kHz, its
+  encoder 10 or 50 nm after 2 nm of noise, declared; scipy DOP853 between the samples
+  (:func:`prefriction.identify.synthetic_events.closed_loop_event_record`); the closed-loop
+  route :func:`prefriction.identify.fit_closed_loop` from a start within a factor 2, the mass
+  known.
+
 ``prefriction bench --identify`` prints the table; ``tests/test_identify_coverage.py`` runs a
 short version.
 """
@@ -130,6 +137,31 @@ def _closed_loop(rng: np.random.Generator, n: int) -> tuple:
                                                                         "offset": True}
 
 
+def _loop_fit(quantum: float) -> Callable:
+    """The 2.5 kg stage of ``examples/stage_workflow.py`` (Dahl, offset 0.2 N) under a PID at
+    5 kHz on an encoder of step ``quantum`` after 2 nm of noise, declared
+    (:func:`prefriction.identify.synthetic_events.closed_loop_event_record`), fitted by
+    :func:`prefriction.identify.fit_closed_loop` from a start within a factor 2, the mass known."""
+    def make(rng: np.random.Generator, n: int) -> tuple:
+        from prefriction.identify.closed_loop_fit import fit_closed_loop
+        from prefriction.identify.data import Motion
+        from prefriction.identify.digital_loop import DigitalLoop
+        from prefriction.identify.synthetic_events import closed_loop_event_record
+        from prefriction.models import Dahl
+
+        dt, gains = 2e-4, {"Kp": 7.5e6, "Ki": 5e9, "Kd": 7.5e3}
+        t = np.arange(n) * dt
+        r = 6e-6 * np.sin(2 * np.pi * 8 * t) * (0.55 - 0.45 * np.cos(2 * np.pi * t / 0.2))
+        rec = closed_loop_event_record(Dahl(sigma=2e6, Fc=3.0), 2.5, dt, r, offset=0.2, quantum=quantum, noise=2e-9,
+                                       rng=rng, rtol=1e-11, **gains)
+        f = np.exp(rng.uniform(-np.log(2.0), np.log(2.0), 2))
+        loop = DigitalLoop(dt, gains["Kp"], gains["Kd"], Ki=gains["Ki"])
+        data = Motion(rec.t, rec.x, rec.u, 2.5, x_noise=2e-9, quantum=quantum)
+        return data, Dahl(sigma=2e6 * f[0], Fc=3.0 * f[1]), {"sigma": 2e6, "Fc": 3.0, "offset": 0.2}, {
+            "fixed": ["gamma"], "fitter": lambda m, d, **kw: fit_closed_loop(m, d, loop, r, **kw)}
+    return make
+
+
 def _stage(index: int) -> Callable:
     """A stage of :data:`prefriction.identify._success.GRID`: a scipy record (LSODA per sample,
     the encoder rounding after noise of a third of a step), a :class:`Motion` fit with the mass
@@ -161,6 +193,8 @@ CASES: dict[str, tuple[Callable, int]] = {
     "user-stage-dahl-open": (_stage(9), 1000),
     "user-stage-dahl-bare-open": (_stage(11), 1000),
     "user-stage-lugre-bare-open": (_stage(15), 1000),
+    "loop-fit-pid-10nm": (_loop_fit(1e-8), 1500),
+    "loop-fit-pid-50nm": (_loop_fit(5e-8), 1500),
 }
 """Case name: (record maker, samples)."""
 
@@ -221,11 +255,12 @@ def coverage_table(cases: tuple[str, ...] = tuple(CASES), runs: int = 40, seed: 
         times, failures, within, either = [], 0, 0, 0
         for j in range(runs):
             data, start, truth, kw = make(np.random.default_rng([seed, c, j]), n)
+            fitter = kw.pop("fitter", fit)   # the closed-loop cases bring their route
             t0 = time.perf_counter()
             try:
                 with warnings.catch_warnings():
                     warnings.simplefilter("ignore")
-                    res = fit(start, data, **kw)
+                    res = fitter(start, data, **kw)
             except Exception:  # noqa: BLE001 - a failed fit is counted, not raised
                 failures += 1
                 continue

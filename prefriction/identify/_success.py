@@ -43,7 +43,7 @@ class Stage:
     name : str
         Short label of the table.
     friction : LuGre or Dahl
-        The true friction (Dahl with ``gamma >= 1``).
+        The true friction (Dahl with any ``gamma``).
     mass : float
         Moving mass [kg].
     b : float
@@ -263,8 +263,8 @@ def start_model(stage: Stage, rng: np.random.Generator,
                 distance: float) -> tuple[FrictionModel, float, float | None]:
     """Start model, start mass [kg] and start offset [N] (``None`` without a fitted offset):
     every free parameter at the truth times ``exp(U(-ln d, ln d))`` (``gamma`` kept at 1 or
-    above; LuGre's ``Fs`` at the start ``Fc`` times the true ratio ``Fs / Fc``), the offset at
-    the truth plus ``U(-ln d, ln d) Fc``."""
+    above, or at 0.95 or below for a true ``gamma < 1``; LuGre's ``Fs`` at the start ``Fc``
+    times the true ratio ``Fs / Fc``), the offset at the truth plus ``U(-ln d, ln d) Fc``."""
     import dataclasses
 
     def factor() -> float:
@@ -275,7 +275,9 @@ def start_model(stage: Stage, rng: np.random.Generator,
     for name in stage.free:
         if hasattr(fr, name) and name != "Fs":
             value = getattr(fr, name) * factor()
-            new[name] = max(value, 1.0) if name == "gamma" else value
+            if name == "gamma":  # kept on the truth's side of the Dahl structure boundary gamma = 1
+                value = max(value, 1.0) if fr.gamma >= 1.0 else min(value, 0.95)
+            new[name] = value
     if isinstance(fr, LuGre):  # Fs - Fc started at the truth's ratio (0 for Fs = Fc: no Stribeck peak)
         Fc0 = new.get("Fc", fr.Fc)
         new["Fs"] = max(Fc0 * fr.Fs / fr.Fc, Fc0)  # Fs = Fc stays so after the rounding of the ratio

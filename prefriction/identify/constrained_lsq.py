@@ -94,7 +94,8 @@ class _Cache:
 def solve(full: Callable, plain: Callable, w0: np.ndarray, lo: np.ndarray, hi: np.ndarray, *, max_iter: int,
           tol: float, gtol: float = 1e-9, weight: float = _MU0,
           restart: Callable[[np.ndarray], np.ndarray] | None = None,
-          progress: Callable[[str], None] | None = None) -> LsqOutcome:
+          progress: Callable[[str], None] | None = None, inner_tol: float = 1e-8,
+          final_tol: float = 0.0) -> LsqOutcome:
     """Constrained least squares from ``w0`` by the method of multipliers (1).
 
     Parameters
@@ -123,6 +124,11 @@ def solve(full: Callable, plain: Callable, w0: np.ndarray, lo: np.ndarray, hi: n
         moves between sub-steps) the trust region can shrink to nothing. At most :data:`_RESTARTS` times, each reported.
     progress : callable, optional
         Called with one line per outer iteration.
+    inner_tol : float, default 1e-8
+        ``ftol`` of the inner solves before the last (their ``xtol`` is ``1e-8``).
+    final_tol : float, default 0.0
+        The last inner solve uses ``max(tol, final_tol)``: a problem that is only piecewise smooth
+        never meets a tight ``ftol`` (its trust region shrinks on the kinks until ``max_nfev``).
     """
     cache = _Cache(full, plain)
     nb = lo.size
@@ -166,7 +172,8 @@ def solve(full: Callable, plain: Callable, w0: np.ndarray, lo: np.ndarray, hi: n
         final = outer > 1 and gmax_prev <= 10.0 * gtol
         sol = least_squares(fun, w, jac=jac, bounds=(lower, upper), method="trf",
                             tr_solver="exact" if dense else "lsmr",
-                            x_scale="jac", xtol=tol if final else max(tol, 1e-8), ftol=tol if final else 1e-8,
+                            x_scale="jac", xtol=max(tol, final_tol) if final else max(tol, 1e-8),
+                            ftol=max(tol, final_tol) if final else inner_tol,
                             gtol=1e-12, max_nfev=max(min(budget, _INNER) * 2, 2))
         stalled = np.array_equal(sol.x, w) or sol.nfev <= 1
         w = sol.x

@@ -3,7 +3,8 @@
 Two forms of the force computed at sample ``k`` from the measured positions ``x``, the reference
 ``r`` and an optional recorded additive force ``e`` (pulses):
 
-    PD on the measurement:  u_k = Kp (r_k - x_k) - Kd sum_j c_j (x_{k-j} - x_{k-j-1}) / dt + e_k     (1)
+    PID on the measurement: u_k = Kp (r_k - x_k) + Ki dt sum_{j<=k} (r_j - x_j)
+                                  - Kd sum_j c_j (x_{k-j} - x_{k-j-1}) / dt + e_k              (1)
     LTI on the error:       a_0 u_k = sum_j b_j eps_{k-j} - sum_{j>=1} a_j u_{k-j},  eps = r - x  (2)
 
 (2) is any discrete transfer function ``b(z^-1) / a(z^-1)`` from the error [m] to the force [N]
@@ -27,7 +28,7 @@ __all__ = ["DigitalLoop"]
 
 @dataclass(frozen=True)
 class DigitalLoop:
-    """A sampled position loop: PD on the measured position (1) or a linear law on the error (2).
+    """A sampled position loop: PID on the measured position (1) or a linear law on the error (2).
 
     Parameters
     ----------
@@ -43,6 +44,8 @@ class DigitalLoop:
         Samples between computing a force and applying it (0 to 4).
     limit : float, default inf
         Saturation of the force [N].
+    Ki : float, default 0.0
+        Integral gain [N/(m s)] of (1) (the rectangle rule, the sample's own error included).
     num, den : tuple of float, default ()
         Coefficients ``b_0, b_1, ...`` and ``a_0, a_1, ...`` of (2) in powers of ``z^-1`` (up to
         9 each, ``a_0 != 0``); when given, (2) replaces (1).
@@ -68,10 +71,11 @@ class DigitalLoop:
     limit: float = math.inf
     num: tuple[float, ...] = ()
     den: tuple[float, ...] = ()
+    Ki: float = 0.0
 
     def __post_init__(self) -> None:
         check_positive("dt", self.dt)
-        for name in ("Kp", "Kd"):
+        for name in ("Kp", "Kd", "Ki"):
             if not (math.isfinite(getattr(self, name)) and getattr(self, name) >= 0.0):
                 raise ValueError(f"{name} must be finite and >= 0, got {getattr(self, name)!r}")
         if not 1 <= len(self.taps) <= 8 or not all(math.isfinite(c) for c in self.taps):
@@ -167,6 +171,6 @@ class DigitalLoop:
             xp = np.concatenate((np.full(n, x[0]), x))
             v = sum(c * (xp[n - j:xp.size - j] - xp[n - j - 1:xp.size - j - 1])
                     for j, c in enumerate(self.taps)) / self.dt
-            u = self.Kp * (r - x) - self.Kd * v
+            u = self.Kp * (r - x) + self.Ki * self.dt * np.cumsum(r - x) - self.Kd * v
         u = u + (0.0 if extra is None else extra)
         return np.clip(u, -self.limit, self.limit)

@@ -266,7 +266,7 @@ def benchmark(directory: str | os.PathLike, *, starts: tuple[float, ...] = (1.0,
                 model = Dahl(sigma=f * 5e6, Fc=f * P["Fc"]) + Viscous(f * P["b"])
                 rows.append(_row("closed-loop", "Dahl + Viscous", f"{f:g} x", lambda model=model, f=f: fit_closed_loop(
                     model, data, loop, est.reference, fixed=["gamma"], mass0=f * P["mass"],
-                    offset0=f * P["offset"]), pulses))
+                    offset0=f * P["offset"], recorded=False), pulses))
                 say(f"closed-loop: Dahl + Viscous from {f:g} x, {rows[-1].seconds:.1f} s")
     ref = Row("published", "rigid body (Script_IDIM_LS.m)", "-",
               {n: (v, v, v) for n, v in P.items()})

@@ -39,7 +39,7 @@ from prefriction.identify.parameters import ParameterSpace
 from prefriction.identify.reversals import locate_reversals
 from prefriction.models.base import FrictionModel
 
-__all__ = ["LONG", "SEGMENT", "MotionSolution", "fit_motion"]
+__all__ = ["LONG", "SEGMENT", "MotionSolution", "fit_motion", "start_error"]
 
 SEGMENT = 50
 """Samples per shooting segment."""
@@ -51,6 +51,19 @@ WINDOW = 2_000
 its estimates, so it needs few iterations and its cost stays linear in the samples."""
 LONG = 5_000
 """Records of at least this many samples report each iteration on stderr (long work)."""
+NATIVE_FROM = 1_000
+"""Records of a model with in-branch events of at least this many samples run the compiled steps
+(compiling once per structure takes 10 to 30 s and makes every evaluation about 7 times faster)."""
+INNER_TOL_EVENTS = 1e-5
+"""``ftol`` of the inner solves before the last of a model with in-branch events
+(:func:`prefriction.identify.constrained_lsq.solve`): its motion is only piecewise smooth in the
+parameters (an event that moves from one sub-step to the next changes the error of its location),
+and tighter inner solves creep on those kinks."""
+FINAL_TOL_EVENTS = 1e-8
+"""Least ``xtol`` and ``ftol`` of the last inner solve of a model with in-branch events: a tighter
+one is never met on the kinks (a 2,000-sample Maxwell-slip(3) window ran 14 multiplier updates
+of 80 evaluations each with its defects at 1e-10); the polish then measures the rest in
+standard errors."""
 _NODE_WINDOW = 7
 """Samples of the Savitzky-Golay window of the node start values (short: coarse records)."""
 _MAPPED: dict[Any, tuple[ca.Function, ca.Function]] = {}
@@ -112,11 +125,16 @@ def _layout(data: Motion, K: int, directions: np.ndarray, scl: np.ndarray) -> _L
     return _Layout(K, nodes, u0, u1, dt, directions[nodes], scl, n)
 
 
+def native_steps(model: FrictionModel, n: int) -> bool:
+    """Whether a fit of ``n`` samples runs the compiled steps (:func:`segment_functions`)."""
+    return model.n_events > 0 and n >= NATIVE_FROM
+
+
 def _mapped(model: FrictionModel, space: ParameterSpace, K: int, n_sub: int, mass_free: bool,
-            J: int) -> tuple[ca.Function, ca.Function]:
-    key = (type(model), model.structure_key(), tuple(space.free), tuple(space.fixed), K, n_sub, mass_free, J)
+            J: int, native: bool = False) -> tuple[ca.Function, ca.Function]:
+    key = (type(model), model.structure_key(), tuple(space.free), tuple(space.fixed), K, n_sub, mass_free, J, native)
     if key not in _MAPPED:
-        plain, sens = segment_functions(model, space, K, n_sub, mass_free)
+        plain, sens = segment_functions(model, space, K, n_sub, mass_free, native)
         _MAPPED.clear()
         _MAPPED[key] = (plain.map(J), sens.map(J))
     return _MAPPED[key]
@@ -132,9 +150,10 @@ class _Problem:
     multiple-shooting iterate and make the residuals discontinuous."""
 
     def __init__(self, model: FrictionModel, space: ParameterSpace, data: Motion, lay: _Layout, n_sub: int,
-                 mass_free: bool, mass: float, xs: float) -> None:
+                 mass_free: bool, mass: float, xs: float, native: bool | None = None) -> None:
         self.lay, self.nth, self.ny = lay, space.n_free, 2 + model.n_states
-        self.plain, self.sens = _mapped(model, space, lay.K, n_sub, mass_free, lay.J)
+        self.native = native_steps(model, len(data)) if native is None else native
+        self.plain, self.sens = _mapped(model, space, lay.K, n_sub, mass_free, lay.J, self.native)
         self.fixed, self.mass, self.xs = space.fixed_values(), mass, xs
         self.samples = lay.samples()
         self.rows = np.flatnonzero(self.samples >= 0)
@@ -149,13 +168,16 @@ class _Problem:
     def carry_states(self, w: np.ndarray, single: ca.Function, everything: bool = False) -> np.ndarray:
         """``w`` with every node's model state after the first replaced by the end state of the
         segment before it (simulated from the start values): states consistent with the history.
-        ``everything``: the positions and velocities too, and no state capped (single shooting from
-        the first node: the chain is continuous to rounding)."""
+        ``everything``: the positions and velocities too, no state capped, and the flags of each
+        node those the segment before ends with (single shooting from the first node: the chain is
+        continuous to rounding, the in-branch events' modes included); otherwise the flags after
+        the first node are cleared (the multiple-shooting convention of the class)."""
         w = w.copy()
         th, nodes = self.split(w)
         a, K = self.args, self.lay.K
         if a["m0"].size:
             a["m0"][:, 0] = self.first_flags
+            a["m0"][:, 1:] = 0.0
         for j in range(self.lay.J - 1):
             cols = slice(j * K, (j + 1) * K)
             out = single(node=nodes[:, j], m0=a["m0"][:, j], theta=th, s0=a["s0"][j], s_to=a["s_to"][j],
@@ -164,8 +186,14 @@ class _Problem:
             ye = np.asarray(out["Ye"]).ravel()
             if np.all(np.isfinite(ye)):
                 nodes[:, j + 1] = ye if everything else np.r_[nodes[:2, j + 1], np.clip(ye[2:], -STATE_CAP, STATE_CAP)]
+            if everything and a["m0"].size:
+                a["m0"][:, j + 1] = np.asarray(out["Me"]).ravel()
         w[self.nth:] = nodes.T.ravel()
         return w
+
+    def clear_flags(self) -> None:
+        """Back to the multiple-shooting convention: no flag set at the nodes after the first."""
+        self.args["m0"][:, 1:] = 0.0
 
     def weigh(self, w: np.ndarray) -> None:
         """Scale each state row of the continuity constraints by ``1 / max(1, |z|)`` at ``w``: a
@@ -321,6 +349,29 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
     return dataclasses.replace(sol, steps=tuple(steps))
 
 
+def start_error(model: FrictionModel, data: Motion, space: ParameterSpace) -> float:
+    """Mean square position error [m^2] of the shooting segments at ``space``'s start values.
+
+    Each segment of :data:`SEGMENT` samples starts at the smoothed data (position, velocity) with
+    the model state carried from the segment before (as the fit's first iterate) and runs open
+    loop: how closely the start model follows the record, in the record's units whatever the
+    model (interpreted steps: no compilation). ``inf`` if the motion is not finite.
+    """
+    theta0 = space.theta0
+    vals = space.values(theta0)
+    mass_free = "mass" in space.start and "mass" in space.free
+    mass = vals["mass"] if mass_free else float(data.mass)
+    xsm, v, a = derivatives(data.t, data.x, _NODE_WINDOW)
+    n_sub = _substeps(model, data, mass, float(np.max(np.abs(v))), None)
+    lay = _layout(data, min(SEGMENT, len(data) - 1), _directions(data.t, data.x, v, None),
+                  np.array([model.Fc / model.sigma, model.Fc / math.sqrt(mass * model.sigma)]))
+    prob = _Problem(model, space, data, lay, n_sub, mass_free, mass, 1.0, native=False)
+    single = segment_functions(model, space, lay.K, n_sub, mass_free, False)[0]
+    w0, prob.first_flags = _start(model, data, theta0, lay, xsm, v, a, mass, vals.get("offset", 0.0), 0.5)
+    r, _g = prob.plain_eval(prob.carry_states(w0, single))
+    return float(np.mean(r * r)) if np.all(np.isfinite(r)) else math.inf
+
+
 def _busiest_window(data: Motion) -> int:
     """First sample of the :data:`WINDOW`-sample window (starts every ``WINDOW / 4`` samples) with
     the most velocity reversals of the smoothed positions, then the most travel: the part of the
@@ -349,13 +400,16 @@ def _solve_record(model: FrictionModel, data: Motion, space: ParameterSpace, the
     mass = space.values(theta0)["mass"] if mass_free else float(data.mass)
     xsm, v, a = derivatives(data.t, data.x, _NODE_WINDOW)
     directions = _directions(data.t, data.x, v, reversals)
+    requested = n_sub
     n_sub = _substeps(model, data, mass, float(np.max(np.abs(v))), n_sub)
+    if requested is None and native_steps(model, len(data)):  # compiled per count: powers of 2 only
+        n_sub = min(64, 2 ** math.ceil(math.log2(n_sub)))
     X, V = model.Fc / model.sigma, model.Fc / math.sqrt(mass * model.sigma)
     offset0 = space.values(theta0).get("offset", 0.0)
     lay = _layout(data, min(SEGMENT, len(data) - 1), directions, np.array([X, V]))
     xs = max(float(np.ptp(data.x)) * 1e-3, 1e-300)
     prob = _Problem(model, space, data, lay, n_sub, mass_free, mass, xs)
-    single = segment_functions(model, space, lay.K, n_sub, mass_free)[0]
+    single = segment_functions(model, space, lay.K, n_sub, mass_free, prob.native)[0]
     for level in (0.5, 0.0):  # node states of the force balance, else of zero force (see _start)
         w0, prob.first_flags = _start(model, data, theta0, lay, xsm, v, a, mass, offset0, level)
         w0 = prob.carry_states(w0, single)
@@ -376,10 +430,12 @@ def _solve_record(model: FrictionModel, data: Motion, space: ParameterSpace, the
         return prob.carry_states(fresh, single)
 
     out = solve(prob.full_eval, prob.plain_eval, w0, lo, hi, max_iter=max_iter, tol=tol, gtol=GTOL,
-                weight=weight, restart=restart, progress=progress)
+                weight=weight, restart=restart, progress=progress,
+                inner_tol=INNER_TOL_EVENTS if model.n_events else 1e-8,
+                final_tol=FINAL_TOL_EVENTS if model.n_events else 0.0)
     w = out.w
     polished = ""
-    if out.success and not model.n_flags:  # flags (in-branch events) are not carried from segment to segment
+    if out.success:
         w, polished = _polish(prob, w, single, lo, hi)
     r, _g, res = prob.residuals(w)
     Jred = prob.reduced_jacobian(w)
@@ -409,7 +465,8 @@ def _polish(prob: _Problem, w: np.ndarray, single: ca.Function, lo: np.ndarray,
     minimum of the single-shooting problem (measured on the 2.5 kg open-loop stage of
     ``docs/identify.md#coverage``): an error the intervals do not contain. The statistics
     linearise the single-shooting residual ``r(theta, y_0)`` (the chain of segments from the first
-    node), so its Gauss-Newton step ``d = -(J^T J)^+ J^T r`` measures how far ``w`` is from the
+    node, each node's flags, the modes of a model's in-branch events, those its predecessor ends
+    with), so its Gauss-Newton step ``d = -(J^T J)^+ J^T r`` measures how far ``w`` is from the
     minimum in the covariance's own units. Each step moves the parameters (those strictly inside
     their bounds) and the first node, re-chains the nodes and is kept only if it lowers
     ``|r|^2`` (else halved once); the loop ends when every parameter's step is below
@@ -429,6 +486,7 @@ def _polish(prob: _Problem, w: np.ndarray, single: ca.Function, lo: np.ndarray,
     w = prob.carry_states(w, single, everything=True)
     r, g = prob.plain_eval(w)
     if not (np.all(np.isfinite(r)) and np.all(np.isfinite(g))):
+        prob.clear_flags()
         return w_ms, "; the single-shooting chain is not finite at the solution: not polished"
     with np.errstate(invalid="ignore"):
         margin = 1e-9 * np.maximum(1.0, np.abs(w[:nth]))
@@ -460,6 +518,7 @@ def _polish(prob: _Problem, w: np.ndarray, single: ca.Function, lo: np.ndarray,
     # (a chi-square); a chain that ends far above that drifts from the data (a long record)
     allowed = rss_ms + g_ms.size * rss_ms / max(r_ms.size - nth - ny, 1)
     if float(r @ r) > allowed:
+        prob.clear_flags()
         return w_ms, (f"; the single-shooting chain from the first node drifts from the data (|r|^2 "
                       f"{float(r @ r):.3g} against {rss_ms:.3g} of the segments): not polished")
     if not taken:

@@ -32,7 +32,7 @@ from scipy.integrate import solve_ivp
 from prefriction.errors import SolverError
 from prefriction.identify.data import Motion
 
-__all__ = ["EventRun", "event_motion", "event_record"]
+__all__ = ["EventRun", "closed_loop_event_record", "event_motion", "event_record"]
 
 
 @dataclass(frozen=True)
@@ -126,7 +126,8 @@ class _Laws:
 
 
 def event_motion(model: Any, mass: float, t: Any, u: Any, *, offset: float = 0.0, v0: float = 0.0,
-                 hold: str = "zoh", rtol: float = 1e-11) -> EventRun:
+                 hold: str = "zoh", rtol: float = 1e-11,
+                 controller: Callable[[int, float], float] | None = None) -> EventRun:
     """The motion of ``mass`` under ``u`` and the friction of ``model`` from its virgin state.
 
     Parameters
@@ -145,6 +146,10 @@ def event_motion(model: Any, mass: float, t: Any, u: Any, *, offset: float = 0.0
         The force over a sample: ``u[k]`` held, or linear to ``u[k + 1]``.
     rtol : float, default 1e-11
         Relative tolerance of DOP853 (absolute: ``rtol`` times the position scale).
+    controller : callable, optional
+        ``(k, x_k) -> u_k``: a digital loop's force [N] at sample ``k`` from the true position
+        there [m] (its encoder inside), held over the next interval (``hold="zoh"``); replaces
+        ``u``, which then only sets the direction at rest through ``u[0]``.
 
     Returns
     -------
@@ -153,6 +158,10 @@ def event_motion(model: Any, mass: float, t: Any, u: Any, *, offset: float = 0.0
     law = _Laws(model)
     t = np.asarray(t, dtype=float)
     u = np.asarray(u, dtype=float) * np.ones(t.size)
+    if controller is not None:
+        if hold != "zoh":
+            raise ValueError(f"a controller holds its force over each sample: hold must be 'zoh', got {hold!r}")
+        u[0] = controller(0, 0.0)
     s = 1.0 if v0 > 0 else -1.0 if v0 < 0 else (1.0 if u[0] - offset >= 0 else -1.0)
     sat = np.zeros(law.n, dtype=bool)
     z = law.to_state(np.zeros(law.n), s)
@@ -162,6 +171,8 @@ def event_motion(model: Any, mass: float, t: Any, u: Any, *, offset: float = 0.0
     revs: list[float] = []
     evs: list[float] = []
     for k in range(t.size - 1):
+        if controller is not None and k:
+            u[k] = controller(k, float(y[0]))
         t0, t1 = float(t[k]), float(t[k + 1])
         slope = 0.0 if hold == "zoh" else (u[k + 1] - u[k]) / (t1 - t0)
         force: Callable[[float], float] = lambda tt, k=k, t0=t0, slope=slope: u[k] + slope * (tt - t0)  # noqa: E731
@@ -227,3 +238,57 @@ def event_record(model: Any, mass: float, t: Any, u: Any, *, offset: float = 0.0
     x = run.x if noise == 0.0 else run.x + noise * (rng or np.random.default_rng(0)).standard_normal(run.x.size)
     return Motion(np.asarray(t, dtype=float), x, np.asarray(u, dtype=float) * np.ones(len(x)),
                   mass if known_mass else None, hold)
+
+
+def closed_loop_event_record(model: Any, mass: float, dt: float, r: Any, *, Kp: float, Ki: float = 0.0,
+                             Kd: float = 0.0, offset: float = 0.0, quantum: float = 0.0, noise: float = 0.0,
+                             rng: np.random.Generator | None = None, rtol: float = 1e-11) -> Motion:
+    """A record of the stage of :func:`event_motion` under a digital PID on the encoder.
+
+    At each sample ``k`` the encoder reads ``x_m = quantum round((x_k + n_k) / quantum)``
+    (``n_k`` Gaussian of deviation ``noise``; no rounding for ``quantum = 0``) and the loop applies
+    ``u_k = Kp (r_k - x_m,k) + Ki dt sum_{j<=k} (r_j - x_m,j) - Kd (x_m,k - x_m,k-1) / dt`` [N]
+    over the next interval (``x_m,-1 = x_m,0``); the stage starts at rest at 0 on a virgin branch.
+
+    Parameters
+    ----------
+    model : Dahl, MaxwellSlip or GMS
+        The friction.
+    mass : float
+        Mass [kg].
+    dt : float
+        Sample interval [s].
+    r : array_like
+        Reference positions [m], one per sample.
+    Kp, Ki, Kd : float
+        Gains [N/m], [N/(m s)], [N s/m].
+    offset : float, default 0.0
+        Force offset ``F_off`` [N].
+    quantum, noise : float, default 0.0
+        Encoder step [m] and noise deviation [m].
+    rng : numpy.random.Generator, optional
+        Source of the noise.
+    rtol : float, default 1e-11
+        Relative tolerance of DOP853.
+
+    Returns
+    -------
+    Motion
+        Encoder positions, the loop's force, the mass (known).
+    """
+    r = np.asarray(r, dtype=float)
+    n = r.size
+    e = noise * (rng or np.random.default_rng(0)).standard_normal(n)
+    xm, u = np.empty(n), np.empty(n)
+    total = [0.0]
+
+    def controller(k: int, x: float) -> float:
+        xm[k] = x + e[k] if quantum == 0.0 else quantum * np.round((x + e[k]) / quantum)
+        total[0] += r[k] - xm[k]
+        u[k] = Kp * (r[k] - xm[k]) + Ki * dt * total[0] - Kd * (xm[k] - xm[max(k - 1, 0)]) / dt
+        return float(u[k])
+
+    t = np.arange(n) * dt
+    run = event_motion(model, mass, t, np.zeros(n), offset=offset, rtol=rtol, controller=controller)
+    controller(n - 1, float(run.x[-1]))
+    return Motion(t, xm, u, mass, "zoh")
