@@ -83,6 +83,7 @@ class MotionSolution:
     message: str
     success: bool = True
     steps: tuple[str, ...] = ()
+    n_sub: int = 0
 
 
 @dataclass(frozen=True)
@@ -409,6 +410,7 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
         head = Motion(data.t[part], data.x[part], data.u[part], data.mass, data.hold)
         given = None if reversals is None else [r for r in reversals if head.t[0] < r < head.t[-1]]
         first = _solve(model, head, space, theta0, n_sub, max_iter, tol, given, progress, 0.01, steps)
+        least = first.n_sub if first.success else 1
         if first.success:
             theta0 = first.w[: space.n_free]
             vals = space.values(theta0)
@@ -419,18 +421,20 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
             steps.append(f"continuation: the fit of samples {k0} to {k0 + WINDOW - 1} did not converge "
                          f"({first.message}); the full record started from the start values")
     sol = _solve(model, data, space, theta0, n_sub, max_iter, tol, reversals, progress,
-                 0.01 if not steps or "did not" in steps[-1] else 10.0, steps)
+                 0.01 if not steps or "did not" in steps[-1] else 10.0, steps, least if len(data) > 2 * WINDOW else 1)
     return dataclasses.replace(sol, steps=tuple(steps))
 
 
 def _solve(model: FrictionModel, data: Motion, space: ParameterSpace, theta0: np.ndarray, n_sub: int | None,
            max_iter: int, tol: float, reversals: Any, progress: Any, weight: float,
-           steps: list[str]) -> MotionSolution:
+           steps: list[str], least_sub: int = 1) -> MotionSolution:
     """:func:`_solve_record` with the chain whole; if that does not converge and the record has
     long hovers (:func:`_hover_nodes`), again from its estimates with the chain cut there (the
     continuity through a long hover is piecewise smooth on the scale of the defects; a chain kept
-    whole where it converges keeps the information the rests carry). Notes go to ``steps``."""
-    sol = _solve_record(model, data, space, theta0, n_sub, max_iter, tol, reversals, progress, weight, False)
+    whole where it converges keeps the information the rests carry). Notes go to ``steps``;
+    ``least_sub``: fewest automatic sub-steps (those a window's fit found necessary)."""
+    sol = _solve_record(model, data, space, theta0, n_sub, max_iter, tol, reversals, progress, weight, False,
+                        least_sub)
     if sol.success:
         return sol
     _x, v, _a = derivatives(data.t, data.x, _NODE_WINDOW)
@@ -440,7 +444,7 @@ def _solve(model: FrictionModel, data: Motion, space: ParameterSpace, theta0: np
     if not cut or not np.all(np.isfinite(theta)):
         return sol
     again = _solve_record(space.build(space.values(theta)), data, space, theta, n_sub, max_iter, tol, reversals,
-                          progress, 10.0, True)
+                          progress, 10.0, True, max(least_sub, sol.n_sub))
     steps.append(f"samples {len(data)}: the whole chain did not converge ({sol.message[-160:]}); the {cut} nodes after "
                  f"the segments of long hovers then started pieces of the chain, from its estimates: "
                  + ("converged" if again.success else "did not converge either, the whole chain's result kept"))
@@ -491,15 +495,18 @@ def _busiest_window(data: Motion) -> int:
 
 def _solve_record(model: FrictionModel, data: Motion, space: ParameterSpace, theta0: np.ndarray,
                   n_sub: int | None, max_iter: int, tol: float, reversals: Any, progress: Any,
-                  weight: float, pieces: bool = False) -> MotionSolution:
+                  weight: float, pieces: bool = False, least_sub: int = 1) -> MotionSolution:
     """One multiple-shooting fit of ``data`` from the scaled parameters ``theta0``; ``model``
-    (values at ``theta0``) sets the node scales and the sub-steps."""
+    (values at ``theta0``) sets the node scales and the sub-steps (at least ``least_sub``). With
+    the sub-steps chosen automatically, a converged fit is solved again with twice as many while
+    doubling them moves an estimate by more than :data:`prefriction.identify.substep_check.STEP_SHIFT`
+    of its standard error (:func:`_refine_substeps`)."""
     mass_free = "mass" in space.start and "mass" in space.free
     mass = space.values(theta0)["mass"] if mass_free else float(data.mass)
     xsm, v, a = derivatives(data.t, data.x, _NODE_WINDOW)
     directions = _directions(data.t, data.x, v, reversals)
     requested = n_sub
-    n_sub = _substeps(model, data, mass, float(np.max(np.abs(v))), n_sub)
+    n_sub = max(_substeps(model, data, mass, float(np.max(np.abs(v))), n_sub), 1 if requested else least_sub)
     if requested is None and native_steps(model, len(data)):  # compiled per count: powers of 2 only
         n_sub = min(64, 2 ** math.ceil(math.log2(n_sub)))
     X, V = model.Fc / model.sigma, model.Fc / math.sqrt(mass * model.sigma)
@@ -536,6 +543,18 @@ def _solve_record(model: FrictionModel, data: Motion, space: ParameterSpace, the
     polished = ""
     if out.success:
         w, polished = _polish(prob, w, single, lo, hi)
+        if requested is None:
+            prob, single, out, w, n_sub, refined = _refine_substeps(prob, single, out, w, n_sub, lo, hi,
+                                                                    lambda p, s, w_: solve(
+                                                                        p.full_eval, p.plain_eval, w_, lo, hi,
+                                                                        max_iter=max_iter, tol=tol, gtol=GTOL,
+                                                                        weight=weight, progress=progress,
+                                                                        inner_tol=INNER_TOL_EVENTS if model.n_events
+                                                                        else 1e-8,
+                                                                        final_tol=FINAL_TOL_EVENTS if model.n_events
+                                                                        else 0.0),
+                                                                    (model, space, data, mass_free, mass, xs))
+            polished += refined
     r, _g, res = prob.residuals(w)
     Jred = prob.reduced_jacobian(w)
     Xv = res["X"]
@@ -546,7 +565,59 @@ def _solve_record(model: FrictionModel, data: Motion, space: ParameterSpace, the
                           f"multiple shooting, {lay.J} segments of {lay.K} samples, {n_sub} RK4 sub-steps per "
                           f"sample{_pieces(lay)}, scipy least_squares in an augmented Lagrangian: "
                           f"{out.message}{polished}",
-                          out.success)
+                          out.success, n_sub=n_sub)
+
+
+def _refine_substeps(prob: _Problem, single: ca.Function, out: Any, w: np.ndarray, n_sub: int, lo: np.ndarray,
+                     hi: np.ndarray, resolve: Any, setup: tuple) -> tuple:
+    """Double the RK4 sub-steps while doing so moves an estimate by more than
+    :data:`prefriction.identify.substep_check.STEP_SHIFT` standard errors
+    (:func:`prefriction.identify.substep_check.step_shift`, measured on the single-shooting chain
+    from the first node at ``w``); each doubling solves the fit again from ``w`` (``resolve``) and
+    polishes it. The doubled steps of the measurement are interpreted (a model with in-branch events
+    compiles them only if the fit is solved again).
+
+    Returns
+    -------
+    tuple
+        ``(prob, single, out, w, n_sub, note)``: the problem, chain function, solver result,
+        solution and sub-steps kept, and a note for the solver message (``""`` if unchanged).
+    """
+    from prefriction.identify.substep_check import STEP_SHIFT, step_shift
+
+    model, space, data, mass_free, mass, xs = setup
+    lay, nth = prob.lay, prob.nth
+    note = ""
+    while n_sub < 64:
+        saved = prob.args["m0"].copy()
+        wc = prob.carry_states(w, single, everything=True)
+        r, _g = prob.plain_eval(wc)
+        J = prob.reduced_jacobian(wc)
+        fine = _Problem(model, space, data, lay, 2 * n_sub, mass_free, mass, xs, False)
+        fine.first_flags = list(prob.first_flags)
+        fine_single = segment_functions(model, space, lay.K, 2 * n_sub, mass_free, False)[0]
+        rf, _gf = fine.plain_eval(fine.carry_states(w, fine_single, everything=True))
+        prob.args["m0"][...] = saved
+        with np.errstate(invalid="ignore"):
+            margin = 1e-9 * np.maximum(1.0, np.abs(w[:nth]))
+        params = np.flatnonzero((w[:nth] - lo > margin) & (hi - w[:nth] > margin))
+        shift = step_shift(J, r, rf, params)
+        if shift <= STEP_SHIFT:
+            break
+        n_sub *= 2
+        nxt = _Problem(model, space, data, lay, n_sub, mass_free, mass, xs, prob.native)
+        nxt.first_flags, nxt.gw = list(prob.first_flags), prob.gw.copy()
+        nxt_single = segment_functions(model, space, lay.K, n_sub, mass_free, nxt.native)[0]
+        again = resolve(nxt, nxt_single, nxt.carry_states(w, nxt_single))
+        if not again.success:
+            note += (f"; doubling the RK4 sub-steps moved an estimate by {shift:.2g} standard errors, but the fit "
+                     f"with {n_sub} did not converge ({again.message[-120:]}): kept {n_sub // 2}")
+            n_sub //= 2
+            break
+        prob, single, out = nxt, nxt_single, again
+        w, _note = _polish(prob, again.w, single, lo, hi)
+        note += f"; {n_sub} RK4 sub-steps per sample (doubling them moved an estimate by {shift:.2g} standard errors)"
+    return prob, single, out, w, n_sub, note
 
 
 def _pieces(lay: _Layout) -> str:
