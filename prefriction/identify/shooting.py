@@ -616,7 +616,8 @@ def _refine_substeps(prob: _Problem, single: ca.Function, out: Any, w: np.ndarra
             break
         prob, single, out = nxt, nxt_single, again
         w, _note = _polish(prob, again.w, single, lo, hi)
-        note += f"; {n_sub} RK4 sub-steps per sample (doubling them moved an estimate by {shift:.2g} standard errors)"
+        note += (f"; {n_sub} RK4 sub-steps per sample (doubling {n_sub // 2} moved an estimate by {shift:.2g} standard "
+                 f"errors)")
     return prob, single, out, w, n_sub, note
 
 
