@@ -570,11 +570,12 @@ def _solve_record(model: FrictionModel, data: Motion, space: ParameterSpace, the
 
 def _refine_substeps(prob: _Problem, single: ca.Function, out: Any, w: np.ndarray, n_sub: int, lo: np.ndarray,
                      hi: np.ndarray, resolve: Any, setup: tuple) -> tuple:
-    """Double the RK4 sub-steps while doing so moves an estimate by more than
+    """Refine the RK4 sub-steps while doubling them moves an estimate by more than
     :data:`prefriction.identify.substep_check.STEP_SHIFT` standard errors
     (:func:`prefriction.identify.substep_check.step_shift`, measured on the single-shooting chain
-    from the first node at ``w``); each doubling solves the fit again from ``w`` (``resolve``) and
-    polishes it. The doubled steps of the measurement are interpreted (a model with in-branch events
+    from the first node at ``w``): the shift ``d`` of ``n_sub`` asks for ``n_sub`` times the power of
+    2 at or above ``(d / STEP_SHIFT)^(1/4)`` (RK4's bias falls as ``n_sub^-4``), at least twice as many,
+    at most 64; each refinement solves the fit again from ``w`` (``resolve``), polishes it and is checked again. The doubled steps of the measurement are interpreted (a model with in-branch events
     compiles them only if the fit is solved again).
 
     Returns
@@ -604,19 +605,20 @@ def _refine_substeps(prob: _Problem, single: ca.Function, out: Any, w: np.ndarra
         shift = step_shift(J, r, rf, params)
         if shift <= STEP_SHIFT:
             break
-        n_sub *= 2
+        # RK4: the bias falls as n_sub^-4; jump to the power-of-2 multiple that brings it below the limit
+        before, n_sub = n_sub, min(64, n_sub * 2 ** max(1, math.ceil(math.log2((shift / STEP_SHIFT) ** 0.25))))
         nxt = _Problem(model, space, data, lay, n_sub, mass_free, mass, xs, prob.native)
         nxt.first_flags, nxt.gw = list(prob.first_flags), prob.gw.copy()
         nxt_single = segment_functions(model, space, lay.K, n_sub, mass_free, nxt.native)[0]
         again = resolve(nxt, nxt_single, nxt.carry_states(w, nxt_single))
         if not again.success:
             note += (f"; doubling the RK4 sub-steps moved an estimate by {shift:.2g} standard errors, but the fit "
-                     f"with {n_sub} did not converge ({again.message[-120:]}): kept {n_sub // 2}")
-            n_sub //= 2
+                     f"with {n_sub} did not converge ({again.message[-120:]}): kept {before}")
+            n_sub = before
             break
         prob, single, out = nxt, nxt_single, again
         w, _note = _polish(prob, again.w, single, lo, hi)
-        note += (f"; {n_sub} RK4 sub-steps per sample (doubling {n_sub // 2} moved an estimate by {shift:.2g} standard "
+        note += (f"; {n_sub} RK4 sub-steps per sample (doubling {before} moved an estimate by {shift:.2g} standard "
                  f"errors)")
     return prob, single, out, w, n_sub, note
 
