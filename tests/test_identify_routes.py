@@ -285,3 +285,29 @@ def test_emps_routes_hold_the_published_values():
     for r in dynamic:
         assert all(r.holds().values()), r
     assert min(r.rmse for r in dynamic) < published.rmse
+
+
+def test_recommend_keeps_a_record_with_a_negative_closed_form_mass_from_the_motion_route():
+    """The stage workflow's closed-loop record (PID at 5 kHz, 10 nm encoder; scipy LSODA from the
+    equations of ``examples/stage_workflow.py``, 1,800 samples): its closed-form inverse model has
+    a negative mass, so the open-loop Motion fit is not advised; the reason says so in words."""
+    import importlib.util
+    import sys
+
+    from _doc_blocks import ROOT
+
+    spec = importlib.util.spec_from_file_location("stage_workflow", ROOT / "examples" / "stage_workflow.py")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules["stage_workflow"] = module
+    spec.loader.exec_module(module)
+    rec = module.synthetic_record(0.36)
+    data = identify.Motion(rec.t, rec.x, rec.u, None)
+    from prefriction.identify.derivatives import derivatives
+    from prefriction.identify.inverse import static_inverse
+
+    d0 = derivatives(data.t, data.x)
+    assert static_inverse(data, derivatives(data.t, data.x, tail=d0.border))["mass"] < 0.0   # the premise
+    advice = identify.recommend(data)
+    assert advice.route == "inverse" and "not physical" in advice.reason and "fit_inverse" in advice.reason
+    known = identify.recommend(data, controller_known=True)
+    assert known.route == "closed-loop" and "fit_closed_loop" in known.reason and "mass" in known.reason

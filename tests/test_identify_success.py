@@ -16,8 +16,8 @@ import pytest
 
 import prefriction as pf
 from prefriction import identify
-from prefriction.identify._success import (GRID, STAGES, coverage_text, pooled_text, stage_record, start_model,
-                                           success_table, table_text)
+from prefriction.identify._success import (GRID, STAGES, SuccessRow, coverage_text, distance_text, pooled_text,
+                                           stage_record, start_model, success_table, table_text)
 from prefriction.identify.motion_start import data_start, start_values, static_start
 from prefriction.identify.motion_step import segment_functions
 from prefriction.identify.parameters import ParameterSpace
@@ -119,6 +119,31 @@ def test_harness_sample_lands_within_5_percent():
     assert max(s for s, _ in rows[0].spread) <= np.log(2.0) and rows[0].returned == 3
     assert "| Dahl | 3/3 (100%)" in pooled_text(rows)
     assert set(rows[0].held) == {"sigma", "Fc", "mass"} and "| Dahl | 1 | 3 |" in coverage_text(rows)
+    assert "| Dahl | x2 | 3/3 (100%) |" in distance_text(rows)
+    assert 0.0 < rows[0].median_cpu and rows[0].max_cpu >= rows[0].median_cpu
+
+
+def _row(stage: str, label: str, seed: int, d: float, ok: int, first: int, held: dict, wall: float) -> SuccessRow:
+    return SuccessRow(stage, d, 100, 2, ok, ok, wall, 2.0 * wall, "", label, 2, held, (), 100.0 + seed, first, seed,
+                      wall / 2.0, wall)
+
+
+def test_tables_count_per_model_distance_and_record():
+    """The distance table adds successes and given-start successes over the stages and seeds of
+    a model; the coverage table counts each (stage, seed) record once, and its binomial SD at
+    95 % is sqrt(0.95 * 0.05 / intervals)."""
+    rows = [_row("A", "Dahl", 0, 1.5, 2, 1, {"sigma": 2, "Fc": 0}, 4.0),
+            _row("A", "Dahl", 1, 1.5, 1, 1, {"sigma": 2, "Fc": 2}, 8.0),
+            _row("A", "Dahl", 1, 2.0, 2, 2, {"sigma": 2, "Fc": 2}, 6.0),
+            _row("B", "LuGre", 0, 2.0, 0, 0, {"sigma0": 1, "Fs": 2}, 20.0)]
+    text = distance_text(rows)
+    assert "| Dahl | x1.5 | 3/4 (75%) | 2 | 6.0 / 16 | 3.0 / 8.0 | 101 |" in text
+    assert "| all | x2 | 2/4 (50%) | 2 |" in text
+    cov = coverage_text(rows)
+    # Dahl: record (A, 0) holds sigma 2/2, Fc 0/2; record (A, 1) holds 4/4 and 4/4 over its two rows
+    assert "| Dahl | 2 | 6 | sigma 100%, Fc 50% | 75% | 4 | 10.9% |" in cov, cov
+    assert "| LuGre | 1 | 2 | sigma0 50%, Fs 100% | 75% | 2 | 15.4% |" in cov, cov
+    assert "| all | 3 | 8 | sigma 100%, Fc 50%, sigma0 50%, Fs 100% | 75% | 6 | 8.9% |" in cov, cov
 
 
 def test_second_start_from_the_data_is_within_a_factor_two():
@@ -222,3 +247,14 @@ def test_success_rate_over_the_stages():
     distance: ``python -m prefriction.identify._success``."""
     rows = success_table((STAGES[0], STAGES[3], STAGES[4]), (2.0,), fits=1, samples=1000, seed=0)
     assert all(r.successes == r.fits for r in rows), table_text(rows)
+
+
+def test_lugre_starts_keep_Fs_at_or_above_Fc():
+    """A LuGre stage with Fs = Fc (no Stribeck peak): every drawn start is a LuGre that constructs,
+    with Fs at its start Fc (the true ratio Fs / Fc = 1 after the rounding of the product)."""
+    stage = GRID[15]                                   # Fc = Fs = 3 N: Fc0 * 3 / 3 rounds below Fc0
+    assert stage.friction.Fs == stage.friction.Fc
+    rng = np.random.default_rng(0)
+    for _ in range(300):
+        start, _, _ = start_model(stage, rng, 2.0)       # raises if Fs < Fc
+        assert start.Fs >= start.Fc and start.Fs == pytest.approx(start.Fc, rel=1e-15)

@@ -27,8 +27,8 @@ from prefriction.models.dahl import Dahl
 from prefriction.models.lugre import LuGre
 from prefriction.models.viscous import Viscous
 
-__all__ = ["GRID", "STAGES", "Stage", "SuccessRow", "coverage_text", "pooled_text", "row_from_dict", "stage_record", "start_model",
-           "success_table", "table_text"]
+__all__ = ["GRID", "STAGES", "Stage", "SuccessRow", "coverage_text", "distance_text", "pooled_text", "row_from_dict",
+           "stage_record", "start_model", "success_table", "table_text"]
 
 TOLERANCE = 0.05
 """Largest relative error of every estimate for a fit to count as a success."""
@@ -43,7 +43,7 @@ class Stage:
     name : str
         Short label of the table.
     friction : LuGre or Dahl
-        The true friction (Dahl with ``gamma >= 1``).
+        The true friction (Dahl with any ``gamma``).
     mass : float
         Moving mass [kg].
     b : float
@@ -230,7 +230,9 @@ class SuccessRow:
     fit's realised start distance) and whether the fit succeeded; ``rss_mb`` is the peak
     resident set size of the process [MB] when the row was done; ``first`` counts the successes
     of the given start alone (without the second start from the data that a failed fit takes,
-    :func:`prefriction.identify.motion_start.data_start`)."""
+    :func:`prefriction.identify.motion_start.data_start`); ``seed`` is the seed of the record and
+    the starts; ``median_cpu`` and ``max_cpu`` are the fits' CPU times [s] (``time.process_time``,
+    all the process's threads), which a loaded machine does not inflate as it does the wall times."""
 
     stage: str
     distance: float
@@ -247,6 +249,9 @@ class SuccessRow:
     spread: tuple = ()
     rss_mb: float = 0.0
     first: int = 0
+    seed: int = 0
+    median_cpu: float = 0.0
+    max_cpu: float = 0.0
 
     @property
     def rate(self) -> float:
@@ -258,8 +263,8 @@ def start_model(stage: Stage, rng: np.random.Generator,
                 distance: float) -> tuple[FrictionModel, float, float | None]:
     """Start model, start mass [kg] and start offset [N] (``None`` without a fitted offset):
     every free parameter at the truth times ``exp(U(-ln d, ln d))`` (``gamma`` kept at 1 or
-    above; LuGre's ``Fs`` at the start ``Fc`` times the true ratio ``Fs / Fc``), the offset at
-    the truth plus ``U(-ln d, ln d) Fc``."""
+    above, or at 0.95 or below for a true ``gamma < 1``; LuGre's ``Fs`` at the start ``Fc``
+    times the true ratio ``Fs / Fc``), the offset at the truth plus ``U(-ln d, ln d) Fc``."""
     import dataclasses
 
     def factor() -> float:
@@ -270,9 +275,12 @@ def start_model(stage: Stage, rng: np.random.Generator,
     for name in stage.free:
         if hasattr(fr, name) and name != "Fs":
             value = getattr(fr, name) * factor()
-            new[name] = max(value, 1.0) if name == "gamma" else value
+            if name == "gamma":  # kept on the truth's side of the Dahl structure boundary gamma = 1
+                value = max(value, 1.0) if fr.gamma >= 1.0 else min(value, 0.95)
+            new[name] = value
     if isinstance(fr, LuGre):  # Fs - Fc started at the truth's ratio (0 for Fs = Fc: no Stribeck peak)
-        new["Fs"] = new.get("Fc", fr.Fc) * fr.Fs / fr.Fc
+        Fc0 = new.get("Fc", fr.Fc)
+        new["Fs"] = max(Fc0 * fr.Fs / fr.Fc, Fc0)  # Fs = Fc stays so after the rounding of the ratio
     start = dataclasses.replace(fr, **new)
     if "b" in stage.free:
         start = start + Viscous(stage.b * factor())
@@ -323,7 +331,7 @@ def success_table(stages: tuple = STAGES, distances: tuple = (1.25, 1.5, 2.0), *
                              f"max error {f.error:.2%} (start within x{math.exp(f.spread):.2f}) in {f.time:.1f} s"
                              + (" after a second start from the data" if f.retried else "")
                              + (f" ({f.message})" if f.message else ""))
-            rows.append(_row(stage, d, samples, fits_done))
+            rows.append(_row(stage, d, samples, fits_done, seed))
     return rows
 
 
@@ -340,6 +348,7 @@ class _Fit:
     held: dict
     message: str
     retried: bool = False
+    cpu: float = 0.0
 
 
 def _one_fit(stage: Stage, data: Motion, start: FrictionModel, m0: float, off0: float | None) -> _Fit:
@@ -353,7 +362,7 @@ def _one_fit(stage: Stage, data: Motion, start: FrictionModel, m0: float, off0: 
     spread = max(abs(math.log(values[n] / v)) for n, v in truth.items() if n != "offset")
     fixed = [e.name for e in _entries(start) if e.name not in stage.free]
     kw = {"offset": True, "offset0": off0} if stage.fit_offset else {}
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     held: dict = {}
     retried = False
     with warnings.catch_warnings():
@@ -369,14 +378,14 @@ def _one_fit(stage: Stage, data: Motion, start: FrictionModel, m0: float, off0: 
         except Exception as exc:  # noqa: BLE001 - a failure is a row of the table
             est, conv, msg = {}, False, f"{type(exc).__name__}: {exc}"
             retried = "second start from" in msg
-    elapsed = time.perf_counter() - t0
+    elapsed, cpu = time.perf_counter() - t0, time.process_time() - c0
     errs = {n: _error(n, est.get(n, math.nan), v, stage) for n, v in truth.items()}
     err = max(errs.values())
     name = max(errs, key=lambda n: errs[n] if math.isfinite(errs[n]) else math.inf)
-    return _Fit(err <= TOLERANCE, conv, err, name, elapsed, spread, held, msg, retried)
+    return _Fit(err <= TOLERANCE, conv, err, name, elapsed, spread, held, msg, retried, cpu)
 
 
-def _row(stage: Stage, d: float, samples: int, fits: list[_Fit]) -> SuccessRow:
+def _row(stage: Stage, d: float, samples: int, fits: list[_Fit], seed: int = 0) -> SuccessRow:
     import resource
 
     bad = [f for f in fits if not f.good]
@@ -388,12 +397,12 @@ def _row(stage: Stage, d: float, samples: int, fits: list[_Fit]) -> SuccessRow:
     for f in fits:
         for n, h in f.held.items():
             held[n] = held.get(n, 0) + int(h)
-    times = [f.time for f in fits]
+    times, cpus = [f.time for f in fits], [f.cpu for f in fits]
     return SuccessRow(stage.name, d, samples, len(fits), sum(f.good for f in fits), sum(f.converged for f in fits),
                       float(np.median(times)), float(np.max(times)), worst, stage.label,
                       sum(bool(f.held) for f in fits), held, tuple((f.spread, f.good) for f in fits),
                       resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
-                      sum(f.good and not f.retried for f in fits))
+                      sum(f.good and not f.retried for f in fits), seed, float(np.median(cpus)), float(np.max(cpus)))
 
 
 def _error(name: str, value: float, truth: float, stage: Stage) -> float:
@@ -405,11 +414,12 @@ def _error(name: str, value: float, truth: float, stage: Stage) -> float:
 
 def table_text(rows: list[SuccessRow]) -> str:
     """The rows as a Markdown table, one line per stage and start distance."""
-    lines = ["| stage | start within | samples | success | converged | median [s] | max [s] | peak RSS [MB] | "
-             "worst miss |", "|---|---:|---:|---:|---:|---:|---:|---:|---|"]
+    lines = ["| stage | seed | start within | samples | success | converged | median [s] | max [s] | CPU median [s] | "
+             "peak RSS [MB] | worst miss |", "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|"]
     for r in rows:
-        lines.append(f"| {r.stage} | x{r.distance:g} | {r.samples} | {r.successes}/{r.fits} | {r.converged}/{r.fits} "
-                     f"| {r.median_time:.1f} | {r.max_time:.1f} | {r.rss_mb:.0f} | {r.worst} |")
+        lines.append(f"| {r.stage} | {r.seed} | x{r.distance:g} | {r.samples} | {r.successes}/{r.fits} "
+                     f"| {r.converged}/{r.fits} | {r.median_time:.1f} | {r.max_time:.1f} | {r.median_cpu:.1f} "
+                     f"| {r.rss_mb:.0f} | {r.worst} |")
     return "\n".join(lines)
 
 
@@ -424,7 +434,7 @@ def pooled_text(rows: list[SuccessRow], key=lambda r: r.label) -> str:
     and the largest peak memory of the group; in brackets the successes of the given start alone
     (without the second start from the data)."""
     groups: dict = {}
-    for r in rows:
+    for r in sorted(rows, key=key):
         groups.setdefault(key(r), []).append(r)
     groups["all"] = list(rows)
     dists = sorted({r.distance for r in rows})
@@ -448,29 +458,83 @@ def pooled_text(rows: list[SuccessRow], key=lambda r: r.label) -> str:
     return "\n".join(lines)
 
 
+def distance_text(rows: list[SuccessRow], key=lambda r: r.label) -> str:
+    """Success rate per model (``key``) and drawn start distance, one line each: successes / fits,
+    the successes of the given start alone (without the second start from the data), the median
+    and largest wall and CPU time of a fit [s] and the largest peak resident set size [MB] of
+    the processes that ran them; the models in alphabetical order, then an ``all`` line per
+    distance."""
+    groups: dict = {}
+    for r in sorted(rows, key=lambda r: (key(r), r.distance)):
+        groups.setdefault((key(r), r.distance), []).append(r)
+    for d in sorted({r.distance for r in rows}):
+        groups[("all", d)] = [r for r in rows if r.distance == d]
+    lines = ["| model | start within | success | given start alone | wall median / max [s] | "
+             "CPU median / max [s] | peak RSS [MB] |", "|---|---:|---:|---:|---:|---:|---:|"]
+    for (name, d), rs in groups.items():
+        ok, n = sum(r.successes for r in rs), sum(r.fits for r in rs)
+        wall = f"{_sec(_median_of(rs, 'median_time'))} / {_sec(max(r.max_time for r in rs))}"
+        cpu = f"{_sec(_median_of(rs, 'median_cpu'))} / {_sec(max(r.max_cpu for r in rs))}"
+        lines.append(f"| {name} | x{d:g} | {_rate(ok, n)} | {sum(r.first for r in rs)} | {wall} | {cpu} | "
+                     f"{max(r.rss_mb for r in rs):.0f} |")
+    return "\n".join(lines)
+
+
+def _sec(x: float) -> str:
+    """Seconds in at most three digits."""
+    return f"{x:.1f}" if x < 10.0 else f"{x:.0f}"
+
+
+def _median_of(rows: list[SuccessRow], name: str) -> float:
+    """Median over the fits of the rows' per-row medians, each weighted by its fit count (exact for
+    rows of one fit)."""
+    return float(np.median(np.repeat([getattr(r, name) for r in rows], [r.fits for r in rows])))
+
+
 def coverage_text(rows: list[SuccessRow], key=lambda r: r.label) -> str:
     """How often the 95 % intervals of the fits of :func:`success_table` hold the truth, per
-    parameter, pooled over the stages with the same ``key``. The fits of one stage share its
-    record (they differ only in the start), so each record counts once: its weight is spread
-    evenly over its fits that returned estimates."""
+    parameter, pooled over the stages with the same ``key``, and over all. The fits of one record
+    (a stage and a seed) share it (they differ only in the start), so each record counts once: its
+    weight is spread evenly over its fits that returned estimates. ``SD`` is the binomial standard
+    deviation of the pooled coverage at a true 95 % over the group's intervals (records times
+    parameters), treated as independent; ``pooled`` is the fraction of those intervals that hold
+    the truth. Groups of several models (``all``, or a ``key`` such as the loop) list each
+    parameter over the records that have it (no list beyond eight names)."""
     records: dict = {}
     for r in rows:
-        rec = records.setdefault(r.stage, {"key": key(r), "held": {}, "returned": 0})
+        rec = records.setdefault((r.stage, r.seed), {"key": key(r), "held": {}, "returned": 0})
         rec["returned"] += r.returned
         for p, h in r.held.items():
             rec["held"][p] = rec["held"].get(p, 0) + h
     groups: dict = {}
-    for rec in records.values():
+    for rec in sorted(records.values(), key=lambda rec: rec["key"]):
         if rec["returned"]:
             groups.setdefault(rec["key"], []).append(rec)
-    lines = ["| model | records | fits with estimates | coverage per parameter (records weighted equally) | pooled |",
-             "|---|---:|---:|---|---:|"]
+    lines = ["| model | records | fits with estimates | coverage per parameter (records weighted equally) | pooled "
+             "| intervals | SD at 95 % |", "|---|---:|---:|---|---:|---:|---:|"]
+    if len(groups) > 1:
+        groups["all"] = [rec for rs in groups.values() for rec in rs]
     for name, recs in groups.items():
-        per = {p: float(np.mean([rec["held"][p] / rec["returned"] for rec in recs])) for p in recs[0]["held"]}
-        text = ", ".join(f"{p} {v:.0%}" for p, v in per.items())
-        fits = sum(rec["returned"] for rec in recs)
-        lines.append(f"| {name} | {len(recs)} | {fits} | {text} | {float(np.mean(list(per.values()))):.0%} |")
+        names = list(dict.fromkeys(p for rec in recs for p in rec["held"]))
+        per = {p: float(np.mean([rec["held"][p] / rec["returned"] for rec in recs if p in rec["held"]]))
+               for p in names}
+        text = ", ".join(f"{p} {v:.0%}" for p, v in per.items()) if len(names) <= 8 else ""
+        n = sum(len(rec["held"]) for rec in recs)
+        held = sum(h / rec["returned"] for rec in recs for h in rec["held"].values())
+        lines.append(f"| {name} | {len(recs)} | {sum(rec['returned'] for rec in recs)} | {text} | {held / n:.0%} "
+                     f"| {n} | {_sd95(n):.1%} |")
     return "\n".join(lines)
+
+
+def _sd95(n: int) -> float:
+    """Binomial standard deviation of a coverage measured on ``n`` intervals at a true 95 %."""
+    return math.sqrt(0.95 * 0.05 / max(n, 1))
+
+
+KEYS = {"model": lambda r: r.label,
+        "loop": lambda r: "closed loop" if " closed" in r.stage else "open loop",
+        "mass": lambda r: r.stage.split(" kg")[0].rsplit(" ", 1)[-1] + " kg"}
+"""Groupings of the tables (``--by``): the model column, the loop, the stage mass (from the stage name)."""
 
 
 def row_from_dict(d: dict) -> SuccessRow:
@@ -484,9 +548,11 @@ def _rate(ok: int, n: int) -> str:
 
 def main(argv: list[str] | None = None) -> None:
     """``python -m prefriction.identify._success [--grid] [--stages 0,3] [--fits N] [--samples N]
-    [--distances 1.5,2] [--jsonl FILE] [--report FILE]``: fit, print the tables (one progress
-    line per fit on stderr); ``--jsonl`` appends each row as a JSON line, ``--report`` prints
-    the tables of such a file without fitting."""
+    [--distances 1.25,1.5,2] [--seeds 0,1] [--jsonl FILE] [--report FILE] [--by model|loop|mass]``: fit,
+    print the tables
+    (one progress line per fit on stderr); each seed gives every stage a new record and new
+    starts; ``--jsonl`` appends each row as a JSON line, ``--report`` prints the tables of such a
+    file (or files, comma-separated) without fitting."""
     import argparse
     import dataclasses
     import json
@@ -495,31 +561,38 @@ def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(prog="python -m prefriction.identify._success", description=main.__doc__)
     ap.add_argument("--fits", type=int, default=10)
     ap.add_argument("--samples", type=int, default=1000)
-    ap.add_argument("--distances", default="1.5,2")
+    ap.add_argument("--distances", default="1.25,1.5,2")
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--seeds", default="", help="comma-separated seeds (instead of --seed): a record per stage each")
     ap.add_argument("--grid", action="store_true", help="the 24 stages of GRID instead of STAGES")
     ap.add_argument("--stages", default="", help="indices into the stage list (default: all)")
     ap.add_argument("--jsonl", default="", help="append the rows to this file, one JSON line each")
-    ap.add_argument("--report", default="", help="print the tables of a --jsonl file and stop")
+    ap.add_argument("--report", default="", help="print the tables of --jsonl files (comma-separated) and stop")
+    ap.add_argument("--by", default="model", choices=sorted(KEYS), help="group the pooled tables by this")
     args = ap.parse_args(argv)
     if args.report:
-        with open(args.report, encoding="utf-8") as fh:
-            rows = [row_from_dict(json.loads(line)) for line in fh if line.strip()]
+        rows = []
+        for path in args.report.split(","):
+            with open(path, encoding="utf-8") as fh:
+                rows += [row_from_dict(json.loads(line)) for line in fh if line.strip()]
     else:
         stages = GRID if args.grid else STAGES
         if args.stages:
             stages = tuple(stages[int(k)] for k in args.stages.split(","))
+        seeds = [int(k) for k in args.seeds.split(",")] if args.seeds else [args.seed]
         rows = []
-        for stage in stages:
+        for seed, stage in ((s, st) for s in seeds for st in stages):
             new = success_table((stage,), tuple(float(d) for d in args.distances.split(",")), fits=args.fits,
-                                samples=args.samples, seed=args.seed,
+                                samples=args.samples, seed=seed,
                                 progress=lambda line: print(line, file=sys.stderr, flush=True))
             rows += new
             if args.jsonl:
                 with open(args.jsonl, "a", encoding="utf-8") as fh:
                     for r in new:
                         fh.write(json.dumps(dataclasses.asdict(r)) + "\n")
-    print(table_text(rows) + "\n\n" + pooled_text(rows) + "\n\n" + coverage_text(rows))
+    key = KEYS[args.by]
+    print(table_text(rows) + "\n\n" + distance_text(rows, key) + "\n\n" + pooled_text(rows, key) + "\n\n"
+          + coverage_text(rows, key))
 
 
 if __name__ == "__main__":

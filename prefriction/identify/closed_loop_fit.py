@@ -52,6 +52,7 @@ from typing import Any, Sequence
 import casadi as ca
 import numpy as np
 
+from prefriction._blas_threads import one_blas_thread
 from prefriction._validation import check_count, check_positive
 from prefriction.identify.data import Motion
 from prefriction.identify.digital_loop import DigitalLoop
@@ -352,8 +353,9 @@ def fit_closed_loop(model: FrictionModel, data: Motion, loop: DigitalLoop, refer
             _, _, dx, du = channels(th)
             return np.vstack((dx / w[0], du / w[1])) if both else dx / w[0]
 
-        sol = least_squares(res, theta, jac=jac, bounds=(lo, hi), method="trf", x_scale=1.0, xtol=tol, ftol=tol,
-                            gtol=tol, max_nfev=max_iter)
+        with one_blas_thread():
+            sol = least_squares(res, theta, jac=jac, bounds=(lo, hi), method="trf", x_scale=1.0, xtol=tol,
+                                ftol=tol, gtol=tol, max_nfev=max_iter)
         return sol, channels, (res, jac)
 
     def spread(ch: Any, th: np.ndarray) -> list[float]:

@@ -33,6 +33,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.optimize import least_squares
 
+from prefriction._blas_threads import with_one_blas_thread
 from prefriction.identify.kkt import STEPS, polish
 
 __all__ = ["LsqOutcome", "solve"]
@@ -91,6 +92,7 @@ class _Cache:
         return self.value
 
 
+@with_one_blas_thread
 def solve(full: Callable, plain: Callable, w0: np.ndarray, lo: np.ndarray, hi: np.ndarray, *, max_iter: int,
           tol: float, gtol: float = 1e-9, weight: float = _MU0,
           restart: Callable[[np.ndarray], np.ndarray] | None = None,
@@ -203,6 +205,10 @@ def solve(full: Callable, plain: Callable, w0: np.ndarray, lo: np.ndarray, hi: n
                 return LsqOutcome(done.w, True, cache.jacobians, f"converged after {outer} multiplier updates and "
                                                                  f"{done.message} ({cache.jacobians} Jacobian "
                                                                  f"evaluations)" + "".join(f"; {x}" for x in restarts))
+            if done.steps:   # the steps taken lowered the merit and met the constraints better: go on from there
+                w = done.w
+                r, g = plain(w)
+                gmax = float(np.abs(g).max(initial=0.0))
         lam = lam + mu * g
         if gmax > 0.1 * gmax_prev:
             mu = min(10.0 * mu, 1e12)

@@ -14,6 +14,7 @@ from prefriction.errors import SolverError
 from prefriction.identify.data import ForceDisplacement, ForceVelocity, Motion
 from prefriction.identify.options import check_solver
 from prefriction.identify.parameters import ParameterSpace, name_list
+from prefriction.identify.pinned import unpinned_message as _unpinned_message
 from prefriction.identify.result import FitResult
 from prefriction.identify.validation import model_name
 from prefriction.identify.statistics import (BoundWarning, ConvergenceWarning, IdentifiabilityWarning,
@@ -243,7 +244,7 @@ def _fit_prescribed(model: FrictionModel, data: ForceDisplacement, free: Any, fi
                          extra=sol.extra_covariance)
     nuisance = {"initial force F0 [N]": float(sol.prediction[0])}
     return _finish(space, values, est, stats, -sol.residuals, sol.prediction, data, None, nuisance, sol.message,
-                   sol.success, level=6)
+                   sol.success, level=6, limit=limit)
 
 
 def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bounds: Any, mass0: Any, offset0: Any,
@@ -251,6 +252,7 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
                 offset: bool) -> FitResult:
     from prefriction.identify.motion_start import data_start, start_values
     from prefriction.identify.shooting import fit_motion
+    from prefriction.identify.structures import gamma_entry
 
     if data.mass is None:
         if mass0 is not None:
@@ -298,8 +300,10 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
                                 reversals=reversals), None
     except SolverError as err:
         sol, error = None, err
+    retried = False
     if sol is None or not sol.success:  # second start from the data alone (motion_start.data_start)
         second = data_start(model, space.free, start)
+        retried = second is not None
         first = str(error) if sol is None else sol.message
         if second is not None:
             try:
@@ -318,23 +322,136 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
                     + ("" if keep else ", the first fit's result kept"),))
                 if keep:
                     sol, space, error = sol2, space2, None
+    gamma = gamma_entry(model)
+    if gamma in space.free and _doubtful(space, sol, limit, gamma):  # continuation in Dahl's gamma
+        cont, line = _gamma_continuation(model, data, space_of(model, start.mass, start.offset), gamma, free, fixed,
+                                         bounds, space_of, substeps, max_iter, tol, reversals, limit)
+        kept = cont is not None and (sol is None or _doubtful(space, sol, limit, gamma)
+                                     or _rss(cont[0]) <= _rss(sol))
+        start = dataclasses.replace(start, steps=start.steps + (
+            line + ("" if cont is None else ": its result kept" if kept else ": the first fit's result kept"),))
+        if kept:
+            sol, space, error = cont[0], cont[1], None
     if sol is None:
         extra = "".join(f"; {x}" for x in (_route_advice(data), *start.steps[len(first_steps):]) if x)
         if extra:
             raise SolverError(f"{error}{extra}") from error
         raise error
+    values, est, stats = _motion_statistics(space, sol, limit)
+    if sol.success and not retried and (found := _unpinned(space, values, est, stats, limit)):
+        second = data_start(model, space.free, start)  # an estimate the bound holds, not the data: retry
+        why = "; ".join(w for _, w in found)
+        if second is None:
+            start = dataclasses.replace(start, steps=start.steps + (
+                f"the fit from these start values ended with {why}; no second start from the data (no static "
+                f"estimates, or they change nothing)",))
+        else:
+            try:
+                space2 = space_of(second[0], second[1], second[2])
+                sol2 = fit_motion(second[0], data, space2, n_sub=substeps, max_iter=max_iter, tol=tol,
+                                  reversals=reversals)
+            except (SolverError, ValueError) as err2:
+                sol2, said = None, f"failed ({str(err2)[:200]})"
+            else:
+                said = "converged" if sol2.success else "did not converge"
+            if sol2 is not None and sol2.success:
+                v2, e2, s2 = _motion_statistics(space2, sol2, limit)
+                if not _unpinned(space2, v2, e2, s2, limit):
+                    sol, space, values, est, stats = sol2, space2, v2, e2, s2
+                    said += ", its result kept"
+                else:
+                    said += " on a bound the data do not pin down either, the first fit's result kept"
+            elif sol2 is not None:
+                said += ", the first fit's result kept"
+            start = dataclasses.replace(start, steps=start.steps + (
+                f"the fit from these start values ended with {why}; second start from {second[3]}: {said}",))
     message = sol.message
     if not sol.success:
         advice = _route_advice(data)
         message = f"{message}; {advice}" if advice else message
+    mass = values["mass"] if data.mass is None else data.mass
+    return _finish(space, values, est, stats, -sol.residuals, sol.prediction, data, mass, sol.nuisance, message,
+                   sol.success, start=start.steps + sol.steps, limit=limit)
+
+
+def _rss(sol: Any) -> float:
+    return float(np.sum(np.square(sol.residuals)))
+
+
+def _doubtful(space: ParameterSpace, sol: Any, limit: float, gamma: str) -> bool:
+    """A Motion solution that failed, ends on a bound the data do not pin down, or leaves Dahl's
+    ``gamma`` unidentifiable (a flat valley, often a local minimum of the start's side)."""
+    if sol is None or not sol.success:
+        return True
+    values, est, stats = _motion_statistics(space, sol, limit)
+    return bool(_unpinned(space, values, est, stats, limit)) or gamma in {n for n, _ in stats.unidentifiable}
+
+
+def _gamma_continuation(model: FrictionModel, data: Motion, space: ParameterSpace, gamma: str, free: Any, fixed: Any,
+                        bounds: Any, space_of: Any, substeps: Any, max_iter: int, tol: float, reversals: Any,
+                        limit: float) -> tuple[tuple[Any, ParameterSpace] | None, str]:
+    """Fit with Dahl's ``gamma`` held at its start value, then with it free from those estimates.
+
+    With ``gamma`` held the branch shape is fixed and the stiffness, Coulomb force, viscous
+    coefficient, mass and offset settle where the data put them; freed from there, ``gamma``
+    starts in the valley of the truth instead of running to a bound (measured on the noisy
+    300-sample Dahl ``gamma = 0.6`` records of ``tests/test_identify_pinned.py``: the fits that
+    ended at ``gamma = 0`` or at an unidentifiable ``gamma`` land within 4 % of every parameter).
+
+    Returns
+    -------
+    ((MotionSolution, ParameterSpace) or None, str)
+        The second stage's solution (``None`` if either stage failed or it is doubtful itself,
+        :func:`_doubtful`) and a line for :attr:`FitResult.start`.
+    """
+    from prefriction.identify.shooting import fit_motion
+
+    mass_start = space.start.get("mass")
+    offset_start = space.start.get("offset", 0.0)
+    held_free = None if free is None else [n for n in free if n != gamma]
+    held_fixed = list(fixed or []) + ([gamma] if free is None else [])
+    what = f"continuation in {gamma}: fitted with {gamma} held at its start {space.start[gamma]:.4g}, then freed"
+    try:
+        sp1 = ParameterSpace(model, held_free, held_fixed, bounds, mass=mass_start if data.mass is None else None,
+                             offset=max(abs(float(model.Fc)), abs(offset_start)) if "offset" in space.start else None,
+                             offset0=offset_start)
+        sol1 = fit_motion(model, data, sp1, n_sub=substeps, max_iter=max_iter, tol=tol, reversals=reversals)
+        if not sol1.success:
+            return None, f"{what}: the first stage did not converge ({sol1.message[:160]})"
+        vals = sp1.values(sol1.w[: sp1.n_free])
+        model2 = sp1.build(vals)
+        sp2 = space_of(model2, vals.get("mass", mass_start), vals.get("offset", offset_start))
+        sol2 = fit_motion(model2, data, sp2, n_sub=substeps, max_iter=max_iter, tol=tol, reversals=reversals)
+    except (SolverError, ValueError) as err:
+        return None, f"{what}: failed ({str(err)[:200]})"
+    if _doubtful(sp2, sol2, limit, gamma):
+        return None, f"{what}: {'did not converge' if not sol2.success else 'no better'} ({_short(sp2, sol2)})"
+    return (sol2, sp2), f"{what}: converged ({_short(sp2, sol2)})"
+
+
+def _short(space: ParameterSpace, sol: Any) -> str:
+    vals = space.values(sol.w[: space.n_free])
+    return ", ".join(f"{n} {vals[n]:.4g}" for n in space.free)
+
+
+def _motion_statistics(space: ParameterSpace, sol: Any, limit: float) -> tuple[dict, np.ndarray, Any]:
+    """Values by name, the free estimates and their statistics of a Motion solution."""
     values = space.values(sol.w[: space.n_free])
     est = np.array([values[n] for n in space.free])
     J, scale = space.physical_jacobian(sol.jacobian)
-    stats = gauss_newton(J, sol.residuals, space.free, est, scale, constraints=sol.constraints, limit=limit,
-                         covariance="hac")
-    mass = values["mass"] if data.mass is None else data.mass
-    return _finish(space, values, est, stats, -sol.residuals, sol.prediction, data, mass, sol.nuisance, message,
-                   sol.success, start=start.steps + sol.steps)
+    return values, est, gauss_newton(J, sol.residuals, space.free, est, scale, constraints=sol.constraints,
+                                     limit=limit, covariance="hac")
+
+
+def _unpinned(space: ParameterSpace, values: dict, est: np.ndarray, stats: Any,
+              limit: float) -> tuple[tuple[str, str], ...]:
+    """The estimates on a bound the data do not pin down (:func:`prefriction.identify.pinned.unpinned`)."""
+    from prefriction.identify.pinned import unpinned
+
+    lower, upper = space.limits(values)
+    start = np.array([abs(space.start[n]) for n in space.free])
+    return unpinned(space.free, est, stats.stderr, stats.low, stats.high, start, lower, upper, space.why_low,
+                    space.why_high, limit)
 
 
 def _start_error(error: Any, model: FrictionModel, data: Motion, space: ParameterSpace) -> float:
@@ -359,8 +476,13 @@ def _route_advice(data: Motion) -> str:
 
 def _finish(space: ParameterSpace, values: dict, est: np.ndarray, stats: Any, residuals: np.ndarray,
             fitted: np.ndarray, data: Any, mass: float | None, nuisance: dict, message: str,
-            success: bool = True, level: int = 4, start: tuple[str, ...] = ()) -> FitResult:
+            success: bool = True, level: int = 4, start: tuple[str, ...] = (), limit: float = 0.5) -> FitResult:
     fitted_model = space.build(values)
+    found = _unpinned(space, values, est, stats, limit) if success else ()
+    if found:  # on a bound the data do not pin down: not a success (docs/identify.md#bounds)
+        tried = "" if not any("second start from" in line for line in start) else \
+            " (a second start from the data was tried, see FitResult.start)"
+        message, success = f"{_unpinned_message(found, tried)}; solver: {message}", False
     for name, why in stats.unidentifiable:
         warnings.warn(f"the data cannot identify {name}: {why}; its interval is meaningless. Fix it (fixed=[{name!r}]) "
                       f"or record data that excite it (docs/identify.md#identifiability)",
@@ -374,7 +496,10 @@ def _finish(space: ParameterSpace, values: dict, est: np.ndarray, stats: Any, re
             todo = "fit the other structure (structures='both')" if "structure" in flag else "widen the bound"
             warnings.warn(f"{name} = {value:.6g} ends {flag}: the data may want a value beyond it; {todo} "
                           f"(docs/identify.md#bounds)", BoundWarning, stacklevel=level)
-    if not success:
+    if found:
+        warnings.warn(f"the fit of {model_name(fitted_model)} is not a success: {message}", ConvergenceWarning,
+                      stacklevel=level)
+    elif not success:
         warnings.warn(f"the fit of {model_name(fitted_model)} did not converge: {message}; the estimates are where "
                       f"the solver stopped (raise max_iter, or give better start values)", ConvergenceWarning,
                       stacklevel=level)

@@ -33,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from prefriction._blas_threads import one_blas_thread
 from prefriction.identify.data import ForceDisplacement, Motion
 from prefriction.identify.hac import sandwich
 from prefriction.identify.options import check_solver
@@ -247,8 +248,9 @@ def fit_inverse(model: FrictionModel | StaticFriction, data: Motion, *, offset: 
     else:
         def res(th: np.ndarray) -> np.ndarray:
             return problem.force(th) - y
-        sol = least_squares(res, problem.theta0, jac=problem.jacobian, bounds=(lo, hi), method="trf", x_scale=1.0,
-                            xtol=tol, ftol=tol, gtol=tol, max_nfev=max_iter)
+        with one_blas_thread():
+            sol = least_squares(res, problem.theta0, jac=problem.jacobian, bounds=(lo, hi), method="trf", x_scale=1.0,
+                                xtol=tol, ftol=tol, gtol=tol, max_nfev=max_iter)
         theta, message, success = sol.x, f"least_squares: {sol.message}", bool(sol.status > 0)
     r = problem.force(theta) - y
     J = problem.jacobian(theta)

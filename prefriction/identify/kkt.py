@@ -36,6 +36,7 @@ fraction of their standard errors, which is how convergence is judged (see :func
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Callable
 
@@ -73,7 +74,8 @@ class PolishOutcome:
 
 
 def kkt_step(J: sp.spmatrix, A: sp.spmatrix, r: np.ndarray, g: np.ndarray, damping: float = 0.0,
-             free: np.ndarray | None = None, border: int = 0) -> tuple[np.ndarray, np.ndarray]:
+             free: np.ndarray | None = None, border: int = 0,
+             info: dict | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Gauss-Newton step ``d`` of (1) and the multipliers ``lam`` from a direct solve of (2).
 
     With ``border > 0`` the leading ``border`` entries of ``w`` (the parameters, touched by every
@@ -101,6 +103,11 @@ def kkt_step(J: sp.spmatrix, A: sp.spmatrix, r: np.ndarray, g: np.ndarray, dampi
         Entries that may move; the others keep ``d = 0`` (bounds that hold).
     border : int, default 0
         Number of leading entries of ``w`` that couple all rows (the model parameters).
+    info : dict, optional
+        Filled with ``"border_variance"``: the diagonal of the border's block of the inverse of
+        (2) (the free border entries, in order), which is the diagonal of the inverse reduced
+        Gauss-Newton Hessian ``(N^T J^T J N)^-1`` of those entries on the constraints' null space
+        (times ``s^2``: their variances); only when the banded solve is used.
 
     Returns
     -------
@@ -128,7 +135,12 @@ def kkt_step(J: sp.spmatrix, A: sp.spmatrix, r: np.ndarray, g: np.ndarray, dampi
     K = sp.bmat(blocks, format="csr")
     rhs = np.concatenate([-r, np.zeros(cols.size), -g])
     nb = int(np.count_nonzero(cols < border))
-    sol = _banded_solve(K, rhs, n + np.arange(nb), Jf[:, nb:], Af[:, nb:]) if nb else None
+    banded = _banded_solve(K, rhs, n + np.arange(nb), Jf[:, nb:], Af[:, nb:]) if nb else None
+    sol = None
+    if banded is not None:
+        sol, variance = banded
+        if info is not None:
+            info["border_variance"] = variance
     if sol is None:
         try:
             sol = splu(K.tocsc(), permc_spec="MMD_AT_PLUS_A").solve(rhs)
@@ -143,9 +155,10 @@ def kkt_step(J: sp.spmatrix, A: sp.spmatrix, r: np.ndarray, g: np.ndarray, dampi
 
 
 def _banded_solve(K: sp.csr_matrix, rhs: np.ndarray, border: np.ndarray, Jn: sp.csc_matrix,
-                  An: sp.csc_matrix) -> np.ndarray | None:
-    """Solve ``K x = rhs`` by the band of the non-border unknowns and the Schur complement of the
-    border; ``None`` when the band is wider than :data:`_BAND` (then a sparse LU is used)."""
+                  An: sp.csc_matrix) -> tuple[np.ndarray, np.ndarray] | None:
+    """Solve ``K x = rhs`` by the band of the non-border unknowns and the Schur complement ``S`` of
+    the border; ``None`` when the band is wider than :data:`_BAND` (then a sparse LU is used).
+    Also returns ``diag(S^-1)``, the border's block of ``K^-1`` (block inversion)."""
     N = K.shape[0]
     n, p = Jn.shape[0], An.shape[0]
     # key of each unknown: the first non-border entry of w it touches; residual rows, then nodes,
@@ -168,11 +181,12 @@ def _banded_solve(K: sp.csr_matrix, rhs: np.ndarray, border: np.ndarray, Jn: sp.
     except np.linalg.LinAlgError as exc:
         raise np.linalg.LinAlgError(f"the Gauss-Newton system of {N} unknowns is singular ({exc})") from exc
     D = K[border][:, border].toarray()
-    y = np.linalg.solve(D - C.T @ X[:, 1:], rhs[border] - C.T @ X[:, 0])
+    S = D - C.T @ X[:, 1:]
+    y = np.linalg.solve(S, rhs[border] - C.T @ X[:, 0])
     x = np.empty(N)
     x[order] = X[:, 0] - X[:, 1:] @ y
     x[border] = y
-    return x
+    return x, np.diag(np.linalg.inv(S)).copy()
 
 
 def _first_column(M: sp.csc_matrix, rows: int) -> np.ndarray:
@@ -196,7 +210,11 @@ def polish(full: Callable, plain: Callable, w: np.ndarray, lower: np.ndarray, up
     ``|J d| / s`` with ``s^2 = |r|^2 / (n - m + p)``, at most :data:`STEP_SE`. On the constraint
     manifold ``|J d|^2 / s^2 = d^T C^{-1} d`` with ``C`` the Gauss-Newton covariance of the
     estimates, so this bounds the remaining change of every estimate by a thousandth of its
-    standard error.
+    standard error. Where the steps of the nuisance entries (the nodes) stay larger because the
+    residuals are only piecewise smooth in them (a stage hovering inside a segment), the test is
+    applied to the parameters alone: every free parameter's step at most :data:`STEP_SE` of its
+    standard error ``s sqrt((S^-1)_ii)``, ``S`` the Schur complement of the parameters in (2),
+    whose inverse is the parameters' block of ``(N^T J^T J N)^-1`` (block inversion).
 
     Parameters
     ----------
@@ -223,8 +241,9 @@ def polish(full: Callable, plain: Callable, w: np.ndarray, lower: np.ndarray, up
         n, m, p = J.shape[0], J.shape[1], A.shape[0]
         free = ~(((w <= lower) & np.isfinite(lower)) | ((w >= upper) & np.isfinite(upper)))
         scale = float(sp.csc_matrix(J).power(2).sum(axis=0).max()) if J.nnz else 1.0
+        info: dict = {}
         try:
-            d, lam = kkt_step(J, A, r, g, _DAMPING * scale, free, border)
+            d, lam = kkt_step(J, A, r, g, _DAMPING * scale, free, border, info)
         except np.linalg.LinAlgError as exc:
             return PolishOutcome(w, False, k - 1, str(exc))
         Jd = J @ d
@@ -232,9 +251,11 @@ def polish(full: Callable, plain: Callable, w: np.ndarray, lower: np.ndarray, up
         s = float(np.sqrt(r @ r / dof)) if r.size else 0.0
         size = float(np.linalg.norm(Jd)) / s if s > 0.0 else float(np.linalg.norm(Jd))
         gmax = float(np.abs(g).max(initial=0.0))
-        if gmax <= gtol and size <= STEP_SE:
-            return PolishOutcome(w, True, k - 1, f"{k - 1} sparse Gauss-Newton steps, |g| = {gmax:.1e}, "
-                                                 f"last step {size:.1e} standard errors")
+        moved = _parameter_step(d, free, border, info, s)
+        if gmax <= gtol and (size <= STEP_SE or moved <= STEP_SE):
+            what = (f"last step {size:.1e} standard errors" if size <= STEP_SE else
+                    f"last step {moved:.1e} standard errors in every parameter ({size:.1e} with the nodes)")
+            return PolishOutcome(w, True, k - 1, f"{k - 1} sparse Gauss-Newton steps, |g| = {gmax:.1e}, {what}")
         nu = max(nu, 2.0 * float(np.abs(lam).max(initial=0.0)))
         merit = 0.5 * float(r @ r) + nu * float(np.abs(g).sum())
         slope = float(r @ Jd) - nu * float(np.abs(g).sum())
@@ -260,13 +281,25 @@ def polish(full: Callable, plain: Callable, w: np.ndarray, lower: np.ndarray, up
                         trial, accepted = corr, True
                         break
             alpha *= 0.5
-        last = f"step {k}: |g| = {gmax:.1e}, step {size:.1e} standard errors, length {alpha:.2g}"
+        last = (f"step {k}: |g| = {gmax:.1e}, step {size:.1e} standard errors ({moved:.1e} in the parameters), "
+                f"length {alpha:.2g}")
         if not accepted:
             return PolishOutcome(w, False, k - 1, f"{last}; no decrease of the merit function along the step")
         w = trial
     r, g = plain(w)
     return PolishOutcome(w, False, steps, f"{last}; {steps} sparse Gauss-Newton steps did not converge "
                                           f"(|g| = {float(np.abs(g).max(initial=0.0)):.1e})")
+
+
+def _parameter_step(d: np.ndarray, free: np.ndarray, border: int, info: dict, s: float) -> float:
+    """Largest change of a free border entry (a model parameter) in the step ``d``, in its
+    standard errors ``s sqrt(diag(S^-1))`` (``info`` of :func:`kkt_step`); ``inf`` without them."""
+    var = info.get("border_variance")
+    cols = np.flatnonzero(free[:border])
+    if var is None or var.size != cols.size or not s > 0.0:
+        return math.inf
+    se = s * np.sqrt(np.clip(var, 1e-300, None))
+    return float(np.max(np.abs(d[cols]) / se, initial=0.0))
 
 
 def _accept(r: np.ndarray, g: np.ndarray, nu: float, merit: float, decrease: float) -> bool:

@@ -20,13 +20,46 @@ from scipy.signal import savgol_filter
 from prefriction.identify.data import Motion
 from prefriction.models.base import FrictionModel
 
-__all__ = ["Start", "StaticStart", "data_start", "derivatives", "start_values", "static_start", "stiffness_from_reversals"]
+__all__ = ["Start", "StaticStart", "data_start", "derivatives", "secant", "start_values", "static_start",
+           "stiffness_from_reversals"]
 
 _RESOLVED = 8
 """Fewest samples in the first third of a reversal transient for a stiffness estimate."""
 _SECANT = 2.0 / (3.0 * np.log(1.5))
 """Secant slope of the first third of a reversal transient in units of the stiffness (exponential
-approach from the opposite sliding level: Dahl with ``gamma = 1``, LuGre at low speed)."""
+approach from the opposite sliding level: Dahl with ``gamma = 1``, LuGre at low speed);
+:func:`secant` for any ``gamma``."""
+
+
+def secant(gamma: float) -> float:
+    """Secant slope of the first third of a Dahl reversal transient in units of ``sigma``.
+
+    On the branch after a reversal the gap ``w = 1 - s F / Fc`` obeys ``dw/dx = -(sigma / Fc)
+    w^gamma`` (Dahl (3.2)), so the travel from ``w = 2`` (the opposite sliding level) to ``w =
+    4/3`` (a third of the change) is ``(Fc / sigma) int_{4/3}^{2} w^-gamma dw = (Fc / sigma)
+    (2^(1 - gamma) - (4/3)^(1 - gamma)) / (1 - gamma)`` (``ln 1.5`` for ``gamma = 1``) while
+    ``F`` changes by ``2 Fc / 3``: the secant slope is ``sigma (2/3) (1 - gamma) / (2^(1 - gamma)
+    - (4/3)^(1 - gamma))``, 1.64 ``sigma`` at ``gamma = 1``, 2.67 ``sigma`` at ``gamma = 2``.
+
+    Parameters
+    ----------
+    gamma : float
+        Dahl's shape exponent, ``gamma >= 0``.
+    """
+    g = 1.0 - float(gamma)
+    if abs(g) < 1e-9:
+        return _SECANT
+    return (2.0 / 3.0) * g / (2.0 ** g - (4.0 / 3.0) ** g)
+
+
+def _shape_gamma(model: FrictionModel) -> float:
+    """The ``gamma`` of the start model's Dahl term (1: no Dahl term, the exponential approach)."""
+    from prefriction.models.dahl import Dahl
+
+    for m in (model, *getattr(model, "models", ())):
+        if isinstance(m, Dahl):
+            return float(m.gamma)
+    return 1.0
 _WINDOW = 21
 """Samples of the Savitzky-Golay window (cubic) of the velocity and acceleration estimates."""
 _V_WINDOW = 11
@@ -197,7 +230,7 @@ def start_values(model: FrictionModel, data: Motion, mass0: float | None, offset
         m_data, off_data = fit.mass, fit.offset
     else:
         m_data, off_data = mass0, offset0 or 0.0
-    k = stiffness_from_reversals(data, m_data, off_data)
+    k = stiffness_from_reversals(data, m_data, off_data, _shape_gamma(model))
     if k is not None:
         checks.append(f"stiffness {model.sigma:.4g} N/m (rough check from {k[1]} reversal transients: {k[0]:.4g} N/m)")
     steps.append("friction parameters as given by the start model" + (": " + ", ".join(checks) if checks else ""))
@@ -264,22 +297,25 @@ def _check(value: float | None, unit: str) -> str:
     return "" if value is None else f"; static least squares says {value:.4g} {unit} (a check only, not used)"
 
 
-def stiffness_from_reversals(data: Motion, mass: float, offset: float) -> tuple[float, int] | None:
+def stiffness_from_reversals(data: Motion, mass: float, offset: float,
+                             gamma: float = 1.0) -> tuple[float, int] | None:
     """Pre-sliding stiffness [N/m] from the transients after the velocity reversals of a forced
     record, and the number of transients used.
 
     After a reversal the friction force ``F = u - m a - F_off`` (``a`` from the smoothed
     positions) moves from one sliding level to the other; its secant slope against the position
-    over the first third of that change, divided by :data:`_SECANT`, is the pre-sliding
-    stiffness: from the sliding level ``-s Fc`` the gap ``w = 1 - s F / Fc`` of Dahl (3.2) with
-    ``gamma = 1`` (and of LuGre at low speed) decays as ``dw/dx = -sigma w / Fc`` from 2 to
-    ``4/3`` over the first third, a secant slope of ``2 sigma / (3 ln 1.5) = 1.64 sigma``
+    over the first third of that change, divided by :func:`secant` of ``gamma`` (the start
+    model's Dahl exponent; 1 for LuGre), is the pre-sliding stiffness: from the sliding level
+    ``-s Fc`` the gap ``w = 1 - s F / Fc`` of Dahl (3.2) decays as ``dw/dx = -sigma w^gamma /
+    Fc`` from 2 to ``4/3`` over the first third, a secant slope of ``2 sigma / (3 ln 1.5) = 1.64
+    sigma`` for ``gamma = 1`` (and LuGre at low speed), ``8 sigma / 3`` for ``gamma = 2``
     (``dF/dx = sigma`` holds only from ``F = 0``). The median over the reversals is returned; ``None`` for a free
     decay or when no transient spans :data:`_RESOLVED` samples (at 1 kHz a stage's transient
     lasts a few samples and the smoothing spans it: the slope came out 50 times too stiff).
     """
     if data.free_decay:
         return None
+    shape = secant(gamma)
     xs, v, a = derivatives(data.t, data.x)
     F = data.u - mass * a - offset
     moving = np.abs(v) > 0.05 * float(np.max(np.abs(v)))
@@ -297,7 +333,7 @@ def stiffness_from_reversals(data: Motion, mass: float, offset: float) -> tuple[
         near = np.abs(Fs - Fs[0]) <= span / 3.0
         if np.count_nonzero(near) < _RESOLVED or np.ptp(xseg[near]) <= 0.0:
             continue
-        slope = np.polyfit(xseg[near], Fs[near], 1)[0] * s / _SECANT
+        slope = np.polyfit(xseg[near], Fs[near], 1)[0] * s / shape
         if slope > 0.0:
             slopes.append(slope)
     if not slopes:

@@ -26,6 +26,7 @@ import numpy as np
 from scipy import sparse
 from scipy.optimize import brentq, least_squares
 
+from prefriction._blas_threads import one_blas_thread
 from prefriction.identify.data import ForceDisplacement
 from prefriction.identify.parameters import ParameterSpace, symbolic_units
 from prefriction.identify.stepping import has_exact_step, interval_function
@@ -214,8 +215,9 @@ def fit_prescribed(model: FrictionModel, data: ForceDisplacement, space: Paramet
         i = int(np.flatnonzero(~np.isfinite(r0))[0])
         raise SolverError(f"the start model's force is not finite at sample {i} (t = {data.t[i]!r} s, "
                           f"x = {data.x[i]!r} m); give start values closer to the data or more substeps")
-    sol = least_squares(fun, w0, jac=jac, bounds=(lo, hi), method="trf", x_scale="jac",
-                        xtol=tol, ftol=tol, gtol=tol, max_nfev=max_iter)
+    with one_blas_thread():
+        sol = least_squares(fun, w0, jac=jac, bounds=(lo, hi), method="trf", x_scale="jac",
+                            xtol=tol, ftol=tol, gtol=tol, max_nfev=max_iter)
     if sol.status < 0 or not np.all(np.isfinite(sol.fun)):
         vals = space.values(sol.x[:-1])
         raise SolverError(f"the least-squares fit failed ({sol.message}) after {sol.nfev} evaluations, "

@@ -10,7 +10,8 @@ while the positions hardly depend on the friction (the EMPS benchmark's descript
 replayed open loop with the recorded force held over each sample (each interval in closed form,
 sticking when the force stays inside the Coulomb band), and the *horizon* is the number of samples before the
 replay leaves the measured positions by more than the tolerance ``10 s_x + 1e-3 ptp(x)``
-(``s_x`` the position noise). A horizon shorter than an eighth of the record marks a record
+(``s_x`` the position noise). A horizon shorter than an eighth of the record, or a closed-form
+mass that is not positive (horizon 0: no positive mass replays the record), marks a record
 whose force does not carry its motion: fit the force balance
 (:func:`prefriction.identify.inverse.fit_inverse`), or the loop
 (:func:`prefriction.identify.closed_loop_fit.fit_closed_loop`) when the controller is known.
@@ -136,19 +137,23 @@ def recommend(data: Motion, *, controller_known: bool = False) -> Recommendation
     except ValueError as exc:
         return Recommendation("motion", f"the inverse model's filters do not apply ({exc})", n, n, 0.0)
     est = static_inverse(data, d)
-    if not est["mass"] > 0.0:
-        return Recommendation("motion", f"the closed-form inverse model gives a mass of {est['mass']:.4g} kg: "
-                              f"the force does not accelerate the mass as measured", n, n, 0.0)
     tol = 10.0 * d.noise + 1e-3 * float(np.ptp(data.x))
+    route = "closed-loop" if controller_known else "inverse"
+    call = ("identify.fit_closed_loop(model, data, loop, reference)" if controller_known
+            else "identify.fit_inverse(model, data) (or identify.fit_closed_loop(model, data, loop, reference) "
+                 "with the record's controller)")
+    if not (np.isfinite(est["mass"]) and est["mass"] > 0.0):
+        return Recommendation(route, f"the closed-form inverse model of the record gives a mass of {est['mass']:.4g} "
+                              f"kg (not physical): the recorded force does not accelerate the mass as measured, as "
+                              f"under a stiff loop that holds the stage on its reference (a closed-loop record), "
+                              f"and an open-loop Motion fit would integrate that force through the mass and drift. "
+                              f"Fit the force balance or the loop instead: {call}", 0, n, tol)
     x = _replay(data.t, data.u, float(data.x[0]), est)
     out = np.flatnonzero(np.abs(x - data.x) > tol)
     horizon = int(out[0]) if out.size else n
     if horizon >= n // 8:
         return Recommendation("motion", f"the open-loop replay of the inverse model stays within {tol:.3g} m for "
                               f"{horizon} of {n} samples: the open-loop Motion fit", horizon, n, tol)
-    route = "closed-loop" if controller_known else "inverse"
-    call = ("identify.fit_closed_loop(model, data, loop, reference)" if controller_known
-            else "identify.fit_inverse(model, data)")
     return Recommendation(route, f"an open-loop replay of the record's inverse model (mass {est['mass']:.4g} kg) "
                           f"leaves the measured positions by more than {tol:.3g} m after {horizon} of {n} samples: "
                           f"the recorded force does not carry the motion (a closed-loop record), and integrating "

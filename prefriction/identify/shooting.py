@@ -30,6 +30,7 @@ import casadi as ca
 import numpy as np
 import scipy.sparse as sp
 
+from prefriction._blas_threads import with_one_blas_thread
 from prefriction.errors import SolverError
 from prefriction.identify.constrained_lsq import solve
 from prefriction.identify.data import Motion
@@ -96,10 +97,16 @@ class _Layout:
     s: np.ndarray
     scl: np.ndarray
     n: int
+    free: np.ndarray
 
     @property
     def J(self) -> int:
         return int(self.nodes.size)
+
+    @property
+    def starts(self) -> np.ndarray:
+        """Nodes that start a piece of the chain (the first node and every node after a hovering segment)."""
+        return np.flatnonzero(self.free)
 
     def samples(self) -> np.ndarray:
         """Index of the data sample of every output column (``-1``: the end of a segment or padding)."""
@@ -110,7 +117,9 @@ class _Layout:
         return idx.ravel()
 
 
-def _layout(data: Motion, K: int, directions: np.ndarray, scl: np.ndarray) -> _Layout:
+def _layout(data: Motion, K: int, directions: np.ndarray, scl: np.ndarray, speed: np.ndarray | None = None) -> _Layout:
+    """Segments of ``K`` samples; with the smoothed speed of the data, the nodes after hovering
+    segments (:func:`_hover_nodes`) start pieces of the chain."""
     n = len(data)
     J = max(1, math.ceil((n - 1) / K))
     nodes = np.arange(J) * K
@@ -122,7 +131,56 @@ def _layout(data: Motion, K: int, directions: np.ndarray, scl: np.ndarray) -> _L
     u1 = u0.copy() if data.hold == "zoh" else np.zeros(total)
     if data.hold == "linear":
         u1[: n - 1] = data.u[1:]
-    return _Layout(K, nodes, u0, u1, dt, directions[nodes], scl, n)
+    free = _hover_nodes(speed, nodes, K) if speed is not None else np.zeros(J, dtype=bool)
+    free[0] = True
+    return _Layout(K, nodes, u0, u1, dt, directions[nodes], scl, n, free)
+
+
+HOVER = 0.02
+"""Fraction of the record's top speed below which the smoothed speed of the data counts as slow."""
+HOVER_RUN = 10
+"""A segment *hovers* when it holds at least this many consecutive slow samples (:data:`HOVER`):
+a stage held about its set point, or settling into or breaking away from a rest. A reversal
+inside a move is slow for a few samples only (measured on the 2.5 kg stage at 10,000 samples:
+2 to 7)."""
+HOVER_SEGMENTS = 3
+"""Fewest consecutive hovering segments of a *long* hover, after whose segments the chain is cut
+(:func:`_hover_nodes`); a short rest stays chained (it converges, and the chain through it
+carries information: on the 1,000-sample EMPS-like record of the first example, cutting after
+every hovering segment widened the intervals 2.5 times)."""
+
+
+def _hover_nodes(speed: np.ndarray, nodes: np.ndarray, K: int) -> np.ndarray:
+    """Nodes after the segments of a long hover (:data:`HOVER_RUN`, :data:`HOVER_SEGMENTS`).
+
+    A stage held about its set point near the friction limit reverses a dozen times per segment
+    under the noise its loop feeds back (the bristle of LuGre at ``z ~ 0.95``: the state's rate
+    is ``v (1 - z)`` one way and ``v (1 + z)`` the other), so a segment's end state is a
+    piecewise-smooth function of its start with kinks on the scale of ``1e-3`` of the node
+    scales, and continuity defects or Gauss-Newton steps of that size cannot be resolved. In a
+    long hover the node after each of its segments carries no continuity constraint: it starts a new piece of the
+    chain with its own free state (a nuisance variable of the statistics). No constraint then
+    passes through a hovering segment: its kinks reach only its own residuals, where the
+    positions change by a fraction of an encoder step, and each move is chained from its start."""
+    top = float(np.max(speed, initial=0.0))
+    if not top > 0.0:
+        return np.zeros(nodes.size, dtype=bool)
+    slow = np.r_[0, (speed <= HOVER * top).astype(int), 0]
+    edges = np.flatnonzero(np.diff(slow))                       # starts and ends of the slow runs
+    starts, ends = edges[::2], edges[1::2]
+    hover = np.zeros(nodes.size, dtype=bool)
+    for a, b in zip(starts, ends):                              # samples a..b-1 are slow
+        first, last = np.searchsorted(nodes, a, side="right") - 1, np.searchsorted(nodes, b - 1, side="right") - 1
+        for j in range(max(first, 0), last + 1):
+            lo, hi = max(a, nodes[j]), min(b, nodes[j] + K + 1)
+            hover[j] |= hi - lo >= HOVER_RUN
+    free = np.zeros(nodes.size, dtype=bool)
+    run = np.r_[0, hover.astype(int), 0]
+    edges = np.flatnonzero(np.diff(run))
+    for a, b in zip(edges[::2], edges[1::2]):                  # segments a..b-1 hover
+        if b - a >= HOVER_SEGMENTS:
+            free[a + 1:min(b + 1, nodes.size)] = True
+    return free
 
 
 def native_steps(model: FrictionModel, n: int) -> bool:
@@ -158,7 +216,8 @@ class _Problem:
         self.samples = lay.samples()
         self.rows = np.flatnonzero(self.samples >= 0)
         self.x = data.x[self.samples[self.rows]]
-        self.gw = np.ones((lay.J - 1) * self.ny)
+        self.keep = np.repeat(~lay.free[1:], self.ny)   # continuity rows (none into a piece's start)
+        self.gw = np.ones(int(self.keep.sum()))
         s = lay.s
         self.args = dict(s0=s, s_to=np.r_[s[1:], s[-1]], scale=space.scale, fixed=self.fixed, mass=mass,
                          U0=lay.U0[None, :], U1=lay.U1[None, :], DT=lay.DT[None, :], scl=lay.scl,
@@ -184,9 +243,9 @@ class _Problem:
                          scale=a["scale"], fixed=a["fixed"], mass=a["mass"], U0=a["U0"][:, cols],
                          U1=a["U1"][:, cols], DT=a["DT"][:, cols], scl=a["scl"])
             ye = np.asarray(out["Ye"]).ravel()
-            if np.all(np.isfinite(ye)):
+            if np.all(np.isfinite(ye)) and not self.lay.free[j + 1]:
                 nodes[:, j + 1] = ye if everything else np.r_[nodes[:2, j + 1], np.clip(ye[2:], -STATE_CAP, STATE_CAP)]
-            if everything and a["m0"].size:
+            if everything and a["m0"].size and not self.lay.free[j + 1]:   # a piece's start: its own state
                 a["m0"][:, j + 1] = np.asarray(out["Me"]).ravel()
         w[self.nth:] = nodes.T.ravel()
         return w
@@ -202,7 +261,7 @@ class _Problem:
         _th, nodes = self.split(w)
         wt = 1.0 / np.maximum(1.0, np.abs(nodes[:, 1:]))
         wt[:2] = 1.0
-        self.gw = wt.T.ravel()
+        self.gw = wt.T.ravel()[self.keep]
 
     def split(self, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return w[: self.nth], w[self.nth:].reshape(self.lay.J, self.ny).T
@@ -216,7 +275,7 @@ class _Problem:
         out = self._call(self.plain, w)
         X = out["X"][0, self.rows]
         _th, nodes = self.split(w)
-        g = (out["Ye"][:, :-1] - nodes[:, 1:]).T.ravel() * self.gw
+        g = (out["Ye"][:, :-1] - nodes[:, 1:]).T.ravel()[self.keep] * self.gw
         return (X - self.x) / self.xs, g, out
 
     def plain_eval(self, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -236,7 +295,7 @@ class _Problem:
         nw = nth + ny * lay.J
         Jr = sp.csr_matrix((dX.ravel(), (np.repeat(np.arange(seg.size), ncol), colmap.ravel())),
                            shape=(seg.size, nw))
-        g = (out["Ye"][:, :-1] - nodes[:, 1:]).T.ravel()
+        g = (out["Ye"][:, :-1] - nodes[:, 1:]).T.ravel()[self.keep]
         dYe = out["dYe"].reshape(ny, lay.J, ncol)[:, :-1, :].transpose(1, 0, 2)   # (J-1, ny, ncol)
         rows_g = np.arange((lay.J - 1) * ny)
         jj = rows_g // ny
@@ -246,20 +305,34 @@ class _Problem:
                           shape=(rows_g.size, nw))
         A = A - sp.csr_matrix((np.ones(rows_g.size), (rows_g, nth + ny * (jj + 1) + rows_g % ny)),
                               shape=(rows_g.size, nw))
+        A = A.tocsr()[self.keep]
         return (X - self.x) / self.xs, Jr, g * self.gw, (sp.diags(self.gw) @ A).tocsr()
 
+    def columns(self) -> np.ndarray:
+        """Index in ``w`` of every column of :meth:`reduced_jacobian`: the parameters, then the
+        state of each piece's first node."""
+        starts = self.lay.starts
+        return np.r_[np.arange(self.nth), (self.nth + self.ny * starts[:, None] + np.arange(self.ny)).ravel()]
+
     def reduced_jacobian(self, w: np.ndarray) -> np.ndarray:
-        """``dr/d(theta, node_0)`` along the constraints (single-shooting Jacobian), dense ``n x ncol``."""
+        """``dr/d(theta, start nodes)`` along the constraints (the single-shooting Jacobian of each
+        piece of the chain), dense ``n x (nth + ny pieces)``."""
         out = self._call(self.sens, w)
         lay, nth, ny = self.lay, self.nth, self.ny
         ncol = nth + ny
+        starts = lay.starts
+        wide = nth + ny * starts.size
         dX = out["dX"].reshape(ncol, lay.J, lay.K + 1)
         dYe = out["dYe"].reshape(ny, lay.J, ncol)
-        M = np.zeros((ny, ncol))
-        M[:, nth:] = np.eye(ny)                                       # d node_0 / d(theta, node_0)
-        full = np.zeros((lay.J * (lay.K + 1), ncol))
+        M = np.zeros((ny, wide))
+        full = np.zeros((lay.J * (lay.K + 1), wide))
+        piece = -1
         for j in range(lay.J):
-            chain = np.zeros((ncol, ncol))
+            if lay.free[j]:                                           # d node_j / d(theta, its own state)
+                piece += 1
+                M = np.zeros((ny, wide))
+                M[:, nth + ny * piece: nth + ny * (piece + 1)] = np.eye(ny)
+            chain = np.zeros((ncol, wide))
             chain[:nth, :nth] = np.eye(nth)
             chain[nth:, :] = M
             full[j * (lay.K + 1):(j + 1) * (lay.K + 1)] = dX[:, j, :].T @ chain
@@ -308,6 +381,7 @@ def _progress(line: str) -> None:
     print(f"motion fit: {line}", file=sys.stderr, flush=True)
 
 
+@with_one_blas_thread
 def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_sub: int | None, max_iter: int,
                tol: float, reversals: Any = None, verbose: bool = False) -> MotionSolution:
     """Multiple-shooting least-squares fit of ``space``'s free parameters to ``data``.
@@ -334,7 +408,7 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
         part = slice(k0, k0 + WINDOW)
         head = Motion(data.t[part], data.x[part], data.u[part], data.mass, data.hold)
         given = None if reversals is None else [r for r in reversals if head.t[0] < r < head.t[-1]]
-        first = _solve_record(model, head, space, theta0, n_sub, max_iter, tol, given, progress, 0.01)
+        first = _solve(model, head, space, theta0, n_sub, max_iter, tol, given, progress, 0.01, steps)
         if first.success:
             theta0 = first.w[: space.n_free]
             vals = space.values(theta0)
@@ -344,9 +418,33 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
         else:
             steps.append(f"continuation: the fit of samples {k0} to {k0 + WINDOW - 1} did not converge "
                          f"({first.message}); the full record started from the start values")
-    sol = _solve_record(model, data, space, theta0, n_sub, max_iter, tol, reversals, progress,
-                        0.01 if not steps or "did not" in steps[0] else 10.0)
+    sol = _solve(model, data, space, theta0, n_sub, max_iter, tol, reversals, progress,
+                 0.01 if not steps or "did not" in steps[-1] else 10.0, steps)
     return dataclasses.replace(sol, steps=tuple(steps))
+
+
+def _solve(model: FrictionModel, data: Motion, space: ParameterSpace, theta0: np.ndarray, n_sub: int | None,
+           max_iter: int, tol: float, reversals: Any, progress: Any, weight: float,
+           steps: list[str]) -> MotionSolution:
+    """:func:`_solve_record` with the chain whole; if that does not converge and the record has
+    long hovers (:func:`_hover_nodes`), again from its estimates with the chain cut there (the
+    continuity through a long hover is piecewise smooth on the scale of the defects; a chain kept
+    whole where it converges keeps the information the rests carry). Notes go to ``steps``."""
+    sol = _solve_record(model, data, space, theta0, n_sub, max_iter, tol, reversals, progress, weight, False)
+    if sol.success:
+        return sol
+    _x, v, _a = derivatives(data.t, data.x, _NODE_WINDOW)
+    K = min(SEGMENT, len(data) - 1)
+    cut = int(_hover_nodes(np.abs(v), np.arange(max(1, math.ceil((len(data) - 1) / K))) * K, K).sum())
+    theta = sol.w[: space.n_free]
+    if not cut or not np.all(np.isfinite(theta)):
+        return sol
+    again = _solve_record(space.build(space.values(theta)), data, space, theta, n_sub, max_iter, tol, reversals,
+                          progress, 10.0, True)
+    steps.append(f"samples {len(data)}: the whole chain did not converge ({sol.message[-160:]}); the {cut} nodes after "
+                 f"the segments of long hovers then started pieces of the chain, from its estimates: "
+                 + ("converged" if again.success else "did not converge either, the whole chain's result kept"))
+    return again if again.success else sol
 
 
 def start_error(model: FrictionModel, data: Motion, space: ParameterSpace) -> float:
@@ -393,7 +491,7 @@ def _busiest_window(data: Motion) -> int:
 
 def _solve_record(model: FrictionModel, data: Motion, space: ParameterSpace, theta0: np.ndarray,
                   n_sub: int | None, max_iter: int, tol: float, reversals: Any, progress: Any,
-                  weight: float) -> MotionSolution:
+                  weight: float, pieces: bool = False) -> MotionSolution:
     """One multiple-shooting fit of ``data`` from the scaled parameters ``theta0``; ``model``
     (values at ``theta0``) sets the node scales and the sub-steps."""
     mass_free = "mass" in space.start and "mass" in space.free
@@ -406,7 +504,8 @@ def _solve_record(model: FrictionModel, data: Motion, space: ParameterSpace, the
         n_sub = min(64, 2 ** math.ceil(math.log2(n_sub)))
     X, V = model.Fc / model.sigma, model.Fc / math.sqrt(mass * model.sigma)
     offset0 = space.values(theta0).get("offset", 0.0)
-    lay = _layout(data, min(SEGMENT, len(data) - 1), directions, np.array([X, V]))
+    lay = _layout(data, min(SEGMENT, len(data) - 1), directions, np.array([X, V]),
+                  np.abs(v) if pieces else None)
     xs = max(float(np.ptp(data.x)) * 1e-3, 1e-300)
     prob = _Problem(model, space, data, lay, n_sub, mass_free, mass, xs)
     single = segment_functions(model, space, lay.K, n_sub, mass_free, prob.native)[0]
@@ -445,8 +544,14 @@ def _solve_record(model: FrictionModel, data: Motion, space: ParameterSpace, the
     nuisance = _nuisance(model, space, w, prob, data, vel, mass_free, mass)
     return MotionSolution(w, r * xs, Jred * xs, None, pred, nuisance,
                           f"multiple shooting, {lay.J} segments of {lay.K} samples, {n_sub} RK4 sub-steps per "
-                          f"sample, scipy least_squares in an augmented Lagrangian: {out.message}{polished}",
+                          f"sample{_pieces(lay)}, scipy least_squares in an augmented Lagrangian: "
+                          f"{out.message}{polished}",
                           out.success)
+
+
+def _pieces(lay: _Layout) -> str:
+    cut = int(lay.starts.size) - 1
+    return f" ({cut} nodes after hovering segments start pieces of the chain)" if cut else ""
 
 
 POLISH_STEPS = 6
@@ -490,7 +595,8 @@ def _polish(prob: _Problem, w: np.ndarray, single: ca.Function, lo: np.ndarray,
         return w_ms, "; the single-shooting chain is not finite at the solution: not polished"
     with np.errstate(invalid="ignore"):
         margin = 1e-9 * np.maximum(1.0, np.abs(w[:nth]))
-    inside = np.r_[(w[:nth] - lo > margin) & (hi - w[:nth] > margin), np.ones(ny, dtype=bool)]
+    where = prob.columns()
+    inside = np.r_[(w[:nth] - lo > margin) & (hi - w[:nth] > margin), np.ones(where.size - nth, dtype=bool)]
     cols = np.flatnonzero(inside)
     taken, largest = 0, 0.0
     for _ in range(POLISH_STEPS):
@@ -503,7 +609,7 @@ def _polish(prob: _Problem, w: np.ndarray, single: ca.Function, lo: np.ndarray,
             break
         for frac in (1.0, 0.5):
             trial = w.copy()
-            trial[cols] += frac * d
+            trial[where[cols]] += frac * d
             trial[:nth] = np.clip(trial[:nth], lo, hi)
             trial = prob.carry_states(trial, single, everything=True)
             rt, gt = prob.plain_eval(trial)

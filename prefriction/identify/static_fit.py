@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 from scipy.optimize import least_squares
 
+from prefriction._blas_threads import one_blas_thread
 from prefriction.identify.data import ForceVelocity
 from prefriction.identify.result import FitResult
 from prefriction.identify.static_map import StaticFriction
@@ -88,8 +89,9 @@ def fit_static(model: StaticFriction, data: ForceVelocity, *, free: Any, fixed: 
     lo = np.where(np.array([n in ("Fc", "Fs", "vs", "delta", "Fc_neg", "Fs_neg") for n in names]) & (lo <= 0.0),
                   1e-9, lo)
     theta0 = np.array([start[n] for n in names]) / scale
-    sol = least_squares(residuals, theta0, jac=jac, bounds=(lo, hi), method="trf", xtol=tol, ftol=tol, gtol=tol,
-                        max_nfev=max_iter, x_scale="jac")
+    with one_blas_thread():
+        sol = least_squares(residuals, theta0, jac=jac, bounds=(lo, hi), method="trf", xtol=tol, ftol=tol, gtol=tol,
+                            max_nfev=max_iter, x_scale="jac")
     fitted_model, off = unpack(sol.x)
     est = sol.x * scale
     stats = gauss_newton(jac(sol.x), sol.fun, names, est, scale, limit=limit)

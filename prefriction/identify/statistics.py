@@ -39,6 +39,8 @@ import numpy as np
 from scipy.linalg import null_space
 from scipy.stats import t as student_t
 
+from prefriction._blas_threads import with_one_blas_thread
+
 __all__ = ["BoundWarning", "ConvergenceWarning", "IdentifiabilityWarning", "NoisyPositionsWarning", "ResidualWarning",
            "Statistics", "at_bounds", "bandwidth", "gauss_newton", "hac"]
 
@@ -152,6 +154,7 @@ def hac(psi: np.ndarray, L: int) -> np.ndarray:
     return (B @ B.T) / (L + 1.0)
 
 
+@with_one_blas_thread
 def gauss_newton(J: np.ndarray, r: np.ndarray, names: list[str], estimates: np.ndarray, scale: np.ndarray,
                  *, constraints: np.ndarray | None = None, limit: float = 0.5, covariance: str = "iid",
                  extra: Callable[[np.ndarray], np.ndarray] | None = None) -> Statistics:

@@ -37,7 +37,10 @@ class ClosedLoop:
     Attributes
     ----------
     friction : LuGre or Dahl
-        The friction model (Dahl with ``gamma >= 1``).
+        The friction model (Dahl with any ``gamma``; for ``gamma < 1`` the gap ``1 - s F / Fc``
+        reaches 0 at a finite travel and the force stays at ``s Fc`` until the reversal: the rate
+        ``sigma v max(gap, 0)^gamma`` is integrated as it stands, the saturation not located as
+        an event, so the force there is exact to the integrator's tolerance).
     mass : float
         Moving mass [kg].
     b : float
@@ -103,7 +106,7 @@ def _rhs(loop: ClosedLoop):
             F = f.sigma0 * z + f.sigma1 * dz + f.sigma2 * v
             return [v, (u - F - loop.offset) / m, dz]
         return rhs
-    if isinstance(f, Dahl) and f.gamma >= 1.0:
+    if isinstance(f, Dahl):  # gamma < 1: the gap reaches 0 (saturation) and the rate stays 0 there
         b_neg = loop.b if loop.b_neg is None else loop.b_neg
 
         def rhs(_t: float, y: np.ndarray, u: float) -> list[float]:
@@ -112,7 +115,7 @@ def _rhs(loop: ClosedLoop):
             b = loop.b if v > 0.0 else b_neg
             return [v, (u - F - b * v - loop.offset) / m, f.sigma * v * gap ** f.gamma]
         return rhs
-    raise TypeError(f"friction must be a LuGre or a Dahl model with gamma >= 1, got {f!r}")
+    raise TypeError(f"friction must be a LuGre or a Dahl model, got {f!r}")
 
 
 def closed_loop_record(loop: ClosedLoop, n: int, rng: np.random.Generator, *, rtol: float = 1e-10) -> Motion:

@@ -2,7 +2,7 @@
 
 Runs :func:`prefriction.identify.emps.benchmark` on the user's copy of the EMPS files in ``DIR``
 (``DATA_EMPS.mat``, ``DATA_EMPS_PULSES.mat``; no data ship with the toolbox) and prints the
-route-by-route table of ``docs/identify.md#emps``: each route's mass, viscous, Coulomb and offset
+route-by-route table of ``docs/identify.md#closed-loop-records``: each route's mass, viscous, Coulomb and offset
 with 95 % intervals (a check mark where the interval holds the published value), and the
 benchmark's open-loop RMSE on the pulses record against the published rigid-body inverse model
 in the same replay. Verdict PASS if the published inverse model is reproduced to its printed

@@ -10,8 +10,9 @@ memory is its own: an EMPS-like record (:func:`prefriction.identify.synthetic_lo
 encoder steps of 5e-8 m and 1e-7 m of position noise) is generated, then fitted with mass,
 ``sigma0``, ``sigma2``, ``Fc`` and the offset free, from start values 1.5 times, 0.5 times and
 0.5 times the truth (``sigma0``, ``sigma2``, ``Fc``) and a mass of 80 kg. Reported: the fit's wall
-time, the process's peak resident set size (``resource.getrusage``, ``ru_maxrss``: everything,
-CasADi's C++ included) before and after the fit, the peak of Python's traced allocations during
+time and CPU time (``time.process_time``: all the process's threads), the process's peak resident
+set size (``resource.getrusage``, ``ru_maxrss``: everything, CasADi's C++ included) before and
+after the fit, the peak of Python's traced allocations during
 the fit (``tracemalloc``: numpy arrays and Python objects, not CasADi's own memory), and the
 largest ``|estimate - truth| / stderr``. Targets (issue 17): 25,000 samples in at most 300 s and
 2048 MB, growth at most linear in the samples.
@@ -60,17 +61,17 @@ def measure(n: int, seed: int = 1) -> dict:
                      vs=0.01)
     rss0 = _rss_mb()
     tracemalloc.start()
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         res = identify.fit(start, data, fixed=["sigma1", "Fs", "vs"], mass0=80.0, offset=True)
-    elapsed = time.perf_counter() - t0
+    elapsed, cpu = time.perf_counter() - t0, time.process_time() - c0
     traced = tracemalloc.get_traced_memory()[1] / 2**20
     tracemalloc.stop()
     z = max(abs(res.estimate(k) - v) / res.stderr[res.names.index(k)] for k, v in T.items())
     it = re.search(r"(\d+) Jacobian evaluations", res.message)
     seg = re.search(r"(\d+) segments of (\d+) samples, (\d+) RK4", res.message)
-    return {"n": n, "generate_s": gen, "fit_s": elapsed, "rss_before_mb": rss0, "rss_peak_mb": _rss_mb(),
+    return {"n": n, "generate_s": gen, "fit_s": elapsed, "cpu_s": cpu, "rss_before_mb": rss0, "rss_peak_mb": _rss_mb(),
             "traced_mb": traced, "z_max": z, "iterations": int(it.group(1)) if it else -1,
             "segments": int(seg.group(1)) if seg else -1, "substeps": int(seg.group(3)) if seg else -1}
 
@@ -85,13 +86,15 @@ def _fresh(n: int) -> dict:
 
 def format_rows(rows: list[dict]) -> list[str]:
     """The table and the target lines."""
-    head = (f"{'samples':>8} {'segments':>8} {'substeps':>8} {'iter':>5} {'fit [s]':>9} {'ms/sample':>9} "
+    head = (f"{'samples':>8} {'segments':>8} {'substeps':>8} {'iter':>5} {'fit [s]':>9} {'CPU [s]':>8} "
+            f"{'ms/sample':>9} "
             f"{'RSS before [MB]':>15} {'RSS peak [MB]':>13} {'traced [MB]':>11} {'max |z|':>8}")
     lines = ["Motion fit of an EMPS-like closed-loop record (LuGre + offset, mass free), each size in a fresh "
              "process;", "RSS = resource ru_maxrss of the whole process, traced = tracemalloc peak during the fit "
              "(Python and numpy only)", head, "-" * len(head)]
     for r in rows:
         lines.append(f"{r['n']:>8} {r['segments']:>8} {r['substeps']:>8} {r['iterations']:>5} {r['fit_s']:>9.1f} "
+                     f"{r.get('cpu_s', float('nan')):>8.1f} "
                      f"{1e3 * r['fit_s'] / r['n']:>9.2f} {r['rss_before_mb']:>15.0f} {r['rss_peak_mb']:>13.0f} "
                      f"{r['traced_mb']:>11.1f} {r['z_max']:>8.2f}")
     big = rows[-1]

@@ -3,9 +3,11 @@ the cost of force-displacement fits against the record length.
 
 - Success rate: :func:`prefriction.identify._success.success_table` on the 24 stages of
   :data:`prefriction.identify._success.GRID` (every free parameter started log-uniformly within
-  a factor 2 of the truth, a success when every estimate lands within 5 %), one stage per fresh
-  process so that its peak resident set size (``ru_maxrss``) is its own; pooled per model, with
-  the coverage of the fits' 95 % intervals.
+  a factor ``d`` of the truth, ``d`` in :data:`DISTANCES`; a success when every estimate lands
+  within 5 %), one fit per distance on each record, a record per stage and seed
+  (:data:`SEEDS`), each stage and seed in a fresh process so that its peak resident set size
+  (``ru_maxrss``) is its own; per model against the start distance, with the wall and CPU time
+  and the memory, and the coverage of the fits' 95 % intervals per model.
 - Coverage: :func:`prefriction.identify._coverage.coverage_table` (how often the 95 % intervals
   hold the truth on seeded records generated from the equations).
 - Cost: a Maxwell-slip(3) :class:`ForceDisplacement` fit of the tribometer record (12-60 s) at
@@ -36,19 +38,23 @@ def _rss_mb() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0  # kB on Linux
 
 
-def _success_stage(index: int, fits: int, samples: int, distances: tuple[float, ...]) -> list[dict]:
-    """One stage of :data:`prefriction.identify._success.GRID`, in this process; rows with the
-    process's peak RSS."""
+def _success_stage(index: int, fits: int, samples: int, distances: tuple[float, ...], seed: int = 0) -> list[dict]:
+    """One stage of :data:`prefriction.identify._success.GRID` and one seed, in this process; rows
+    with the process's peak RSS."""
     from prefriction.identify import _success
 
     stage = _success.GRID[index]
-    rows = _success.success_table((stage,), distances, fits=fits, samples=samples, seed=0,
+    rows = _success.success_table((stage,), distances, fits=fits, samples=samples, seed=seed,
                                   progress=lambda line: print(line, file=sys.stderr, flush=True))
     return [dataclasses.asdict(r) for r in rows]
 
 
 QUICK_STAGES = (3, 7, 17, 20)
 """Stages of the grid in ``--quick``: one per model (Dahl, LuGre, Dahl+b+offset, LuGre+b+offset)."""
+DISTANCES = (1.25, 1.5, 2.0)
+"""Start distances of the full run: starts log-uniform within ``[1/d, d]`` times the truth."""
+SEEDS = (0, 1)
+"""Seeds of the full run: each gives every stage a new record and new starts."""
 
 
 def success_lines(quick: bool) -> tuple[list[str], bool]:
@@ -57,24 +63,25 @@ def success_lines(quick: bool) -> tuple[list[str], bool]:
     at least 90 % of all fits succeed at the largest distance."""
     from prefriction.identify import _success
 
-    fits, samples = (1, 500) if quick else (4, 1000)
-    distances = (2.0,)
+    fits, samples = 1, (500 if quick else 1000)
+    distances, seeds = ((1.5, 2.0), (0,)) if quick else (DISTANCES, SEEDS)
     stages = QUICK_STAGES if quick else range(len(_success.GRID))
     rows, failed = [], []
-    for i in stages:
+    for seed, i in ((s, i) for s in seeds for i in stages):
         stage = _success.GRID[i]
-        print(f"bench --identify: success rate of {stage.name} ...", file=sys.stderr, flush=True)
+        print(f"bench --identify: success rate of {stage.name}, seed {seed} ...", file=sys.stderr, flush=True)
         out = subprocess.run([sys.executable, "-m", "prefriction.cli.bench.identify_rates", "success", str(i),
-                              str(fits), str(samples), ",".join(map(str, distances))],
+                              str(fits), str(samples), ",".join(map(str, distances)), str(seed)],
                              stdout=subprocess.PIPE, text=True, check=False)  # its progress on our stderr
         if out.returncode != 0:
-            failed.append(f"{stage.name}: exit code {out.returncode}, see the messages above")
+            failed.append(f"{stage.name}, seed {seed}: exit code {out.returncode}, see the messages above")
             continue
         rows += [_success.row_from_dict(r) for r in json.loads(out.stdout.strip().splitlines()[-1])]
     lines = [f"Motion fits from starts log-uniform within a factor d of the truth (every free parameter, mass "
-             f"and offset included), {fits} seeded starts per stage, success = every estimate within 5 %",
-             _success.table_text(rows), "", "Pooled per model (in brackets: successes of the given start alone, "
-             "without the second start from the data)", _success.pooled_text(rows), "",
+             f"and offset included), {fits} seeded start per distance on each of {len(seeds)} records per stage, "
+             f"success = every estimate within 5 %", _success.table_text(rows), "",
+             "Per model and start distance (given start alone: without the second start from the data; wall and "
+             "CPU time of one fit; peak RSS of the stage's process)", _success.distance_text(rows), "",
              "Coverage of the 95 % intervals of these fits", _success.coverage_text(rows)]
     lines += [f"stage FAILED: {f}" for f in failed]
     top = [r for r in rows if r.distance == max(distances)]
@@ -179,6 +186,7 @@ def main_rates(quick: bool) -> bool:
 if __name__ == "__main__":
     if sys.argv[1] == "success":
         dist = tuple(float(d) for d in sys.argv[5].split(","))
-        print(json.dumps(_success_stage(int(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4]), dist)))
+        seed_arg = int(sys.argv[6]) if len(sys.argv) > 6 else 0
+        print(json.dumps(_success_stage(int(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4]), dist, seed_arg)))
     elif sys.argv[1] == "cost":
         print(json.dumps(_cost_one(int(sys.argv[2]))))
