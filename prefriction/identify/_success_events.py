@@ -136,14 +136,18 @@ def event_success(stages: tuple = EVENT_STAGES, *, fits: int = 8, samples: int =
 
 
 def main(argv: list[str] | None = None) -> None:
-    """``python -m prefriction.identify._success_events [--fits N] [--samples N]``: the table."""
+    """``python -m prefriction.identify._success_events [--fits N] [--samples N] [--fix C,Fs]``: the table."""
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--fits", type=int, default=8)
     p.add_argument("--samples", type=int, default=1000)
     p.add_argument("--distance", type=float, default=2.0)
     p.add_argument("--model", choices=[s.name.split("(")[0] for s in EVENT_STAGES], default=None)
+    p.add_argument("--fix", default="", help="comma-separated parameters also held at their true values "
+                                             "(e.g. C,Fs: those a record sliding much faster than vs cannot pin)")
     a = p.parse_args(argv)
-    stages = tuple(s for s in EVENT_STAGES if a.model is None or s.name.startswith(a.model))
+    extra = tuple(x for x in a.fix.split(",") if x)
+    stages = tuple(EventStage(s.name + "".join(f", {x} fixed" for x in extra), s.friction, s.fixed + extra)
+                   for s in EVENT_STAGES if a.model is None or s.name.startswith(a.model))
     print("| model | samples | converged | within 5 % | intervals hold the truth | identified: within 5 % and "
           "held | CPU s (median) |")
     print("|---|---|---|---|---|---|---|")

@@ -85,7 +85,7 @@ def predict_motion(result: Any, data: Motion, *, v0: float | None = None, F0: fl
         F0 = check_finite("F0", F0)
     if substeps is not None and not (isinstance(substeps, int) and 1 <= substeps <= 64):
         raise ValueError(f"substeps must be an integer in [1, 64], got {substeps!r}")
-    n_sub = _substeps(model, data, m, float(np.max(np.abs(v))), substeps)
+    n_sub = _substeps(model, data, m, v, substeps)
     s0 = 1.0 if v0 > 0 else -1.0 if v0 < 0 else (1.0 if data.u[0] - off - F0 >= 0 else -1.0)
     z0, m0 = model.initial_state(F0 / model.Fc, s0)
     sc = Scales(x=model.Fc / model.sigma, F=model.Fc, t=math.sqrt(m / model.sigma),

@@ -38,6 +38,7 @@ from prefriction.identify.motion_start import derivatives
 from prefriction.identify.motion_step import STATE_CAP, segment_functions
 from prefriction.identify.parameters import ParameterSpace
 from prefriction.identify.reversals import locate_reversals
+from prefriction.identify.substep_rule import follows_data, rates_along
 from prefriction.models.base import FrictionModel
 
 __all__ = ["LONG", "SEGMENT", "MotionSolution", "fit_motion", "start_error"]
@@ -341,15 +342,27 @@ class _Problem:
         return full[self.rows] / self.xs
 
 
-def _substeps(model: FrictionModel, data: Motion, mass: float, v_max: float, requested: int | None) -> int:
-    """RK4 sub-steps per sample: a normalised sub-step of at most 0.1 (the stuck mass swings with
-    period ``2 pi``) and of at most ``0.5 / lambda``, ``lambda`` the largest rate of the model's
-    state and force at the largest speed of the data (LuGre's bristle relaxes at ``~ |v~|``,
-    Dahl's log-gap not at all), at the start values; 1 to 64."""
+def _substeps(model: FrictionModel, data: Motion, mass: float, v: np.ndarray, requested: int | None) -> int:
+    """RK4 sub-steps per sample (1 to 64), at the start values: a normalised sub-step of at most
+    ``0.1`` of the period's ``1 / (2 pi)`` and at most ``0.5 / lambda``, ``lambda`` the largest
+    decay rate of the model's state and force.
+
+    A model with a Dahl term of ``gamma > 1`` (:func:`prefriction.identify.substep_rule.follows_data`)
+    takes both from its run along the record's velocity ``v`` [m/s] (the local oscillation
+    ``omega`` and decay per sample, :func:`~prefriction.identify.substep_rule.rates_along`): at most
+    ``0.1 / omega`` and ``0.5 / lambda`` at every sample. Any other model: ``0.1`` (the stuck mass
+    swings with period ``2 pi``) and ``lambda`` the largest rate at the record's top speed over a
+    grid of states (LuGre's bristle relaxes at ``~ |v~|``, Dahl's log-gap at ``gamma <= 1`` not at all)."""
     if requested is not None:
         return requested
     T = math.sqrt(mass / model.sigma)
-    h = float(np.max(np.diff(data.t))) / T
+    dt = np.diff(data.t) / T
+    if follows_data(model):
+        omega, lam = rates_along(model, data.t, v, mass)
+        need = np.maximum(np.maximum(omega[:-1], omega[1:]) / 0.1, np.maximum(lam[:-1], lam[1:]) / 0.5)
+        return int(min(64, max(1, math.ceil(float(np.max(dt * np.maximum(need, 1.0 / 0.1)))))))
+    h = float(np.max(dt))
+    v_max = float(np.max(np.abs(v)))
     lam = _stiffness(model, v_max / (model.Fc / math.sqrt(mass * model.sigma)), mass)
     return int(min(64, max(1, math.ceil(h / min(0.1, 0.5 / max(lam, 1e-300))))))
 
@@ -464,7 +477,7 @@ def start_error(model: FrictionModel, data: Motion, space: ParameterSpace) -> fl
     mass_free = "mass" in space.start and "mass" in space.free
     mass = vals["mass"] if mass_free else float(data.mass)
     xsm, v, a = derivatives(data.t, data.x, _NODE_WINDOW)
-    n_sub = _substeps(model, data, mass, float(np.max(np.abs(v))), None)
+    n_sub = _substeps(model, data, mass, v, None)
     lay = _layout(data, min(SEGMENT, len(data) - 1), _directions(data.t, data.x, v, None),
                   np.array([model.Fc / model.sigma, model.Fc / math.sqrt(mass * model.sigma)]))
     prob = _Problem(model, space, data, lay, n_sub, mass_free, mass, 1.0, native=False)
@@ -506,7 +519,7 @@ def _solve_record(model: FrictionModel, data: Motion, space: ParameterSpace, the
     xsm, v, a = derivatives(data.t, data.x, _NODE_WINDOW)
     directions = _directions(data.t, data.x, v, reversals)
     requested = n_sub
-    n_sub = max(_substeps(model, data, mass, float(np.max(np.abs(v))), n_sub), 1 if requested else least_sub)
+    n_sub = max(_substeps(model, data, mass, v, n_sub), 1 if requested else least_sub)
     if requested is None and native_steps(model, len(data)):  # compiled per count: powers of 2 only
         n_sub = min(64, 2 ** math.ceil(math.log2(n_sub)))
     X, V = model.Fc / model.sigma, model.Fc / math.sqrt(mass * model.sigma)
