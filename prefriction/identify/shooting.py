@@ -618,7 +618,7 @@ def _refine_substeps(prob: _Problem, single: ca.Function, out: Any, w: np.ndarra
         with np.errstate(invalid="ignore"):
             margin = 1e-9 * np.maximum(1.0, np.abs(w[:nth]))
         params = np.flatnonzero((w[:nth] - lo > margin) & (hi - w[:nth] > margin))
-        shift = step_shift(J, r, rf, params)
+        shift = step_shift(J, r, rf, params, w[:nth])
         if shift <= STEP_SHIFT:
             break
         # RK4: the bias falls as n_sub^-4; jump to the power-of-2 multiple that brings it below the limit

@@ -21,15 +21,21 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["STEP_SHIFT", "step_shift"]
+__all__ = ["RELATIVE_FLOOR", "STEP_SHIFT", "step_shift"]
 
 STEP_SHIFT = 0.1
 """Most change of an estimate, in its standard errors, that doubling the Runge-Kutta sub-steps
 may cause before a Motion fit is solved again with twice as many (the bias left is then at most
 ``0.1 * 16 / 15`` standard errors)."""
 
+RELATIVE_FLOOR = 1e-6
+"""Smallest standard error, relative to the estimate, that the check measures shifts against: on a
+record with (nearly) no noise the standard errors shrink with the discretisation error itself, and a
+bias below a part per million of every estimate is not worth more sub-steps."""
 
-def step_shift(J: np.ndarray, r: np.ndarray, r_fine: np.ndarray, params: np.ndarray) -> float:
+
+def step_shift(J: np.ndarray, r: np.ndarray, r_fine: np.ndarray, params: np.ndarray,
+               values: np.ndarray | None = None) -> float:
     """Largest change of a parameter, in its white-residual standard errors, from the residuals
     ``r`` to ``r_fine`` at the same point.
 
@@ -41,12 +47,16 @@ def step_shift(J: np.ndarray, r: np.ndarray, r_fine: np.ndarray, params: np.ndar
         Residuals [any unit, the same as ``J``'s rows] of the coarse and the fine simulation.
     params : numpy.ndarray
         Indices of the columns of ``J`` that are parameters (the others are nuisance: marginalised).
+    values : numpy.ndarray, optional
+        The parameters' values in ``J``'s columns; their standard errors are then taken at least
+        :data:`RELATIVE_FLOOR` times ``|values|``.
 
     Returns
     -------
     float
         ``max_i |d_i| / se_i`` over ``params``, ``d = (J^T J)^+ J^T (r_fine - r)`` and
-        ``se_i = s sqrt((J^T J)^+_ii)``, ``s^2 = |r|^2 / (n - c)``; ``inf`` if a residual is not finite.
+        ``se_i = s sqrt((J^T J)^+_ii)``, ``s^2 = |r|^2 / (n - c)`` (at least ``RELATIVE_FLOOR |values_i|``);
+        ``inf`` if a residual is not finite.
     """
     if not (np.all(np.isfinite(r)) and np.all(np.isfinite(r_fine))) or params.size == 0:
         return float("inf") if params.size else 0.0
@@ -54,4 +64,6 @@ def step_shift(J: np.ndarray, r: np.ndarray, r_fine: np.ndarray, params: np.ndar
     d = H @ (J.T @ (r_fine - r))
     s2 = float(r @ r) / max(r.size - J.shape[1], 1)
     se = np.sqrt(np.clip(np.diag(H)[params] * s2, 1e-300, None))
+    if values is not None:
+        se = np.maximum(se, RELATIVE_FLOOR * np.abs(values[params]))
     return float(np.max(np.abs(d[params]) / se))
