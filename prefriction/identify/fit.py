@@ -306,11 +306,8 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
         retried = second is not None
         first = str(error) if sol is None else sol.message
         if second is not None:
-            try:
-                space2 = space_of(second[0], second[1], second[2])
-                sol2 = fit_motion(second[0], data, space2, n_sub=substeps, max_iter=max_iter, tol=tol,
-                                  reversals=reversals)
-            except (SolverError, ValueError) as err2:
+            sol2, space2, err2 = _fit_from(second, data, space_of, substeps, max_iter, tol, reversals)
+            if sol2 is None:
                 start = dataclasses.replace(start, steps=start.steps + (
                     f"the fit from these start values did not converge ({first[:200]}); a second start from "
                     f"{second[3]} failed too ({str(err2)[:200]})",))
@@ -323,11 +320,10 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
                 if keep:
                     sol, space, error = sol2, space2, None
     gamma = gamma_entry(model)
-    if gamma in space.free and _doubtful(space, sol, limit, gamma):  # continuation in Dahl's gamma
+    if gamma in space.free and (doubtful := _doubtful(space, sol, limit, gamma)):  # continuation in Dahl's gamma
         cont, line = _gamma_continuation(model, data, space_of(model, start.mass, start.offset), gamma, free, fixed,
                                          bounds, space_of, substeps, max_iter, tol, reversals, limit)
-        kept = cont is not None and (sol is None or _doubtful(space, sol, limit, gamma)
-                                     or _rss(cont[0]) <= _rss(sol))
+        kept = cont is not None and (sol is None or doubtful or _rss(cont[0]) <= _rss(sol))
         start = dataclasses.replace(start, steps=start.steps + (
             line + ("" if cont is None else ": its result kept" if kept else ": the first fit's result kept"),))
         if kept:
@@ -346,14 +342,9 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
                 f"the fit from these start values ended with {why}; no second start from the data (no static "
                 f"estimates, or they change nothing)",))
         else:
-            try:
-                space2 = space_of(second[0], second[1], second[2])
-                sol2 = fit_motion(second[0], data, space2, n_sub=substeps, max_iter=max_iter, tol=tol,
-                                  reversals=reversals)
-            except (SolverError, ValueError) as err2:
-                sol2, said = None, f"failed ({str(err2)[:200]})"
-            else:
-                said = "converged" if sol2.success else "did not converge"
+            sol2, space2, err2 = _fit_from(second, data, space_of, substeps, max_iter, tol, reversals)
+            said = (f"failed ({str(err2)[:200]})" if sol2 is None
+                    else "converged" if sol2.success else "did not converge")
             if sol2 is not None and sol2.success:
                 v2, e2, s2 = _motion_statistics(space2, sol2, limit)
                 if not _unpinned(space2, v2, e2, s2, limit):
@@ -372,6 +363,21 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
     mass = values["mass"] if data.mass is None else data.mass
     return _finish(space, values, est, stats, -sol.residuals, sol.prediction, data, mass, sol.nuisance, message,
                    sol.success, start=start.steps + sol.steps, limit=limit)
+
+
+def _fit_from(second: tuple, data: Motion, space_of: Any, substeps: Any, max_iter: int, tol: float,
+              reversals: Any) -> tuple[Any, ParameterSpace | None, Exception | None]:
+    """The Motion fit from a second start ``(model, mass, offset, origin)``
+    (:func:`prefriction.identify.motion_start.data_start`): ``(solution, space, None)``, or
+    ``(None, None, error)`` where building its space or solving raised."""
+    from prefriction.identify.shooting import fit_motion
+
+    try:
+        space2 = space_of(second[0], second[1], second[2])
+        return fit_motion(second[0], data, space2, n_sub=substeps, max_iter=max_iter, tol=tol,
+                          reversals=reversals), space2, None
+    except (SolverError, ValueError) as err:
+        return None, None, err
 
 
 def _rss(sol: Any) -> float:
