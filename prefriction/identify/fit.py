@@ -250,6 +250,7 @@ def _fit_prescribed(model: FrictionModel, data: ForceDisplacement, free: Any, fi
 def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bounds: Any, mass0: Any, offset0: Any,
                 reversals: Any, substeps: int | None, max_iter: int, tol: float, limit: float,
                 offset: bool) -> FitResult:
+    from prefriction.identify.held_first import held_first
     from prefriction.identify.motion_start import data_start, start_values
     from prefriction.identify.shooting import fit_motion
     from prefriction.identify.structures import gamma_entry
@@ -275,6 +276,16 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
                               offset=max(abs(float(m.Fc)), abs(offset_start)) if offset else None,
                               offset0=offset_start)
 
+    def held_of(sp: ParameterSpace) -> ParameterSpace | None:
+        """``sp`` with the parameters a first stage holds (:mod:`prefriction.identify.held_first`) fixed."""
+        names = held_first(sp.model, sp)
+        if not names:
+            return None
+        return ParameterSpace(sp.model, None if free is None else [n for n in free if n not in names],
+                              list(fixed or []) + (list(names) if free is None else []), bounds,
+                              mass=sp.start.get("mass"), offset=sp.scale[sp.free.index("offset")] if offset else None,
+                              offset0=sp.start.get("offset", 0.0))
+
     space = space_of(model, start.mass, start.offset)
     from prefriction.identify.element_start import element_start
 
@@ -297,7 +308,7 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
     first_steps = start.steps
     try:
         sol, error = fit_motion(model, data, space, n_sub=substeps, max_iter=max_iter, tol=tol,
-                                reversals=reversals), None
+                                reversals=reversals, held=held_of(space)), None
     except SolverError as err:
         sol, error = None, err
     retried = False
@@ -306,7 +317,7 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
         retried = second is not None
         first = str(error) if sol is None else sol.message
         if second is not None:
-            sol2, space2, err2 = _fit_from(second, data, space_of, substeps, max_iter, tol, reversals)
+            sol2, space2, err2 = _fit_from(second, data, space_of, substeps, max_iter, tol, reversals, held_of)
             if sol2 is None:
                 start = dataclasses.replace(start, steps=start.steps + (
                     f"the fit from these start values did not converge ({first[:200]}); a second start from "
@@ -342,7 +353,7 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
                 f"the fit from these start values ended with {why}; no second start from the data (no static "
                 f"estimates, or they change nothing)",))
         else:
-            sol2, space2, err2 = _fit_from(second, data, space_of, substeps, max_iter, tol, reversals)
+            sol2, space2, err2 = _fit_from(second, data, space_of, substeps, max_iter, tol, reversals, held_of)
             said = (f"failed ({str(err2)[:200]})" if sol2 is None
                     else "converged" if sol2.success else "did not converge")
             if sol2 is not None and sol2.success:
@@ -356,17 +367,26 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
                 said += ", the first fit's result kept"
             start = dataclasses.replace(start, steps=start.steps + (
                 f"the fit from these start values ended with {why}; second start from {second[3]}: {said}",))
-    message = sol.message
+    message, success = sol.message, sol.success
+    loose = tuple(n for n, _ in stats.unidentifiable)
+    if success and loose:  # a curved valley the solver may have stopped short in (identify/settled.py)
+        from prefriction.identify.settled import unsettled, unsettled_message
+
+        J, scale = space.physical_jacobian(sol.jacobian)
+        short = unsettled(J, sol.residuals, space.free, scale, stats.stderr,
+                          np.array([n not in loose for n in space.free]))
+        if short:
+            message, success = f"{unsettled_message(short, loose)}; solver: {message}", False
     if not sol.success:
         advice = _route_advice(data)
         message = f"{message}; {advice}" if advice else message
     mass = values["mass"] if data.mass is None else data.mass
     return _finish(space, values, est, stats, -sol.residuals, sol.prediction, data, mass, sol.nuisance, message,
-                   sol.success, start=start.steps + sol.steps, limit=limit)
+                   success, start=start.steps + sol.steps, limit=limit)
 
 
 def _fit_from(second: tuple, data: Motion, space_of: Any, substeps: Any, max_iter: int, tol: float,
-              reversals: Any) -> tuple[Any, ParameterSpace | None, Exception | None]:
+              reversals: Any, held_of: Any) -> tuple[Any, ParameterSpace | None, Exception | None]:
     """The Motion fit from a second start ``(model, mass, offset, origin)``
     (:func:`prefriction.identify.motion_start.data_start`): ``(solution, space, None)``, or
     ``(None, None, error)`` where building its space or solving raised."""
@@ -375,7 +395,7 @@ def _fit_from(second: tuple, data: Motion, space_of: Any, substeps: Any, max_ite
     try:
         space2 = space_of(second[0], second[1], second[2])
         return fit_motion(second[0], data, space2, n_sub=substeps, max_iter=max_iter, tol=tol,
-                          reversals=reversals), space2, None
+                          reversals=reversals, held=held_of(space2)), space2, None
     except (SolverError, ValueError) as err:
         return None, None, err
 

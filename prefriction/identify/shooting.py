@@ -397,7 +397,8 @@ def _progress(line: str) -> None:
 
 @with_one_blas_thread
 def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_sub: int | None, max_iter: int,
-               tol: float, reversals: Any = None, verbose: bool = False) -> MotionSolution:
+               tol: float, reversals: Any = None, verbose: bool = False,
+               held: ParameterSpace | None = None) -> MotionSolution:
     """Multiple-shooting least-squares fit of ``space``'s free parameters to ``data``.
 
     Parameters
@@ -405,6 +406,11 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
     verbose : bool, default False
         One line per outer iteration of the solver on stderr (always for records of :data:`LONG`
         samples or more).
+    held : ParameterSpace, optional
+        ``space`` with some free parameters held at their start values
+        (:func:`prefriction.identify.held_first.held_first`): the first stage (the window of a
+        long record, else the whole record) fits this space, and the record is then fitted with
+        every parameter of ``space`` free from its estimates.
 
     Raises
     ------
@@ -417,25 +423,38 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
     steps: list[str] = []
     theta0 = space.theta0
     progress = _progress if verbose or len(data) >= LONG else None
-    if len(data) > 2 * WINDOW:
-        k0 = _busiest_window(data)
-        part = slice(k0, k0 + WINDOW)
-        head = Motion(data.t[part], data.x[part], data.u[part], data.mass, data.hold)
-        given = None if reversals is None else [r for r in reversals if head.t[0] < r < head.t[-1]]
-        first = _solve(model, head, space, theta0, n_sub, max_iter, tol, given, progress, 0.01, steps)
+    first_space = space if held is None else held
+    least = 1
+    if len(data) > 2 * WINDOW or held is not None:
+        long = len(data) > 2 * WINDOW
+        k0 = _busiest_window(data) if long else 0
+        part = slice(k0, k0 + WINDOW) if long else slice(0, len(data))
+        head = Motion(data.t[part], data.x[part], data.u[part], data.mass, data.hold) if long else data
+        given = None if reversals is None or not long else [r for r in reversals if head.t[0] < r < head.t[-1]]
+        what = f"samples {k0} to {k0 + WINDOW - 1}" if long else "the record"
+        if held is not None:
+            what += f" with {', '.join(n for n in space.free if n not in held.free)} held"
+        first = _solve(model, head, first_space, first_space.theta0, n_sub, max_iter, tol, given, progress, 0.01,
+                       steps)
         least = first.n_sub if first.success else 1
         if first.success:
-            theta0 = first.w[: space.n_free]
-            vals = space.values(theta0)
-            model = space.build(vals)  # the sub-steps of the full record from the window's estimates
-            steps.append(f"continuation: samples {k0} to {k0 + WINDOW - 1} fitted first ({first.message}); the "
-                         f"full record started from their estimates ({_at(space, first.w)})")
+            vals = dict(space.start, **first_space.values(first.w[: first_space.n_free]))
+            theta0 = _theta_of(space, vals)
+            model = first_space.build(vals)  # the sub-steps of the full record from the first stage's estimates
+            steps.append(f"continuation: {what} fitted first ({first.message}); the full record started from "
+                         f"their estimates ({_at(first_space, first.w)})")
         else:
-            steps.append(f"continuation: the fit of samples {k0} to {k0 + WINDOW - 1} did not converge "
-                         f"({first.message}); the full record started from the start values")
+            steps.append(f"continuation: the fit of {what} did not converge ({first.message}); the full record "
+                         f"started from the start values")
     sol = _solve(model, data, space, theta0, n_sub, max_iter, tol, reversals, progress,
-                 0.01 if not steps or "did not" in steps[-1] else 10.0, steps, least if len(data) > 2 * WINDOW else 1)
+                 0.01 if not steps or "did not" in steps[-1] else 10.0, steps, least)
     return dataclasses.replace(sol, steps=tuple(steps))
+
+
+def _theta_of(space: ParameterSpace, values: dict[str, float]) -> np.ndarray:
+    """The scaled free entries of ``space`` at the physical ``values`` (:attr:`ParameterSpace.scale`)."""
+    return np.array([(values[n] - values[space.excess[n]]) / sc if n in space.excess else values[n] / sc
+                     for n, sc in zip(space.free, space.scale)])
 
 
 def _solve(model: FrictionModel, data: Motion, space: ParameterSpace, theta0: np.ndarray, n_sub: int | None,
@@ -648,6 +667,9 @@ POLISH_STEPS = 6
 """Most Gauss-Newton steps of :func:`_polish`."""
 POLISH_TOL = 1e-3
 """A Gauss-Newton step below this many standard errors in every parameter ends :func:`_polish`."""
+POLISH_FRACTIONS = (1.0, 0.5, 0.25, 0.125, 0.0625)
+"""Fractions of a Gauss-Newton step :func:`_polish` tries, largest first: in a curved valley (GMS
+``C`` and ``Fs``, :mod:`prefriction.identify.held_first`) the full step leaves the bend."""
 
 
 def _polish(prob: _Problem, w: np.ndarray, single: ca.Function, lo: np.ndarray,
@@ -697,7 +719,7 @@ def _polish(prob: _Problem, w: np.ndarray, single: ca.Function, lo: np.ndarray,
         size = float(np.max(np.abs(d / se)[cols < nth], initial=0.0))
         if size < POLISH_TOL:
             break
-        for frac in (1.0, 0.5):
+        for frac in POLISH_FRACTIONS:
             trial = w.copy()
             trial[where[cols]] += frac * d
             trial[:nth] = np.clip(trial[:nth], lo, hi)
