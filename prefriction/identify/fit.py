@@ -367,16 +367,26 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
                 said += ", the first fit's result kept"
             start = dataclasses.replace(start, steps=start.steps + (
                 f"the fit from these start values ended with {why}; second start from {second[3]}: {said}",))
+    short = _short_of_minimum(space, sol, stats)
+    if short and held_of(space) is not None:  # once more, the held stage from where it stopped
+        model2 = space.build(values)
+        sol2, space2, err2 = _fit_from((model2, values.get("mass"), values.get("offset", 0.0),
+                                        "the estimates where the fit stopped short of its minimum"),
+                                       data, space_of, substeps, max_iter, tol, reversals, held_of)
+        said = f"failed ({str(err2)[:200]})" if sol2 is None else "converged" if sol2.success else "did not converge"
+        if sol2 is not None and sol2.success and _rss(sol2) < _rss(sol):
+            v2, e2, s2 = _motion_statistics(space2, sol2, limit)
+            short2 = _short_of_minimum(space2, sol2, s2)
+            if len(short2) <= len(short):
+                sol, space, values, est, stats, short = sol2, space2, v2, e2, s2, short2
+                said += ", its result kept (a lower sum of squares)"
+        start = dataclasses.replace(start, steps=start.steps + (
+            f"the fit stopped short of its minimum; the continuation again from its estimates: {said}",))
     message, success = sol.message, sol.success
-    loose = tuple(n for n, _ in stats.unidentifiable)
-    if success and loose:  # a curved valley the solver may have stopped short in (identify/settled.py)
-        from prefriction.identify.settled import unsettled, unsettled_message
+    if success and short:
+        from prefriction.identify.settled import unsettled_message
 
-        J, scale = space.physical_jacobian(sol.jacobian)
-        short = unsettled(J, sol.residuals, space.free, scale, stats.stderr,
-                          np.array([n not in loose for n in space.free]))
-        if short:
-            message, success = f"{unsettled_message(short, loose)}; solver: {message}", False
+        message, success = f"{unsettled_message(short, stats.unidentifiable)}; solver: {message}", False
     if not sol.success:
         advice = _route_advice(data)
         message = f"{message}; {advice}" if advice else message
@@ -398,6 +408,18 @@ def _fit_from(second: tuple, data: Motion, space_of: Any, substeps: Any, max_ite
                           reversals=reversals, held=held_of(space2)), space2, None
     except (SolverError, ValueError) as err:
         return None, None, err
+
+
+def _short_of_minimum(space: ParameterSpace, sol: Any, stats: Any) -> tuple[tuple[str, float], ...]:
+    """The pinned estimates of a converged fit with unidentifiable parameters that stopped short of
+    the minimum (:func:`prefriction.identify.settled.unsettled`: a curved valley), else ``()``."""
+    loose = {n for n, _ in stats.unidentifiable}
+    if not sol.success or not loose:
+        return ()
+    from prefriction.identify.settled import unsettled
+
+    J, scale = space.physical_jacobian(sol.jacobian)
+    return unsettled(J, sol.residuals, space.free, scale, stats.stderr, np.array([n not in loose for n in space.free]))
 
 
 def _rss(sol: Any) -> float:

@@ -64,13 +64,14 @@ def unsettled(J: np.ndarray, r: np.ndarray, names: list[str], scale: np.ndarray,
                  if pinned[i] and np.isfinite(size[i]) and size[i] > SETTLED)
 
 
-def unsettled_message(found: tuple[tuple[str, float], ...], loose: tuple[str, ...]) -> str:
-    """The message of a fit that stopped short of its minimum (:func:`unsettled`): where, why and what helps."""
+def unsettled_message(found: tuple[tuple[str, float], ...], loose: tuple[tuple[str, str], ...]) -> str:
+    """The message of a fit that stopped short of its minimum (:func:`unsettled`): where, why and
+    what helps; ``loose`` the unidentifiable parameters and why (``Statistics.unidentifiable``)."""
     steps = ", ".join(f"{n} by {s:.2g}" for n, s in found)
-    why = (f"; the record pins {', '.join(loose)} only in a combination (a flat, curved valley the solver "
-           f"creeps along)") if loose else ""
-    hold = f"hold {'it' if len(loose) == 1 else 'one of them'} at a value you know (fixed={list(loose)[:1]!r}), " \
-        if loose else ""
+    names = [n for n, _ in loose]
+    why = (f"; the record does not pin {', '.join(names)} (" + "; ".join(f"{n}: {w}" for n, w in loose)
+           + "): a flat, curved valley of the sum of squares the solver creeps along") if names else ""
+    hold = ("hold " + " or ".join(f"fixed=[{n!r}]" for n in names) + " at a value you know, ") if names else ""
     return (f"the solver stopped short of the minimum: a Gauss-Newton step at the solution moves {steps} standard "
             f"errors{why}. The estimates and their intervals are not final. What helps: {hold}start values "
             f"closer to the truth, or a record that excites the friction more (slow reversals, speeds near the "

@@ -9,7 +9,9 @@ minimised subject to the continuity of the segments by scipy's trust-region leas
 augmented Lagrangian on sparse matrices (:mod:`prefriction.identify.constrained_lsq`), with
 forward sensitivities propagated sample by sample. A record longer than ``2 WINDOW`` samples
 fits its :data:`WINDOW` samples with the most reversals first and starts the full record from
-their estimates (continuation). Nothing holds more than a few numbers per sample and sensitivity column, so the
+their estimates (continuation); parameters the record pins only together with another
+(:mod:`prefriction.identify.held_first`) are held at their start values in the window and in a
+first fit of the full record, and freed in the last. Nothing holds more than a few numbers per sample and sensitivity column, so the
 time and the memory of a fit grow linearly with the samples (measured:
 ``docs/identify_motion.md``).
 
@@ -408,9 +410,9 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
         samples or more).
     held : ParameterSpace, optional
         ``space`` with some free parameters held at their start values
-        (:func:`prefriction.identify.held_first.held_first`): the first stage (the window of a
-        long record, else the whole record) fits this space, and the record is then fitted with
-        every parameter of ``space`` free from its estimates.
+        (:func:`prefriction.identify.held_first.held_first`): the first stages (the window of a
+        long record, then the whole record) fit this space, and the record is then fitted with
+        every parameter of ``space`` free from their estimates.
 
     Raises
     ------
@@ -421,33 +423,34 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
         with ``success = False`` instead).
     """
     steps: list[str] = []
-    theta0 = space.theta0
     progress = _progress if verbose or len(data) >= LONG else None
-    first_space = space if held is None else held
-    least = 1
-    if len(data) > 2 * WINDOW or held is not None:
-        long = len(data) > 2 * WINDOW
-        k0 = _busiest_window(data) if long else 0
-        part = slice(k0, k0 + WINDOW) if long else slice(0, len(data))
-        head = Motion(data.t[part], data.x[part], data.u[part], data.mass, data.hold) if long else data
-        given = None if reversals is None or not long else [r for r in reversals if head.t[0] < r < head.t[-1]]
-        what = f"samples {k0} to {k0 + WINDOW - 1}" if long else "the record"
-        if held is not None:
-            what += f" with {', '.join(n for n in space.free if n not in held.free)} held"
-        first = _solve(model, head, first_space, first_space.theta0, n_sub, max_iter, tol, given, progress, 0.01,
-                       steps)
-        least = first.n_sub if first.success else 1
-        if first.success:
-            vals = dict(space.start, **first_space.values(first.w[: first_space.n_free]))
-            theta0 = _theta_of(space, vals)
-            model = first_space.build(vals)  # the sub-steps of the full record from the first stage's estimates
-            steps.append(f"continuation: {what} fitted first ({first.message}); the full record started from "
-                         f"their estimates ({_at(first_space, first.w)})")
-        else:
-            steps.append(f"continuation: the fit of {what} did not converge ({first.message}); the full record "
-                         f"started from the start values")
-    sol = _solve(model, data, space, theta0, n_sub, max_iter, tol, reversals, progress,
-                 0.01 if not steps or "did not" in steps[-1] else 10.0, steps, least)
+    stages: list[tuple[Motion, ParameterSpace, Any, str]] = []
+    long = len(data) > 2 * WINDOW
+    what = "" if held is None else f" with {', '.join(n for n in space.free if n not in held.free)} held"
+    if long:
+        k0 = _busiest_window(data)
+        part = slice(k0, k0 + WINDOW)
+        stages.append((Motion(data.t[part], data.x[part], data.u[part], data.mass, data.hold),
+                       space if held is None else held,
+                       None if reversals is None else [r for r in reversals if data.t[k0] < r < data.t[k0 + WINDOW - 1]],
+                       f"samples {k0} to {k0 + WINDOW - 1}{what}"))
+    if held is not None:
+        stages.append((data, held, reversals, f"the record{what}"))
+    vals, least, weight, moved = dict(space.start), 1, 0.01, False
+    for head, sp_k, given, name in stages:   # continuation (module notes, identify/held_first.py)
+        stage = _solve(sp_k.build(vals) if moved else model, head, sp_k, _theta_of(sp_k, vals), n_sub, max_iter, tol, given, progress,
+                       weight, steps, least)
+        if not stage.success:
+            steps.append(f"continuation: the fit of {name} did not converge ({stage.message}); the next stage "
+                         f"started from the values before it")
+            continue
+        least, weight, moved = stage.n_sub, 10.0, True
+        vals = dict(vals, **sp_k.values(stage.w[: sp_k.n_free]))
+        steps.append(f"continuation: {name} fitted ({stage.message}); the next stage started from these estimates "
+                     f"({_at(sp_k, stage.w)})")
+    # the sub-steps of the full record from the last stage's estimates
+    sol = _solve(space.build(vals) if moved else model, data, space, _theta_of(space, vals), n_sub, max_iter, tol, reversals, progress,
+                 weight, steps, least)
     return dataclasses.replace(sol, steps=tuple(steps))
 
 
