@@ -368,7 +368,10 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
             start = dataclasses.replace(start, steps=start.steps + (
                 f"the fit from these start values ended with {why}; second start from {second[3]}: {said}",))
     short = _short_of_minimum(space, sol, stats)
-    if short and held_of(space) is not None:  # once more, the held stage from where it stopped
+    from prefriction.identify.shooting import WINDOW
+
+    # once more, the held stage from where it stopped (a long record: its cost, and the flag, instead)
+    if short and held_of(space) is not None and len(data) <= 2 * WINDOW:
         model2 = space.build(values)
         sol2, space2, err2 = _fit_from((model2, values.get("mass"), values.get("offset", 0.0),
                                         "the estimates where the fit stopped short of its minimum"),
