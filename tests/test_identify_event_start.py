@@ -129,8 +129,8 @@ def test_maxwell_slip_motion_fit_from_a_factor_two_start():
 def test_gms_motion_fit_from_a_factor_two_start():
     """GMS(2) with k, Fc, Fs, C, mass and offset free, each about 2x off: converges, the
     stiffnesses, Fc and the mass within 10 % of the truth, the offset within 0.01 N; the record
-    (sliding far faster than vs) cannot pin Fs, and the fit says so (reported as not identifiable;
-    C, also barely excited, can end far off: docs/identify_motion.md#limits)."""
+    (sliding far faster than vs) pins Fs and C only in a combination (docs/identify_motion.md#limits;
+    tests/test_identify_gms_free.py checks what the fit reports of them)."""
     start = pf.GMS(k=[3e4, 8e4], alpha=[0.4, 0.6], Fc=0.5, Fs=1.3 * 0.5 * 1.6, vs=1e-3, C=100.0)
     res, truth = _fit(GMS, GMS_TRUTH, GMS_FIXED, start, 2.0, 0)
     assert res.success, res.message
