@@ -367,7 +367,7 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
                 said += ", the first fit's result kept"
             start = dataclasses.replace(start, steps=start.steps + (
                 f"the fit from these start values ended with {why}; second start from {second[3]}: {said}",))
-    short = _short_of_minimum(space, sol, stats)
+    short = _short_of_minimum(space, sol, stats, held_of(space) is not None)
     from prefriction.identify.shooting import WINDOW
 
     # once more, the held stage from where it stopped (a long record: its cost, and the flag, instead)
@@ -379,7 +379,7 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
         said = f"failed ({str(err2)[:200]})" if sol2 is None else "converged" if sol2.success else "did not converge"
         if sol2 is not None and sol2.success and _rss(sol2) < _rss(sol):
             v2, e2, s2 = _motion_statistics(space2, sol2, limit)
-            short2 = _short_of_minimum(space2, sol2, s2)
+            short2 = _short_of_minimum(space2, sol2, s2, True)
             if len(short2) <= len(short):
                 sol, space, values, est, stats, short = sol2, space2, v2, e2, s2, short2
                 said += ", its result kept (a lower sum of squares)"
@@ -413,11 +413,13 @@ def _fit_from(second: tuple, data: Motion, space_of: Any, substeps: Any, max_ite
         return None, None, err
 
 
-def _short_of_minimum(space: ParameterSpace, sol: Any, stats: Any) -> tuple[tuple[str, float], ...]:
-    """The pinned estimates of a converged fit with unidentifiable parameters that stopped short of
-    the minimum (:func:`prefriction.identify.settled.unsettled`: a curved valley), else ``()``."""
+def _short_of_minimum(space: ParameterSpace, sol: Any, stats: Any, valley: bool) -> tuple[tuple[str, float], ...]:
+    """The pinned estimates of a converged fit that stopped short of the minimum
+    (:func:`prefriction.identify.settled.unsettled`: a curved valley), else ``()``; checked where
+    the fit has unidentifiable parameters or ``valley`` (parameters a first stage held,
+    :mod:`prefriction.identify.held_first`, that the record may pin only barely)."""
     loose = {n for n, _ in stats.unidentifiable}
-    if not sol.success or not loose:
+    if not sol.success or not (loose or valley):
         return ()
     from prefriction.identify.settled import unsettled
 
