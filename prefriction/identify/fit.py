@@ -389,7 +389,9 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
     if success and short:
         from prefriction.identify.settled import unsettled_message
 
-        message, success = f"{unsettled_message(short, stats.unidentifiable)}; solver: {message}", False
+        loose = stats.unidentifiable or tuple((n, "the record pins it only barely, in a combination with Fs")
+                                              for n in held_first(space.model, space))
+        message, success = f"{unsettled_message(short, loose)}; solver: {message}", False
     if not sol.success:
         advice = _route_advice(data)
         message = f"{message}; {advice}" if advice else message
