@@ -27,6 +27,7 @@ import numpy as np
 from prefriction.identify.data import Motion
 from prefriction.identify.synthetic_events import event_record
 from prefriction.models.base import FrictionModel
+from prefriction.models.elasto_plastic import ElastoPlastic
 from prefriction.models.gms import GMS
 from prefriction.models.maxwell_slip import MaxwellSlip
 
@@ -50,6 +51,8 @@ EVENT_STAGES = (
     EventStage("Maxwell-slip(3) + offset", MaxwellSlip([6e4, 3e4, 1e4], [0.3, 0.4, 0.3])),
     EventStage("GMS(2) + offset", GMS(k=[6e4, 4e4], alpha=[0.4, 0.6], Fc=1.0, Fs=1.3, vs=1e-3, C=50.0),
                ("alpha[0]", "alpha[1]", "vs", "delta", "sigma2", "damping[0]", "damping[1]")),
+    EventStage("ElastoPlastic + offset", ElastoPlastic(sigma0=1e5, sigma1=100.0, sigma2=10.0, Fc=1.0, Fs=1.5,
+                                                       vs=5e-3, z_ba=5e-6)),
 )
 
 
