@@ -106,3 +106,37 @@ def test_reference_matches_the_toolbox_simulator():
                       t_end=t[-1], rtol=1e-10, dense=t[1:])
     assert run.reversals.size >= 4 and run.events.size >= 4
     assert np.max(np.abs(np.asarray(sim.x) - run.x[1:])) < 1e-7 * np.ptp(run.x)
+
+
+def test_every_point_of_the_fit_box_is_a_valid_elasto_plastic_model():
+    """``z_ba < Fc / sigma0`` is part of the problem: anywhere in the scaled bounds (corners
+    included) the values build a model, and the statistics' change of variables back to the
+    physical parameters is the derivative of the map (central differences)."""
+    from prefriction.identify.parameters import ParameterSpace
+
+    space = ParameterSpace(pf.ElastoPlastic(**EP), None, None, None, mass=MASS, offset=1.0)
+    lo, hi = space.theta_bounds()
+    lo, hi = np.maximum(lo, -1.0), np.minimum(hi, 4.0 * space.theta0 + 1.0)   # finite corners of open ranges
+    rng = np.random.default_rng(0)
+    for _ in range(200):
+        theta = lo + (hi - lo) * rng.choice([0.0, 1.0, rng.uniform()], size=lo.size)
+        v = space.values(theta)
+        assert v["z_ba"] < v["Fc"] / v["sigma0"]
+        space.build(v)
+    theta = space.theta0 * np.array([1.1, 0.9, 1.2, 0.6, 1.3, 1.1, 1.4, 1.05, 1.0]) + np.r_[np.zeros(8), 0.2]
+    J, s = space.physical_jacobian(np.eye(space.n_free), theta)
+    p = space.values(theta)
+
+    def theta_of(q: dict) -> np.ndarray:    # the inverse map, written from the class text
+        R0 = space.start["Fc"] / space.start["sigma0"]
+        raw = {**q, "Fs": q["Fs"] - q["Fc"], "z_ba": q["z_ba"] * q["sigma0"] / q["Fc"] * R0}
+        return np.array([raw[n] for n in space.free]) / space.scale
+
+    assert np.allclose(theta_of(p), theta, rtol=1e-12, atol=1e-12)
+    for j, name in enumerate(space.free):
+        h = 1e-6 * s[j]
+        up, down = dict(p), dict(p)
+        up[name] += h
+        down[name] -= h
+        fd = (theta_of(up) - theta_of(down)) / (2e-6)
+        assert np.allclose(fd, J[:, j], rtol=1e-6, atol=1e-9), name
