@@ -144,7 +144,7 @@ def main(argv: list[str] | None = None) -> None:
     p.add_argument("--fits", type=int, default=8)
     p.add_argument("--samples", type=int, default=1000)
     p.add_argument("--distance", type=float, default=2.0)
-    p.add_argument("--model", choices=[s.name.split("(")[0] for s in EVENT_STAGES], default=None)
+    p.add_argument("--model", choices=[s.name.split("(")[0].split(" ")[0] for s in EVENT_STAGES], default=None)
     p.add_argument("--fix", default="", help="comma-separated parameters also held at their true values "
                                              "(e.g. C,Fs: those a record sliding much faster than vs cannot pin)")
     a = p.parse_args(argv)

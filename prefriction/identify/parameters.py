@@ -199,7 +199,8 @@ class ParameterSpace:
         self.fraction: dict[str, tuple[str, str]] = {}
         """``{name: (num, den)}`` of the bounds ``name < num / den`` with ``name`` free: ``name`` is moved
         as ``q = value[name] (value[den] / value[num]) (start[num] / start[den])``, bounded by
-        ``start[num] / start[den]``."""
+        ``start[num] / start[den]`` (the start values of ``num`` and ``den`` are their scales, or
+        their fixed values: inputs of the compiled steps, so one step serves every start)."""
         for name, num, den in _fractions(model):
             self._bound_by_ratio(name, num, den)
         for name in self.free:
@@ -299,8 +300,9 @@ class ParameterSpace:
             out[n] = fixed[i]
         for hi_name, lo_name in self.excess.items():
             out[hi_name] = out[lo_name] + out[hi_name]
-        for name, (num, den) in self.fraction.items():
-            out[name] = out[name] * (out[num] / out[den]) * (self.start[den] / self.start[num])
+        ref = {n: scale[i] for i, n in enumerate(self.free)} | {n: fixed[i] for i, n in enumerate(self.fixed)}
+        for name, (num, den) in self.fraction.items():   # start[num] / start[den] from the inputs, not baked in
+            out[name] = out[name] * (out[num] / out[den]) * (ref[den] / ref[num])
         return out
 
     def values(self, theta: np.ndarray) -> dict[str, float]:
