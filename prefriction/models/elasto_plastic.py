@@ -89,8 +89,7 @@ class ElastoPlastic(FrictionModel):
     crossings : bool, default True
         Locate the breakaway and saturation crossings as events (flags ``broke``, ``sat``).
         ``False``: ``alpha`` straight from its definition inside the right-hand side (C1 kinks
-        that the integrators' error control steps over; no flags and no events), the form
-        :func:`prefriction.identify.fit` needs for :class:`~prefriction.identify.Motion` data.
+        that the integrators' error control steps over; no flags and no events).
 
     Raises
     ------
