@@ -5,10 +5,11 @@ every sample, velocity reversal and in-branch event), independent of the fitter:
 driven both ways by a two-tone force with an offset of 0.1 N, 0.1 time units ``sqrt(m / sigma)``
 per sample, the position rounded to an encoder step of 0.005 pre-sliding distances ``Fc / sigma``
 after Gaussian noise of 0.003 of them. Each fit starts every free parameter (mass and offset
-included) at the truth times a factor drawn log-uniformly in ``[1 / d, d]`` (a GMS ``Fs`` at
-least 1.05 ``Fc``). A fit *converges* when the solver says so, *lands* when every estimate is
-within 5 % of its true value (the offset within 5 % of ``Fc``), and *covers* when every 95 %
-interval holds the true value. Used by ``python -m prefriction.identify._success_events`` and
+included) at the truth times a factor drawn log-uniformly in ``[1 / d, d]`` (a GMS or
+ElastoPlastic ``Fs`` at least 1.05 ``Fc``, an ElastoPlastic ``z_ba`` at most 0.95 ``Fc / sigma0``).
+A fit *converges* when the solver says so, *lands* when every estimate is within 5 % of its true
+value (the offset within 5 % of ``Fc``), and *covers* when every 95 % interval holds the true
+value. Used by ``python -m prefriction.identify._success_events`` and
 ``docs/identify_motion.md#limits``; the rows complement :mod:`prefriction.identify._success`.
 """
 
@@ -91,6 +92,8 @@ def _start(stage: EventStage, d: float, rng: np.random.Generator) -> tuple[Frict
     vals = {k: (v * d ** rng.uniform(-1.0, 1.0) if k in space.free else v) for k, v in space.start.items()}
     if "Fs" in vals:
         vals["Fs"] = max(vals["Fs"], 1.05 * vals["Fc"])
+    if "z_ba" in vals:   # ElastoPlastic: breakaway before the start's pre-sliding distance
+        vals["z_ba"] = min(vals["z_ba"], 0.95 * vals["Fc"] / vals["sigma0"])
     return space.build(vals), MASS * d ** rng.uniform(-1.0, 1.0)
 
 
