@@ -8,6 +8,7 @@ the cost of force-displacement fits against the record length.
   (:data:`SEEDS`), each stage and seed in a fresh process so that its peak resident set size
   (``ru_maxrss``) is its own; per model against the start distance, with the wall and CPU time
   and the memory, and the coverage of the fits' 95 % intervals per model.
+- Models with in-branch events (Maxwell-slip, GMS): :mod:`prefriction.cli.bench.identify_events`.
 - Coverage: :func:`prefriction.identify._coverage.coverage_table` (how often the 95 % intervals
   hold the truth on seeded records generated from the equations).
 - Cost: a Maxwell-slip(3) :class:`ForceDisplacement` fit of the tribometer record (12-60 s) at
@@ -174,9 +175,12 @@ def cost_lines(quick: bool) -> tuple[list[str], bool]:
 
 
 def main_rates(quick: bool) -> bool:
-    """Print the three tables; True if every target passes."""
+    """Print the four tables (the event models' from :mod:`prefriction.cli.bench.identify_events`);
+    True if every target passes."""
+    from prefriction.cli.bench.identify_events import event_lines
+
     ok = True
-    for part in (success_lines, coverage_lines, cost_lines):
+    for part in (success_lines, event_lines, coverage_lines, cost_lines):
         lines, good = part(quick)
         print("\n".join(lines) + "\n", flush=True)
         ok &= good
