@@ -189,3 +189,18 @@ def test_one_compiled_map_serves_every_start():
     want = b.symbols(b.theta0, b.fixed_values())
     assert np.allclose(got, list(want.values()), rtol=1e-14, atol=0.0)
     assert want["z_ba"] == pytest.approx(2e-6, rel=1e-14) and want["sigma0"] == pytest.approx(1.7e5, rel=1e-14)
+
+
+def test_a_fixed_breakaway_bounds_the_free_coulomb_force_or_stiffness():
+    """``z_ba`` held: ``Fc > sigma0 z_ba`` bounds a free ``Fc`` (``sigma0`` held), and
+    ``sigma0 < Fc / z_ba`` a free ``sigma0`` (``Fc`` held)."""
+    from prefriction.identify.parameters import ParameterSpace
+
+    a = ParameterSpace(pf.ElastoPlastic(**EP), None, ["z_ba", "sigma0", "Fs"], None)
+    assert a.low["Fc"] == pytest.approx(EP["sigma0"] * EP["z_ba"], rel=1e-8)
+    b = ParameterSpace(pf.ElastoPlastic(**EP), None, ["z_ba", "Fc"], None)
+    assert b.high["sigma0"] == pytest.approx(EP["Fc"] / EP["z_ba"], rel=1e-8)
+    for space in (a, b):
+        lo, hi = space.theta_bounds()
+        space.build(space.values(np.where(np.isfinite(hi), hi, 4.0)))
+        space.build(space.values(lo))

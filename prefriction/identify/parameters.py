@@ -239,9 +239,11 @@ class ParameterSpace:
                 self.fraction[name] = (num, den)
                 self.high[name], self.why_high[name] = ratio * (1.0 - _OPEN), f"{num} / {den} ({why})"
         elif num in free and den not in free and self.start[name] * self.start[den] > self.low[num]:
-            self.low[num], self.why_low[num] = self.start[name] * self.start[den], f"the fixed {name} and {den} ({why})"
+            self.low[num] = self.start[name] * self.start[den] * (1.0 + _OPEN)
+            self.why_low[num] = f"the fixed {name} and {den} ({why})"
         elif den in free and num not in free and self.start[num] / self.start[name] < self.high[den]:
-            self.high[den], self.why_high[den] = self.start[num] / self.start[name], f"the fixed {name} and {num} ({why})"
+            self.high[den] = self.start[num] / self.start[name] * (1.0 - _OPEN)
+            self.why_high[den] = f"the fixed {name} and {num} ({why})"
 
     def _set_bound(self, name: str, lim: Any, names: list[str]) -> None:
         if name not in names:

@@ -29,8 +29,9 @@ __all__ = ["ElastoPlasticLaw"]
 
 
 class ElastoPlasticLaw:
-    """The law of one :class:`prefriction.ElastoPlastic` for :func:`~prefriction.identify.synthetic_events.event_motion`:
-    state ``[z]`` (bristle deflection [m]), two events per branch (0 breakaway, 1 saturation)."""
+    """The law of one :class:`prefriction.ElastoPlastic` for
+    :func:`~prefriction.identify.synthetic_events.event_motion`: state ``[z]`` (bristle deflection
+    [m]), two events per branch (0 breakaway, 1 saturation)."""
 
     kind = "ElastoPlastic"
     n = 1
