@@ -1,6 +1,6 @@
 """friction_along's states made on first access: the C pass writes only the forces, and the
 states, flags and events per sample come from the same pass run again. Checked against the
-Maxwell-slip stop operator (closed form, written here) and against the CasADi block path, which
+Maxwell-slip stop operator (closed form, written in tests/_stop_operator.py) and against the CasADi block path, which
 computes them with the run."""
 
 from __future__ import annotations
@@ -14,36 +14,23 @@ import prefriction as pf
 import prefriction.along.run as along_run
 from prefriction.simulation.compiled import jit_available
 
-pytestmark = pytest.mark.skipif(not jit_available(), reason="the C pass needs a C compiler")
+from _stop_operator import K, W, element_forces, two_tone
 
-K, W = np.array([6e4, 3e4, 1e4]), np.array([0.3, 0.4, 0.3])
+pytestmark = pytest.mark.skipif(not jit_available(), reason="the C pass needs a C compiler")
 
 
 def _motion() -> tuple[np.ndarray, np.ndarray]:
     """Reversals of several sizes, a pause, uneven sample times: 600 samples."""
-    rng = np.random.default_rng(11)
-    t = np.cumsum(rng.uniform(0.5e-3, 1.5e-3, 600))
-    x = 2.5e-5 * np.sin(2 * np.pi * 2.3 * t) + 6e-6 * np.sin(2 * np.pi * 13.0 * t)
+    t, x = two_tone(11, 600, (2.5e-5, 6e-6), (2.3, 13.0))
     x[300:330] = x[300]
     return t, x
-
-
-def _stop_operator(x: np.ndarray) -> np.ndarray:
-    """Element forces [N] from the relaxed state, ``n x 3``: element i carries ``k_i (x - a_i)``
-    clipped to ``+-W_i``, its anchor ``a_i`` dragged along while it slips."""
-    a = np.full(K.size, x[0])
-    out = np.empty((x.size, K.size))
-    for j, xj in enumerate(x):
-        out[j] = np.clip(K * (xj - a), -W, W)
-        a = xj - out[j] / K
-    return out
 
 
 def test_states_on_access_match_closed_form_and_eager_path(monkeypatch: pytest.MonkeyPatch) -> None:
     t, x = _motion()
     model = pf.MaxwellSlip(K, W)
     lazy = pf.friction_along(model, t, x)
-    Fi = _stop_operator(x)
+    Fi = element_forces(x)
     np.testing.assert_allclose(lazy.F, Fi.sum(axis=1), rtol=0, atol=1e-12 * W.sum())
     # z_i = k_i d_i / Fc; the retrace guard is zero on every branch
     np.testing.assert_allclose(lazy.states[:, :3], Fi / W.sum(), rtol=0, atol=1e-12)
@@ -98,7 +85,7 @@ def test_generated_step_without_straight_line_form(monkeypatch: pytest.MonkeyPat
     t, x = _motion()
     res = pf.friction_along(pf.MaxwellSlip(K, W), t, x)
     assert native._CACHE and all(lib is not None for lib in native._CACHE.values())  # the C pass ran
-    Fi = _stop_operator(x)
+    Fi = element_forces(x)
     np.testing.assert_allclose(res.F, Fi.sum(axis=1), rtol=0, atol=1e-12 * W.sum())
     np.testing.assert_allclose(res.states[:, :3], Fi / W.sum(), rtol=0, atol=1e-12)
 
@@ -159,7 +146,7 @@ def test_result_pickles_with_its_states() -> None:
     res = pf.friction_along(pf.MaxwellSlip(K, W), t, x)
     back = pickle.loads(pickle.dumps(res))
     np.testing.assert_array_equal(back.F, res.F)
-    np.testing.assert_allclose(back.states[:, :3], _stop_operator(x) / W.sum(), rtol=0, atol=1e-12)
+    np.testing.assert_allclose(back.states[:, :3], element_forces(x) / W.sum(), rtol=0, atol=1e-12)
     np.testing.assert_array_equal(back.flags, res.flags)
     np.testing.assert_array_equal(back.events, res.events)
     assert back.n_events == res.n_events and repr(back) == repr(res)

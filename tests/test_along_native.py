@@ -12,31 +12,22 @@ import prefriction as pf
 import prefriction.along.run as along_run
 from prefriction.simulation.compiled import jit_available
 
-pytestmark = pytest.mark.skipif(not jit_available(), reason="the C pass needs a C compiler")
+from _stop_operator import K, W, element_forces, two_tone
 
-K, W = np.array([6e4, 3e4, 1e4]), np.array([0.3, 0.4, 0.3])
+pytestmark = pytest.mark.skipif(not jit_available(), reason="the C pass needs a C compiler")
 
 
 def _motion() -> tuple[np.ndarray, np.ndarray]:
     """Flat at the start and in between, reversals, uneven sample times: 400 samples."""
-    rng = np.random.default_rng(3)
-    t = np.cumsum(rng.uniform(0.5e-3, 1.5e-3, 400))
-    x = 2e-5 * np.sin(2 * np.pi * 3.1 * t) + 4e-6 * np.sin(2 * np.pi * 17.0 * t)
+    t, x = two_tone(3, 400, (2e-5, 4e-6), (3.1, 17.0))
     x[:5] = x[5]  # no displacement before the first moving interval
     x[120:150] = x[120]  # at rest
     return t, x
 
 
 def _stop_operator(x: np.ndarray) -> np.ndarray:
-    """Maxwell-slip force [N] from the relaxed state: element i is ``k_i (x - a_i)`` clipped to
-    ``+-w_i``, its anchor ``a_i`` dragged while it slips (exact for a piecewise-linear motion)."""
-    a = np.full(K.size, x[0])
-    F = np.empty(x.size)
-    for j, xj in enumerate(x):
-        Fi = np.clip(K * (xj - a), -W, W)
-        a = xj - Fi / K
-        F[j] = Fi.sum()
-    return F
+    """Maxwell-slip force [N] from the relaxed state: the elements' forces summed."""
+    return element_forces(x).sum(axis=1)
 
 
 def _definition(t: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import re
 import warnings
 
+import pytest
 from _doc_blocks import ROOT, run_block
 
 PAGE = (ROOT / "docs" / "identify_motion.md").read_text()
@@ -19,6 +20,8 @@ def _shown(after: str) -> list[str]:
     return [m.group(1)] if m else []
 
 
+@pytest.mark.slow  # the page's first block is the 1,000-sample closed-loop fit that the fast suite runs in
+# tests/test_identify_closed_loop.py (the same record, start and options): about 10 s of CPU again
 def test_every_python_block_runs_and_prints_what_the_page_shows():
     namespace: dict = {}
     blocks = list(re.finditer(r"```python\n(.*?)```", PAGE, flags=re.S))

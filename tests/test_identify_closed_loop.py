@@ -118,6 +118,7 @@ def test_free_decay_refuses_an_offset():
                      offset=True)
 
 
+@pytest.mark.slow  # a 600-sample fit (13 s of CPU) for the bench row; the fast suite keeps the fit above
 def test_bench_identify_row_and_table():
     from prefriction.cli.bench.identify import format_rows, measure
 

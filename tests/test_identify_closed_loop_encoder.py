@@ -102,7 +102,7 @@ def test_maxwell_slip_fit_in_the_loop():
 
 
 def test_step_shift_is_the_gauss_newton_step_in_standard_errors():
-    from prefriction.identify.closed_loop_fit import _step_shift
+    from prefriction.identify.substep_check import step_shift
 
     rng = np.random.default_rng(4)
     J = rng.standard_normal((500, 3))
@@ -111,7 +111,7 @@ def test_step_shift_is_the_gauss_newton_step_in_standard_errors():
     delta = np.array([0.0, 0.02, -0.05])
     se = np.sqrt(np.diag(np.linalg.inv(J.T @ J))) * np.std(r)
     # residuals that move by J delta (plus a constant: the profiled initial position) move the estimates by delta
-    assert _step_shift(J, r, r + J @ delta + 3.0) == pytest.approx(np.max(np.abs(delta) / se), rel=1e-9)
+    assert step_shift(J, r, r + J @ delta + 3.0, centred=True) == pytest.approx(np.max(np.abs(delta) / se), rel=1e-9)
 
 
 @pytest.mark.slow  # ten records and fits, about 40 s

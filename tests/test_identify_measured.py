@@ -101,6 +101,7 @@ def triangle(t: np.ndarray) -> np.ndarray:
 CLEAN = dahl_loop_force(TRUE, triangle(T)) + OFFSET
 
 
+@pytest.mark.slow  # 20 fits (coverage over seeds, 4 s of CPU)
 def test_offset_and_dahl_intervals_cover_on_record_like_data():
     truth = np.array([TRUE.sigma, TRUE.Fc, TRUE.gamma, OFFSET])
     inside = np.zeros(4, dtype=int)

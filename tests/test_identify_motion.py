@@ -58,6 +58,7 @@ def test_free_decay_reversals_located_and_parameters_recovered(clean, exact_time
     assert res.mass == MASS and res.unidentifiable == ()
 
 
+@pytest.mark.slow  # 20 fits (coverage over seeds, 6 s of CPU)
 def test_free_decay_intervals_cover_the_true_parameters_in_18_of_20_seeds(clean, exact_times):
     inside = np.zeros(2, dtype=int)
     for seed in range(20):

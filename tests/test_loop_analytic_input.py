@@ -4,7 +4,7 @@ sample periods: an analytic disturbance (``Sine``) and a ``Step`` between two sa
 The native sampled loop (``native/loop.c``) evaluates the input with the forced driver's generated
 C (``pf_input``), the integration broken at the input's breaks inside a period. It is held to
 CasADi's loop (``method="erk"``, one integrator call per period) and to an independent reference:
-python-control's discrete PID around ``solve_ivp`` of the Dahl equations written here, the
+python-control's discrete PID around ``solve_ivp`` of the Dahl equations (tests/_sampled_loop.py), the
 controller's output held over each period and the sine force added.
 """
 
@@ -14,13 +14,12 @@ import math
 
 import numpy as np
 import pytest
-from scipy.integrate import solve_ivp
 
 import prefriction as pf
 from prefriction.signals import Chirp, PointToPoint, Ramp, Samples, Sine, Step, Traced, ZeroOrderHold
 from prefriction.simulation.compiled import jit_available
 
-from _sampled_loop import MODELS, REF, STROKE, TS, agree, feedback
+from _sampled_loop import MODELS, TS, agree, assert_dahl_loop_matches_reference, feedback
 
 pytestmark = pytest.mark.skipif(not jit_available(), reason="the native loop needs a C compiler")
 
@@ -96,32 +95,4 @@ def test_dahl_under_a_sine_disturbance_against_python_control_and_solve_ivp() ->
     assert float(d(0.01)) == pytest.approx(amp * math.sin(w * 0.01), abs=1e-15)  # the force written below
     fb, Cd = _feedback()
     res = pf.simulate(pf.Oscillator(pf.Dahl(sigma=sigma, Fc=Fc), m, d), 0.0, t_end=T_END, feedback=fb, rtol=1e-10)
-
-    n_s = len(res.t)
-    tk = np.arange(n_s) * TS
-    y, xc = np.zeros(3), np.zeros(Cd.nstates)
-    xs, us, rev = np.zeros(n_s), np.zeros(n_s), []
-
-    def vzero(t, s, u):
-        return s[1]
-
-    def rhs(t, s, u):
-        return [s[1], (u + amp * math.sin(w * t) - s[2]) / m, sigma * (s[1] - abs(s[1]) * s[2] / Fc)]
-
-    for k in range(n_s):
-        e = float(REF(tk[k])) - y[0]
-        uk = float(Cd.output(tk[k], xc, [e])[0])
-        us[k] = uk + amp * math.sin(w * tk[k])  # the applied force: held controller output and the input
-        xs[k] = y[0]
-        xc = np.asarray(Cd.dynamics(tk[k], xc, [e]), dtype=float)
-        if k == n_s - 1:
-            break
-        sol = solve_ivp(rhs, (tk[k], tk[k + 1]), y, method="DOP853", rtol=1e-12, atol=1e-20, events=vzero,
-                        args=(uk,))
-        rev += [t for t in sol.t_events[0] if t > tk[k]]
-        y = sol.y[:, -1]
-    np.testing.assert_allclose(res.t, tk, rtol=1e-12, atol=0)
-    assert np.max(np.abs(res.x - xs)) <= 1e-7 * STROKE
-    assert np.max(np.abs(res.u - us)) <= 1e-6 * np.max(np.abs(us))
-    assert len(res.reversals) == len(rev) >= 2
-    np.testing.assert_allclose(res.reversals.t, rev, rtol=0, atol=1e-8 * T_END)
+    assert_dahl_loop_matches_reference(res, Cd, sigma, Fc, m, T_END, lambda t: amp * math.sin(w * t))

@@ -3,7 +3,7 @@
 A sampled controller around an oscillator without input force runs in C (the loop driver of
 ``controllers.simulate_loop``, ``native/loop.c``). References: the CasADi path
 (``method="erk"``, one CasADi call per period) to the tolerance on Dahl, LuGre and Maxwell-slip;
-and an independent closed loop written here: python-control's discrete-time controller
+and an independent closed loop (tests/_sampled_loop.py): python-control's discrete-time controller
 (``StateSpace.dynamics`` / ``output`` of ``PID.c2d``) around ``solve_ivp`` (DOP853, rtol 1e-12)
 of the Dahl equations ``x' = v, v' = (u - F) / m, F' = sigma (v - |v| F / Fc)``, the force held
 over each sample period.
@@ -13,13 +13,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from scipy.integrate import solve_ivp
 
 import prefriction as pf
 from prefriction.signals import Samples, Step, ZeroOrderHold
 from prefriction.simulation.compiled import jit_available
 
-from _sampled_loop import MODELS, REF, STROKE, TS, agree, feedback
+from _sampled_loop import MODELS, STROKE, TS, agree, assert_dahl_loop_matches_reference, feedback
 
 pytestmark = pytest.mark.skipif(not jit_available(), reason="the native loop needs a C compiler")
 
@@ -103,31 +102,4 @@ def test_dahl_loop_against_python_control_and_solve_ivp() -> None:
     stage = pf.Oscillator(pf.Dahl(sigma=sigma, Fc=Fc), m)
     fb, Cd = feedback(stage)
     res = pf.simulate(stage, 0.0, t_end=T_END, feedback=fb, rtol=1e-10)
-
-    n_s = len(res.t)
-    tk = np.arange(n_s) * TS
-    y, xc = np.zeros(3), np.zeros(Cd.nstates)
-    xs, us, rev = np.zeros(n_s), np.zeros(n_s), []
-
-    def vzero(t, s, u):
-        return s[1]
-
-    for k in range(n_s):
-        e = float(REF(tk[k])) - y[0]
-        us[k] = float(Cd.output(tk[k], xc, [e])[0])
-        xs[k] = y[0]
-        xc = np.asarray(Cd.dynamics(tk[k], xc, [e]), dtype=float)
-        if k == n_s - 1:
-            break
-        if us[k] == 0.0 and not np.any(y):  # at rest without force: v = 0 identically (no events)
-            continue
-        sol = solve_ivp(lambda t, s, u: [s[1], (u - s[2]) / m, sigma * (s[1] - abs(s[1]) * s[2] / Fc)],
-                        (tk[k], tk[k + 1]), y, method="DOP853", rtol=1e-12, atol=1e-20, events=vzero,
-                        args=(us[k],))
-        rev += [t for t in sol.t_events[0] if t > tk[k]]
-        y = sol.y[:, -1]
-    np.testing.assert_allclose(res.t, tk, rtol=1e-12, atol=0)
-    assert np.max(np.abs(res.x - xs)) <= 1e-7 * STROKE
-    assert np.max(np.abs(res.u - us)) <= 1e-6 * np.max(np.abs(us))
-    assert len(res.reversals) == len(rev) >= 2
-    np.testing.assert_allclose(res.reversals.t, rev, rtol=0, atol=1e-8 * T_END)
+    assert_dahl_loop_matches_reference(res, Cd, sigma, Fc, m, T_END)

@@ -26,20 +26,7 @@ from prefriction.analysis.maxwell_slip_exact import maxwell_slip_trajectory
 sys.path.insert(0, str(Path(__file__).parent))
 from test_accuracy import dahl_reference  # noqa: E402  (the Dahl reference of the accuracy tests)
 from test_gms import MASS, PD, P, GMSReference  # noqa: E402  (the reference of the GMS tests)
-
-FINITE = dict(stiffness=[6e4, 3e4, 1e4], slip_force=[0.3, 0.4, 0.3])
-ENDLESS = dict(stiffness=[3e4, 2e4, 5e4], slip_force=[0.3, 0.5, 1.0])
-TIES = dict(stiffness=[1e4, 2e4, 2e4], slip_force=[0.1, 0.2, 0.65])  # two slips at one instant
-
-
-def slip_bounds(traj, tol: float = 1e-6) -> tuple[np.ndarray, np.ndarray]:
-    """Least and most slips per half-cycle: a slip within ``tol`` (normalised distance) of its
-    reversal, or an element touching its slip force there, may be counted or not."""
-    sc = traj._scales
-    groups = np.split(traj.slip_gap / sc.x, np.cumsum(traj.slips)[:-1])
-    lo = np.array([int(np.sum(g >= tol)) for g in groups])
-    touch = np.sum(np.nan_to_num(traj.margin, nan=1.0) < tol, axis=1)
-    return lo, traj.slips + touch
+from test_maxwell_slip import ENDLESS, FINITE, TIES, slip_bounds  # noqa: E402  (the Maxwell-slip cases)
 
 
 @pytest.mark.parametrize(("params", "v0n", "n"), [(FINITE, 2.2, 12), (ENDLESS, 2.2, 10), (TIES, 1.3, 8)])

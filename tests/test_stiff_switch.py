@@ -14,68 +14,19 @@ import math
 
 import numpy as np
 import pytest
-from scipy.integrate import solve_ivp
 
 import prefriction as pf
+
+from _gms_radau import gms_reversals
 
 GMS_P = dict(k=[6e4, 3e4, 1e4], alpha=[0.2, 0.3, 0.5], Fc=1.0, Fs=1.5, vs=1e-3, C=1e7)
 MASS, V0, N_REV = 1.0, 0.05, 6
 
 
 def _gms_reference():
-    """Reversals (t, x, F) of m x'' = -sum F_i, GMS elements: sticking F_i' = k_i v, slipping
-    F_i' = s C (1 - s F_i / (alpha_i S(v))), S(v) = Fc + (Fs - Fc) exp(-(v/vs)^2); an element
-    slips from s F_i = alpha_i S(v) on; at a reversal every element sticks again."""
-    k, alpha = np.array(GMS_P["k"]), np.array(GMS_P["alpha"])
-    Fc, Fs, vs, C = GMS_P["Fc"], GMS_P["Fs"], GMS_P["vs"], GMS_P["C"]
-    S = lambda v: Fc + (Fs - Fc) * math.exp(-((v / vs) ** 2))
-    n = len(k)
-    s, slip, t, y, rows = 1.0, np.zeros(n, bool), 0.0, np.r_[0.0, V0, np.zeros(n)], []
-    inside = False  # within 5 vs of v = 0 (toggled by the band's events)
-    while len(rows) < N_REV:
-        sl = slip.copy()
-
-        def rhs(_t, yy, s=s, sl=sl):
-            dF = np.where(sl, s * C * (1.0 - s * yy[2:] / (alpha * S(yy[1]))), k * yy[1])
-            return np.r_[yy[1], -yy[2:].sum() / MASS, dF]
-
-        def jac(_t, yy, s=s, sl=sl):
-            J = np.zeros((n + 2, n + 2))
-            J[0, 1] = 1.0
-            J[1, 2:] = -1.0 / MASS
-            Sv = S(yy[1])
-            dS = -2.0 * yy[1] / vs**2 * (Sv - Fc)
-            for i in range(n):
-                if sl[i]:
-                    J[2 + i, 2 + i] = -C / (alpha[i] * Sv)
-                    J[2 + i, 1] = C * yy[2 + i] / alpha[i] * dS / Sv**2
-                else:
-                    J[2 + i, 1] = k[i]
-            return J
-
-        events = [lambda _t, yy, s=s: s * yy[1]]
-        for j in range(n):
-            events.append(lambda _t, yy, j=j, s=s, sl=sl: 1.0 if sl[j] else alpha[j] * S(yy[1]) - s * yy[2 + j])
-        # the Stribeck curve is narrow (vs = 1 mm/s against 5 cm/s): within 5 vs of v = 0 the
-        # steps are at most vs / 20 of speed (Radau's steps would jump over it)
-        events.append(lambda _t, yy, s=s, inside=inside: (5 * vs - s * yy[1]) if inside else (s * yy[1] - 5 * vs))
-        for ev in events:
-            ev.terminal, ev.direction = True, -1.0
-        sol = solve_ivp(rhs, (t, t + 10.0), y, method="Radau", jac=jac, rtol=1e-10,
-                        atol=np.r_[1e-19, 1e-17, np.full(n, 1e-16)], events=events,
-                        max_step=0.05 * vs * MASS / max(abs(y[2:].sum()), 1e-3) if inside else np.inf)
-        assert sol.status == 1
-        te, i = min((float(e[0]), i) for i, e in enumerate(sol.t_events) if len(e))
-        t, y = te, sol.y_events[i][0].copy()
-        if i == n + 1:
-            inside = not inside
-            continue
-        if i == 0:
-            s, slip[:], y[1], inside = -s, False, 0.0, True
-            rows.append((t, y[0], y[2:].sum()))
-        else:
-            slip[i - 1] = True
-    return np.array(rows)
+    """Reversals (t, x, F) of m x'' = -sum F_i from x = 0, v = V0, unloaded elements (scipy's Radau on
+    the GMS equations, tests/_gms_radau.py)."""
+    return gms_reversals(GMS_P, MASS, np.r_[0.0, V0, np.zeros(len(GMS_P["k"]))], n_rev=N_REV)
 
 
 @pytest.fixture(scope="module")

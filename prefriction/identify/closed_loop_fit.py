@@ -62,6 +62,7 @@ from prefriction.identify.options import check_solver
 from prefriction.identify.result import FitResult
 from prefriction.identify.statistics import (ConvergenceWarning, IdentifiabilityWarning, NoisyPositionsWarning,
                                              at_bounds, gauss_newton)
+from prefriction.identify.substep_check import STEP_SHIFT, step_shift
 from prefriction.models.base import FrictionModel
 
 __all__ = ["fit_closed_loop", "simulate_closed_loop"]
@@ -162,22 +163,6 @@ class _Simulator:
         _, O = self.acc(c0, np.vstack((r, e)), theta, self.space.scale, self.space.fixed_values(), mass)
         O = np.asarray(O)
         return O[0], O[1], O[2:2 + nth].T, O[2 + nth:2 + 2 * nth].T
-
-
-STEP_SHIFT = 0.1
-"""Most change of an estimate, in its standard errors, that halving the Runge-Kutta sub-steps may
-cause before the recorded-force stage refits with twice as many."""
-
-
-def _step_shift(J: np.ndarray, r: np.ndarray, r_fine: np.ndarray) -> float:
-    """Largest change of an estimate, in its (white-residual) standard errors, from the residuals
-    ``r`` to ``r_fine`` at the same parameters: the Gauss-Newton step ``(J^T J)^-1 J^T (r_fine - r)``
-    (both centred: the initial position is profiled out)."""
-    d = (r_fine - r_fine.mean()) - (r - r.mean())
-    H = np.linalg.pinv(J.T @ J)
-    step = H @ (J.T @ d)
-    se = np.sqrt(np.clip(np.diag(H), 1e-300, None)) * max(float(np.std(r)), 1e-300)
-    return float(np.max(np.abs(step) / se))
 
 
 def _series(name: str, value: Any, n: int, unit: str) -> np.ndarray:
@@ -398,7 +383,7 @@ def fit_closed_loop(model: FrictionModel, data: Motion, loop: DigitalLoop, refer
                     fine = _Simulator(model, free_loop, space, data.t.size, 2 * k_sub, data.mass is None)
                     run = lambda t_, f=fine: f.run(t_, x0, r, um, mass)   # noqa: E731
                     J = fns[1](theta)
-                    shift = _step_shift(J, fns[0](theta), (run(theta)[0] - xm) / w[0])
+                    shift = step_shift(J, fns[0](theta), (run(theta)[0] - xm) / w[0], centred=True)
                     if shift <= STEP_SHIFT:
                         break
                     k_sub *= 2

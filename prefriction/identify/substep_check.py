@@ -25,7 +25,7 @@ __all__ = ["RELATIVE_FLOOR", "STEP_SHIFT", "step_shift"]
 
 STEP_SHIFT = 0.1
 """Most change of an estimate, in its standard errors, that doubling the Runge-Kutta sub-steps
-may cause before a Motion fit is solved again with twice as many (the bias left is then at most
+may cause before a Motion fit (or the closed-loop route's recorded-force stage) is solved again with twice as many (the bias left is then at most
 ``0.1 * 16 / 15`` standard errors)."""
 
 RELATIVE_FLOOR = 1e-6
@@ -34,8 +34,8 @@ record with (nearly) no noise the standard errors shrink with the discretisation
 bias below a part per million of every estimate is not worth more sub-steps."""
 
 
-def step_shift(J: np.ndarray, r: np.ndarray, r_fine: np.ndarray, params: np.ndarray,
-               values: np.ndarray | None = None) -> float:
+def step_shift(J: np.ndarray, r: np.ndarray, r_fine: np.ndarray, params: np.ndarray | None = None,
+               values: np.ndarray | None = None, *, centred: bool = False) -> float:
     """Largest change of a parameter, in its white-residual standard errors, from the residuals
     ``r`` to ``r_fine`` at the same point.
 
@@ -45,24 +45,32 @@ def step_shift(J: np.ndarray, r: np.ndarray, r_fine: np.ndarray, params: np.ndar
         Residual Jacobian ``n x c`` (parameters and nuisance columns).
     r, r_fine : numpy.ndarray
         Residuals [any unit, the same as ``J``'s rows] of the coarse and the fine simulation.
-    params : numpy.ndarray
-        Indices of the columns of ``J`` that are parameters (the others are nuisance: marginalised).
+    params : numpy.ndarray, optional
+        Indices of the columns of ``J`` that are parameters (the others are nuisance: marginalised);
+        all columns if omitted.
     values : numpy.ndarray, optional
         The parameters' values in ``J``'s columns; their standard errors are then taken at least
         :data:`RELATIVE_FLOOR` times ``|values|``.
+    centred : bool
+        The residuals carry a profiled-out constant (the closed-loop replay's initial position,
+        :mod:`prefriction.identify.closed_loop_fit`): ``r`` and ``r_fine`` are centred first and
+        ``s^2 = |r - mean(r)|^2 / n``.
 
     Returns
     -------
     float
         ``max_i |d_i| / se_i`` over ``params``, ``d = (J^T J)^+ J^T (r_fine - r)`` and
-        ``se_i = s sqrt((J^T J)^+_ii)``, ``s^2 = |r|^2 / (n - c)`` (at least ``RELATIVE_FLOOR |values_i|``);
-        ``inf`` if a residual is not finite.
+        ``se_i = s sqrt((J^T J)^+_ii)``, ``s^2 = |r|^2 / (n - c)`` (centred: ``|r - mean(r)|^2 / n``; at
+        least ``RELATIVE_FLOOR |values_i|``); ``inf`` if a residual is not finite.
     """
+    params = np.arange(J.shape[1]) if params is None else params
     if not (np.all(np.isfinite(r)) and np.all(np.isfinite(r_fine))) or params.size == 0:
         return float("inf") if params.size else 0.0
+    if centred:
+        r, r_fine = r - r.mean(), r_fine - r_fine.mean()
     H = np.linalg.pinv(J.T @ J)
     d = H @ (J.T @ (r_fine - r))
-    s2 = float(r @ r) / max(r.size - J.shape[1], 1)
+    s2 = float(r @ r) / (r.size if centred else max(r.size - J.shape[1], 1))
     se = np.sqrt(np.clip(np.diag(H)[params] * s2, 1e-300, None))
     if values is not None:
         se = np.maximum(se, RELATIVE_FLOOR * np.abs(values[params]))
