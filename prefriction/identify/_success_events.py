@@ -5,10 +5,11 @@ every sample, velocity reversal and in-branch event), independent of the fitter:
 driven both ways by a two-tone force with an offset of 0.1 N, 0.1 time units ``sqrt(m / sigma)``
 per sample, the position rounded to an encoder step of 0.005 pre-sliding distances ``Fc / sigma``
 after Gaussian noise of 0.003 of them. Each fit starts every free parameter (mass and offset
-included) at the truth times a factor drawn log-uniformly in ``[1 / d, d]`` (a GMS ``Fs`` at
-least 1.05 ``Fc``). A fit *converges* when the solver says so, *lands* when every estimate is
-within 5 % of its true value (the offset within 5 % of ``Fc``), and *covers* when every 95 %
-interval holds the true value.
+included) at the truth times a factor drawn log-uniformly in ``[1 / d, d]`` (a GMS or
+ElastoPlastic ``Fs`` at least 1.05 ``Fc``, an ElastoPlastic ``z_ba`` at most 0.95 ``Fc / sigma0``).
+A fit *converges* when the solver says so, *lands* when every estimate is within 5 % of its true
+value (the offset within 5 % of ``Fc``), and *covers* when every 95 % interval holds the true
+value.
 
 The estimates of a Maxwell-slip fit are strongly correlated (one soft direction carries most of
 every parameter's variance), so one fit's intervals fail together and a handful of fits says little
@@ -39,6 +40,7 @@ from scipy.stats import t as student_t
 from prefriction.identify.data import Motion
 from prefriction.identify.synthetic_events import EventRun, event_motion
 from prefriction.models.base import FrictionModel
+from prefriction.models.elasto_plastic import ElastoPlastic
 from prefriction.models.gms import GMS
 from prefriction.models.maxwell_slip import MaxwellSlip
 
@@ -65,6 +67,8 @@ EVENT_STAGES = (
     EventStage("Maxwell-slip(3) + offset", MaxwellSlip([6e4, 3e4, 1e4], [0.3, 0.4, 0.3])),
     EventStage("GMS(2) + offset", GMS(k=[6e4, 4e4], alpha=[0.4, 0.6], Fc=1.0, Fs=1.3, vs=1e-3, C=50.0),
                ("alpha[0]", "alpha[1]", "vs", "delta", "sigma2", "damping[0]", "damping[1]")),
+    EventStage("ElastoPlastic + offset", ElastoPlastic(sigma0=1e5, sigma1=100.0, sigma2=10.0, Fc=1.0, Fs=1.5,
+                                                       vs=5e-3, z_ba=5e-6)),
 )
 
 
@@ -121,6 +125,8 @@ def _start(stage: EventStage, d: float, rng: np.random.Generator) -> tuple[Frict
     vals = {k: (v * d ** rng.uniform(-1.0, 1.0) if k in space.free else v) for k, v in space.start.items()}
     if "Fs" in vals:
         vals["Fs"] = max(vals["Fs"], 1.05 * vals["Fc"])
+    if "z_ba" in vals:   # ElastoPlastic: breakaway before the start's pre-sliding distance
+        vals["z_ba"] = min(vals["z_ba"], 0.95 * vals["Fc"] / vals["sigma0"])
     return space.build(vals), MASS * d ** rng.uniform(-1.0, 1.0)
 
 
@@ -226,7 +232,7 @@ def main(argv: list[str] | None = None) -> None:
     p.add_argument("--samples", type=int, default=1000)
     p.add_argument("--distance", type=float, default=2.0)
     p.add_argument("--draws", type=int, default=0, help="linear draws per fit (coverage by linearisation)")
-    p.add_argument("--model", choices=[s.name.split("(")[0] for s in EVENT_STAGES], default=None)
+    p.add_argument("--model", choices=[s.name.split("(")[0].split(" ")[0] for s in EVENT_STAGES], default=None)
     p.add_argument("--fix", default="", help="comma-separated parameters also held at their true values "
                                              "(e.g. C,Fs: those a record sliding much faster than vs cannot pin)")
     a = p.parse_args(argv)

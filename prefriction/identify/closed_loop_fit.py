@@ -54,6 +54,7 @@ import numpy as np
 
 from prefriction._blas_threads import one_blas_thread
 from prefriction._validation import check_count, check_positive
+from prefriction.errors import SolverError
 from prefriction.identify.data import Motion
 from prefriction.identify.digital_loop import DigitalLoop
 from prefriction.identify.encoder import grid_step, rounding_covariance, widened
@@ -225,10 +226,38 @@ def simulate_closed_loop(model: FrictionModel, loop: DigitalLoop, t: Any, r: Any
     return x, u
 
 
+def _loop_substeps(model: FrictionModel, data: Motion, mass: float, requested: int | None) -> int:
+    """RK4 sub-steps per sample: ``requested`` (checked), or the Motion fit's step rule
+    (:func:`prefriction.identify.shooting._substeps`) at the start values and the record's
+    finite-difference velocity, at least 2 (2 for a model without a friction state)."""
+    if requested is not None:
+        return check_count("substeps", requested, 1, 64)
+    if not model.n_states:
+        return 2
+    from prefriction.identify.shooting import _substeps
+
+    v = np.gradient(np.asarray(data.x, dtype=float), np.asarray(data.t, dtype=float))
+    return max(2, _substeps(model, data, mass, v, None))
+
+
+def _require_finite(dx: np.ndarray, du: np.ndarray, t: np.ndarray, theta: np.ndarray, space: Any,
+                    n_sub: int) -> None:
+    """Raise :class:`SolverError` where the loop's sensitivities stop being finite (an RK4 step
+    outside its stability region for the model's fastest rate at ``theta``)."""
+    bad = ~(np.isfinite(dx).all(axis=1) & np.isfinite(du).all(axis=1))
+    if bad.any():
+        k = int(np.argmax(bad))
+        vals = space.values(theta)
+        raise SolverError(f"fit_closed_loop: the loop's sensitivities are not finite from sample {k} "
+                          f"(t = {t[k]:.6g} s) at {', '.join(f'{n} = {vals[n]:.6g}' for n in space.free)}: "
+                          f"{n_sub} RK4 sub-steps per sample are too coarse for the friction state's fastest "
+                          f"rate there; give substeps= larger (up to 64), or start nearer the data")
+
+
 def fit_closed_loop(model: FrictionModel, data: Motion, loop: DigitalLoop, reference: Any, *, offset: bool = True,
                     extra: Any = None, free: Sequence[str] | None = None, fixed: Sequence[str] | None = None,
                     bounds: dict | None = None, mass0: float | None = None, offset0: float = 0.0,
-                    forces: bool = True, substeps: int = 2, max_iter: int = 100, tol: float = 1e-8,
+                    forces: bool = True, substeps: int | None = None, max_iter: int = 100, tol: float = 1e-8,
                     identifiability_limit: float = 0.5, recorded: bool = True) -> FitResult:
     """Fit a friction model (and mass, offset) to a closed-loop record by simulating the loop.
 
@@ -256,8 +285,11 @@ def fit_closed_loop(model: FrictionModel, data: Motion, loop: DigitalLoop, refer
         Start of the offset [N].
     forces : bool, default True
         Fit the recorded forces too (both channels weighted by their residual spread).
-    substeps : int, default 2
-        Runge-Kutta sub-steps per sample (1 to 64).
+    substeps : int, optional
+        Runge-Kutta sub-steps per sample (1 to 64). Default: the Motion fit's step rule at the
+        start values and the record's top speed (at least 2), so that the friction state's fastest
+        decay stays inside RK4's stability region (LuGre sliding at ``|v|`` relaxes at
+        ``sigma0 |v| / g(v)``); refined after the fit while halving the step moves an estimate.
     max_iter : int, default 100
         Most solver evaluations (per pass; two passes).
     tol : float, default 1e-8
@@ -305,7 +337,7 @@ def fit_closed_loop(model: FrictionModel, data: Motion, loop: DigitalLoop, refer
     fscale = max(float(np.std(data.u)), 1e-300)
     space = ParameterSpace(model, name_list("free", free), name_list("fixed", fixed), bounds,
                            mass=mass0 if data.mass is None else None, offset=fscale if offset else None)
-    n_sub = check_count("substeps", substeps, 1, 64)
+    n_sub = _loop_substeps(model, data, mass0 if data.mass is None else float(data.mass), substeps)
     sim = _Simulator(model, loop, space, data.t.size, n_sub, data.mass is None)
     theta0 = space.theta0.copy()
     if offset:
@@ -324,6 +356,7 @@ def fit_closed_loop(model: FrictionModel, data: Motion, loop: DigitalLoop, refer
             if key not in memo:   # the solver asks the Jacobian where it evaluated the residuals
                 memo.clear()
                 x, u, dx, du = run(th)
+                _require_finite(dx, du, data.t, th, space, n_sub)
                 rx = x - xm[:x.size]
                 if shift:   # an open-loop replay from x0 + c is the replay from x0 plus c
                     rx, dx = rx - rx.mean(), dx - dx.mean(axis=0)
@@ -402,11 +435,11 @@ def fit_closed_loop(model: FrictionModel, data: Motion, loop: DigitalLoop, refer
             warnings.warn(f"fit_closed_loop: {steps[-1]}", ConvergenceWarning, stacklevel=2)
     res, jac = fns
     rx, ru, _, _ = ch(theta)
-    J, rr = jac(theta), res(theta)
-    est = theta * space.scale
-    names = list(space.free)
-    stats = gauss_newton(J, rr, names, est, space.scale, limit=identifiability_limit)
-    stats, lag = sandwich(J, rr, stats, est, space.scale, channels=2 if both else 1, names=names,
+    rr, vals, names = res(theta), space.values(theta), list(space.free)
+    est = np.array([vals[n] for n in names])   # physical values: Fs, not its excess over Fc; z_ba, not its fraction
+    J, scale = space.physical_jacobian(jac(theta), theta)
+    stats = gauss_newton(J, rr, names, est, scale, limit=identifiability_limit)
+    stats, lag = sandwich(J, rr, stats, est, scale, channels=2 if both else 1, names=names,
                           limit=identifiability_limit)
     if route == "recorded" and data.quantum == 0.0 and (q := grid_step(xm)) > 0.0:
         warnings.warn(f"the positions lie on a grid of {q:.3g} m (an encoder) that data does not declare: the "
@@ -414,20 +447,19 @@ def fit_closed_loop(model: FrictionModel, data: Motion, loop: DigitalLoop, refer
                       f"declare it, Motion(..., quantum={q:.3g}, x_noise=...) (docs/identify_closed_loop.md)",
                       NoisyPositionsWarning, stacklevel=2)
     if route == "recorded" and data.quantum > 0.0:   # the rounding error shared by samples on the same grid place
-        W = np.linalg.pinv(J.T @ J) @ J.T * (space.scale[:, None] / w[0])
+        W = np.linalg.pinv(J.T @ J) @ J.T * (scale[:, None] / w[0])
         stats = widened(stats, rounding_covariance(W, rx + xm, float(data.x_noise), float(data.quantum)), est)
     for name, reason in stats.unidentifiable:
         warnings.warn(f"the data cannot identify {name}: {reason}; fix it or excite it", IdentifiabilityWarning,
                       stacklevel=2)
-    lows = {n: space.low[n] for n in names}
-    highs = {n: space.high[n] for n in names}
+    lows, highs = space.limits(vals)
+    floor = {hi: max(float(stats.low[names.index(lo)]), lows[lo]) for hi, lo in space.excess.items()}
     low, high, flags = at_bounds(names, est, stats.low, stats.high, space.scale, lows, highs,
                                  {n: space.why_low.get(n, "the declared range") for n in names},
-                                 {n: space.why_high.get(n, "the declared range") for n in names})
+                                 {n: space.why_high.get(n, "the declared range") for n in names}, floor)
     if not sol.status > 0:
         warnings.warn(f"fit_closed_loop stopped without converging ({sol.message}); the estimates are its last: "
                       f"raise max_iter or start closer (identify.inverse_start)", ConvergenceWarning, stacklevel=2)
-    vals = space.values(theta)
     fitted_mass = vals["mass"] if data.mass is None else float(data.mass)
     x_sim, u_sim = rx + xm, ru + um
     stats = dataclasses.replace(stats, sigma_hat=float(np.sqrt(np.sum(rx ** 2) / stats.dof)))

@@ -239,7 +239,7 @@ def _fit_prescribed(model: FrictionModel, data: ForceDisplacement, free: Any, fi
     sol = fit_prescribed(model, data, space, n_sub=substeps, max_iter=max_iter, tol=tol)
     values = space.values(sol.w[:-1])
     est = np.array([values[n] for n in space.free])
-    J, scale = space.physical_jacobian(sol.jacobian)
+    J, scale = space.physical_jacobian(sol.jacobian, sol.w[:-1])
     stats = gauss_newton(J, sol.residuals, space.free, est, scale, limit=limit, covariance="hac",
                          extra=sol.extra_covariance)
     nuisance = {"initial force F0 [N]": float(sol.prediction[0])}
@@ -493,7 +493,7 @@ def _motion_statistics(space: ParameterSpace, sol: Any, limit: float) -> tuple[d
     """Values by name, the free estimates and their statistics of a Motion solution."""
     values = space.values(sol.w[: space.n_free])
     est = np.array([values[n] for n in space.free])
-    J, scale = space.physical_jacobian(sol.jacobian)
+    J, scale = space.physical_jacobian(sol.jacobian, sol.w[: space.n_free])
     return values, est, gauss_newton(J, sol.residuals, space.free, est, scale, constraints=sol.constraints,
                                      limit=limit, covariance="hac")
 

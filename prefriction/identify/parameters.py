@@ -101,6 +101,23 @@ def _relations(model: FrictionModel) -> list[tuple[str, str]]:
     return [("Fc", "Fs")] if isinstance(model, (LuGre, ElastoPlastic, GMS)) else []
 
 
+def _fractions(model: FrictionModel) -> list[tuple[str, str, str]]:
+    """``(name, num, den)`` entry names with ``value[name] < value[num] / value[den]`` required by the
+    model's constructor: ElastoPlastic's ``z_ba < Fc / sigma0`` (each term of a sum under its
+    qualified names)."""
+    from prefriction.models.elasto_plastic import ElastoPlastic
+    from prefriction.models.parallel import Parallel
+
+    if isinstance(model, Parallel):
+        entries = _entries(model)
+        out = []
+        for i, m in enumerate(model.models):
+            local = {e.local: e.name for e in entries if e.part == i}
+            out += [(local[a], local[b], local[c]) for a, b, c in _fractions(m)]
+        return out
+    return [("z_ba", "Fc", "sigma0")] if isinstance(model, ElastoPlastic) else []
+
+
 class ParameterSpace:
     """Which of a model's parameters (and the mass) a fit moves, their start values and bounds.
 
@@ -179,6 +196,13 @@ class ParameterSpace:
         """``{high: low}`` of the relations with both ends free: ``high`` is moved as ``high - low``."""
         for lo_name, hi_name in _relations(model):
             self._relate(lo_name, hi_name)
+        self.fraction: dict[str, tuple[str, str]] = {}
+        """``{name: (num, den)}`` of the bounds ``name < num / den`` with ``name`` free: ``name`` is moved
+        as ``q = value[name] (value[den] / value[num]) (start[num] / start[den])``, bounded by
+        ``start[num] / start[den]`` (the start values of ``num`` and ``den`` are their scales, or
+        their fixed values: inputs of the compiled steps, so one step serves every start)."""
+        for name, num, den in _fractions(model):
+            self._bound_by_ratio(name, num, den)
         for name in self.free:
             if self._scale[name] == 0.0:
                 raise ValueError(f"the start value of {name} is 0: a fitted parameter needs a non-zero start "
@@ -202,6 +226,24 @@ class ParameterSpace:
             gap = self.start[hi_name] - self.start[lo_name]
             self._scale[hi_name] = gap if gap > _OPEN * abs(self.start[hi_name]) else 0.1 * abs(self.start[hi_name])
             self.why_low[hi_name] = f"{lo_name} ({why})"
+
+    def _bound_by_ratio(self, name: str, num: str, den: str) -> None:
+        """Make ``value[name] < value[num] / value[den]`` part of the problem (positive values)."""
+        free, why = set(self.free), f"{name} < {num} / {den}"
+        if name in free:
+            ratio = self.start[num] / self.start[den]
+            if self.start[name] >= ratio:
+                raise ValueError(f"the start value {name} = {self.start[name]!r} must be below {num} / {den} = "
+                                 f"{ratio!r}: the model needs {why}")
+            if name not in self.excess and self.high[name] >= ratio:
+                self.fraction[name] = (num, den)
+                self.high[name], self.why_high[name] = ratio * (1.0 - _OPEN), f"{num} / {den} ({why})"
+        elif num in free and den not in free and self.start[name] * self.start[den] > self.low[num]:
+            self.low[num] = self.start[name] * self.start[den] * (1.0 + _OPEN)
+            self.why_low[num] = f"the fixed {name} and {den} ({why})"
+        elif den in free and num not in free and self.start[num] / self.start[name] < self.high[den]:
+            self.high[den] = self.start[num] / self.start[name] * (1.0 - _OPEN)
+            self.why_high[den] = f"the fixed {name} and {num} ({why})"
 
     def _set_bound(self, name: str, lim: Any, names: list[str]) -> None:
         if name not in names:
@@ -260,6 +302,9 @@ class ParameterSpace:
             out[n] = fixed[i]
         for hi_name, lo_name in self.excess.items():
             out[hi_name] = out[lo_name] + out[hi_name]
+        ref = {n: scale[i] for i, n in enumerate(self.free)} | {n: fixed[i] for i, n in enumerate(self.fixed)}
+        for name, (num, den) in self.fraction.items():   # start[num] / start[den] from the inputs, not baked in
+            out[name] = out[name] * (out[num] / out[den]) * (ref[den] / ref[num])
         return out
 
     def values(self, theta: np.ndarray) -> dict[str, float]:
@@ -272,6 +317,8 @@ class ParameterSpace:
                 else max(float(theta[i]) * sc[i], 0.0)
         for hi_name, lo_name in self.excess.items():
             out[hi_name] = min(out[lo_name] + out[hi_name], self.high[hi_name])
+        for name, (num, den) in self.fraction.items():
+            out[name] = out[name] * (out[num] / out[den]) * (self.start[den] / self.start[num])
         return out
 
     def limits(self, values: dict[str, float]) -> tuple[dict[str, float], dict[str, float]]:
@@ -280,14 +327,19 @@ class ParameterSpace:
         low = dict(self.low)
         for hi_name, lo_name in self.excess.items():
             low[hi_name] = max(low[hi_name], values[lo_name])
-        return low, dict(self.high)
+        high = dict(self.high)
+        for name, (num, den) in self.fraction.items():
+            high[name] = values[num] / values[den]
+        return low, high
 
-    def physical_jacobian(self, J: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def physical_jacobian(self, J: np.ndarray, theta: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
         """``J`` (columns: the scaled free entries first) with respect to ``p / s`` instead,
         ``s`` the start values (the offset's force scale), and ``s``: what the statistics of the
-        physical parameters need when a related pair is moved as an excess."""
+        physical parameters need when a related pair is moved as an excess, or an entry bounded
+        by a ratio as its fraction (then ``theta``, the scaled free entries where ``J`` was taken,
+        is required)."""
         s = np.array([abs(self.start[n]) if n in self.excess else self._scale[n] for n in self.free])
-        if not self.excess:
+        if not self.excess and not self.fraction:
             return J, s
         k = self.n_free
         M = np.eye(k)
@@ -297,6 +349,18 @@ class ParameterSpace:
             M[i, i] = s[i] / sc[i]       # d theta_excess / d (p_high / s_high)
             M[i, j] = -s[j] / sc[i]      # d theta_excess / d (p_low / s_low)
             M[j, j] = s[j] / sc[j]
+        if self.fraction:
+            if theta is None:
+                raise ValueError(f"physical_jacobian needs theta: {sorted(self.fraction)} moved as fractions")
+            p = self.values(theta)
+            for name, (num, den) in self.fraction.items():
+                i = self.free.index(name)
+                c = (self.start[num] / self.start[den]) * p[den] / p[num] / sc[i]  # theta_i = c' p_name den / num
+                M[i, i] = c * s[i]
+                if den in self.free:
+                    M[i, self.free.index(den)] = c * p[name] / p[den] * s[self.free.index(den)]
+                if num in self.free:
+                    M[i, self.free.index(num)] = -c * p[name] / p[num] * s[self.free.index(num)]
         J = np.array(J, dtype=float, copy=True)
         J[:, :k] = J[:, :k] @ M
         return J, s

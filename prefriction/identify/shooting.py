@@ -527,6 +527,8 @@ def _solve(model: FrictionModel, data: Motion, space: ParameterSpace, theta0: np
     ``least_sub``: fewest automatic sub-steps (those a window's fit found necessary)."""
     sol = _solve_record(model, data, space, theta0, n_sub, max_iter, tol, reversals, progress, weight, False,
                         least_sub)
+    if n_sub is None and model.n_events:
+        sol = _event_substeps(data, space, sol, max_iter, tol, reversals, progress, steps)
     if sol.success:
         return sol
     _x, v, _a = derivatives(data.t, data.x, _NODE_WINDOW)
@@ -541,6 +543,30 @@ def _solve(model: FrictionModel, data: Motion, space: ParameterSpace, theta0: np
                  f"the segments of long hovers then started pieces of the chain, from its estimates: "
                  + ("converged" if again.success else "did not converge either, the whole chain's result kept"))
     return again if again.success else sol
+
+
+def _event_substeps(data: Motion, space: ParameterSpace, sol: MotionSolution, max_iter: int, tol: float,
+                    reversals: Any, progress: Any, steps: list[str]) -> MotionSolution:
+    """A model with in-branch events keeps the sub-steps of its start (no doubling check,
+    :func:`_refine_substeps`); where :func:`_substeps` at the estimates asks for more (a start's
+    softer stiffness had chosen too few), the fit is solved again from the estimates with that many,
+    kept if it converges or the first did not. Notes go to ``steps``."""
+    theta = sol.w[: space.n_free]
+    if not np.all(np.isfinite(theta)):
+        return sol
+    vals = space.values(theta)
+    fitted = space.build(vals)
+    _x, v, _a = derivatives(data.t, data.x, _NODE_WINDOW)
+    need = _substeps(fitted, data, vals["mass"] if "mass" in space.free else float(data.mass), v, None)
+    if need <= sol.n_sub:
+        return sol
+    again = _solve_record(fitted, data, space, theta, None, max_iter, tol, reversals, progress, 10.0, False, need)
+    keep = again.success or not sol.success
+    steps.append(f"samples {len(data)}: {sol.n_sub} RK4 sub-steps per sample from the start values, {need} from the "
+                 f"estimates ({'converged' if sol.success else 'not converged'}); solved again from them with "
+                 f"{again.n_sub}: {'converged' if again.success else 'did not converge'}, "
+                 f"{'its result kept' if keep else 'the first result kept'}")
+    return again if keep else sol
 
 
 def start_error(model: FrictionModel, data: Motion, space: ParameterSpace) -> float:

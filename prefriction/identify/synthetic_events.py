@@ -18,6 +18,10 @@ every velocity reversal and every in-branch event, each located as a terminal ev
   ``s F_i = alpha_i S(v)``, ``S(v) = Fc + (Fs - Fc) exp(-|v / vs|^delta)`` (event), then slips,
   ``F_i' = s C (1 - s F_i / (alpha_i S(v)))``, until the reversal; ``F = sum (F_i + sigma_i
   F_i' / k_i) + sigma2 v`` (``sigma_i`` the micro-damping).
+- **ElastoPlastic** (Dupont, Hayward, Armstrong, Altpeter 2002, eqs. (7)-(9)): the bristle
+  deflection ``z`` with ``alpha(z, v)`` from its definition; the breakaway ``s z = z_ba`` and the
+  first saturation ``s z = z_ss(v)`` on a branch are the events
+  (:mod:`prefriction.identify.synthetic_elasto_plastic`).
 """
 
 from __future__ import annotations
@@ -31,6 +35,7 @@ from scipy.integrate import solve_ivp
 
 from prefriction.errors import SolverError
 from prefriction.identify.data import Motion
+from prefriction.identify.synthetic_elasto_plastic import ElastoPlasticLaw
 
 __all__ = ["EventRun", "closed_loop_event_record", "event_motion", "event_record"]
 
@@ -67,7 +72,18 @@ class _Laws:
             self.damping = np.asarray(model.damping, dtype=float)
             self.n = self.k.size
         else:
-            raise TypeError(f"event_motion integrates Dahl, MaxwellSlip and GMS, got {name}")
+            raise TypeError(f"event_motion integrates Dahl, MaxwellSlip, GMS and ElastoPlastic, got {name}")
+        self.n_events = self.n
+        self.stiffness = float(self.k.sum()) if hasattr(self, "k") else self.sigma
+        self.state_scale = 1.0
+
+    def watched(self, i: int, sat: np.ndarray) -> bool:
+        """Whether event ``i`` can still happen on this branch."""
+        return not sat[i] and (self.kind != "Dahl" or self.saturating)
+
+    def reverse(self, z: np.ndarray, s: float, sat: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The state and flags after a reversal to ``-s``: the forces kept, every element sticking."""
+        return self.to_state(self.forces(z, s, sat), -s), np.zeros(self.n_events, dtype=bool)
 
     @property
     def saturating(self) -> bool:
@@ -132,7 +148,7 @@ def event_motion(model: Any, mass: float, t: Any, u: Any, *, offset: float = 0.0
 
     Parameters
     ----------
-    model : Dahl, MaxwellSlip or GMS
+    model : Dahl, MaxwellSlip, GMS or ElastoPlastic
         The friction (its numbers only are read).
     mass : float
         Mass [kg].
@@ -155,7 +171,7 @@ def event_motion(model: Any, mass: float, t: Any, u: Any, *, offset: float = 0.0
     -------
     EventRun
     """
-    law = _Laws(model)
+    law: Any = ElastoPlasticLaw(model) if type(model).__name__ == "ElastoPlastic" else _Laws(model)
     t = np.asarray(t, dtype=float)
     u = np.asarray(u, dtype=float) * np.ones(t.size)
     if controller is not None:
@@ -163,10 +179,10 @@ def event_motion(model: Any, mass: float, t: Any, u: Any, *, offset: float = 0.0
             raise ValueError(f"a controller holds its force over each sample: hold must be 'zoh', got {hold!r}")
         u[0] = controller(0, 0.0)
     s = 1.0 if v0 > 0 else -1.0 if v0 < 0 else (1.0 if u[0] - offset >= 0 else -1.0)
-    sat = np.zeros(law.n, dtype=bool)
+    sat = np.zeros(law.n_events, dtype=bool)
     z = law.to_state(np.zeros(law.n), s)
     y = np.r_[0.0, float(v0), z]
-    scale = float(np.max(np.abs(u - offset)) + 1.0) / (law.k.sum() if hasattr(law, "k") else law.sigma)
+    scale = float(np.max(np.abs(u - offset)) + 1.0) / law.stiffness
     xs, vs = [0.0], [float(v0)]
     revs: list[float] = []
     evs: list[float] = []
@@ -182,10 +198,9 @@ def event_motion(model: Any, mass: float, t: Any, u: Any, *, offset: float = 0.0
                 break
             t0 = tend
             if what == "reversal":
-                F = law.forces(y[2:], s, sat)
+                z, sat = law.reverse(y[2:], s, sat)
                 s = -s
-                sat[:] = False
-                y = np.r_[y[0], 0.0, law.to_state(F, s)]
+                y = np.r_[y[0], 0.0, z]
                 revs.append(tend)
             else:
                 sat[what] = True
@@ -196,7 +211,7 @@ def event_motion(model: Any, mass: float, t: Any, u: Any, *, offset: float = 0.0
     return EventRun(np.array(xs), np.array(vs), np.array(revs), np.array(evs))
 
 
-def _piece(law: _Laws, mass: float, offset: float, force: Callable[[float], float], y: np.ndarray, s: float,
+def _piece(law: Any, mass: float, offset: float, force: Callable[[float], float], y: np.ndarray, s: float,
            sat: np.ndarray, t0: float, t1: float, rtol: float, scale: float) -> tuple[np.ndarray, float, Any]:
     """Integrate from ``t0`` towards ``t1`` until the first reversal or event: the state, the
     time reached and what happened (``None``, ``"reversal"`` or the element's index)."""
@@ -209,8 +224,8 @@ def _piece(law: _Laws, mass: float, offset: float, force: Callable[[float], floa
         return s * yy[1]
     reversal.terminal, reversal.direction = True, -1  # type: ignore[attr-defined]
     events: list[Any] = [reversal]
-    for i in range(law.n):
-        if sat[i] or (law.kind == "Dahl" and not law.saturating):
+    for i in range(law.n_events):
+        if not law.watched(i, sat):
             continue
 
         def slip(_tt: float, yy: np.ndarray, i: int = i) -> float:
@@ -218,7 +233,7 @@ def _piece(law: _Laws, mass: float, offset: float, force: Callable[[float], floa
         slip.terminal, slip.direction = True, -1  # type: ignore[attr-defined]
         slip.index = i  # type: ignore[attr-defined]
         events.append(slip)
-    atol = np.r_[rtol * scale, rtol * scale / max(t1 - t0, 1e-300), np.full(y.size - 2, rtol * 1e-3)]
+    atol = np.r_[rtol * scale, rtol * scale / max(t1 - t0, 1e-300), np.full(y.size - 2, rtol * 1e-3 * law.state_scale)]
     sol = solve_ivp(rhs, (t0, t1), y, method="DOP853", rtol=rtol, atol=atol, events=events)
     if sol.status == 1 and sol.t_events[0].size and sol.t_events[0][0] <= t0 + 1e-12 * (t1 - t0):
         reversal.terminal = False  # type: ignore[attr-defined]  # at rest under no net force: no reversal
@@ -252,7 +267,7 @@ def closed_loop_event_record(model: Any, mass: float, dt: float, r: Any, *, Kp: 
 
     Parameters
     ----------
-    model : Dahl, MaxwellSlip or GMS
+    model : Dahl, MaxwellSlip, GMS or ElastoPlastic
         The friction.
     mass : float
         Mass [kg].

@@ -89,8 +89,7 @@ class ElastoPlastic(FrictionModel):
     crossings : bool, default True
         Locate the breakaway and saturation crossings as events (flags ``broke``, ``sat``).
         ``False``: ``alpha`` straight from its definition inside the right-hand side (C1 kinks
-        that the integrators' error control steps over; no flags and no events), the form
-        :func:`prefriction.identify.fit` needs for :class:`~prefriction.identify.Motion` data.
+        that the integrators' error control steps over; no flags and no events).
 
     Raises
     ------
@@ -188,9 +187,10 @@ class ElastoPlastic(FrictionModel):
         return [breakaway, saturation]
 
     def on_event(self, k: int, z: Sequence[Any], m: Sequence[Any], s: Any, q: Any) -> tuple[list[Any], list[Any]]:
-        if k == 0:
-            return [s * q[4]], [1.0, 0.0]
-        return [z[0]], [1.0, 1.0]
+        """``zeta`` kept (``alpha`` is continuous at both crossings: no jump of the state, so a state
+        already past ``b`` or ``g``, such as a Motion fit's shooting node, takes its flags at once);
+        breakaway sets ``broke``, saturation ``sat``."""
+        return [z[0]], ([1.0, 0.0] if k == 0 else [1.0, 1.0])
 
     def reverse(self, z: Sequence[Any], m: Sequence[Any], s_new: Any, q: Any, snap: Any) -> tuple[list[Any], list[Any]]:
         """``zeta`` kept; ``broke`` if ``s_new zeta > b`` (the bristle has not unloaded), ``sat`` cleared."""
