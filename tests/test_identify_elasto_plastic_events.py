@@ -204,3 +204,30 @@ def test_a_fixed_breakaway_bounds_the_free_coulomb_force_or_stiffness():
         lo, hi = space.theta_bounds()
         space.build(space.values(np.where(np.isfinite(hi), hi, 4.0)))
         space.build(space.values(lo))
+
+
+def test_settled_check_works_in_the_fraction_coordinates_of_z_ba():
+    """The settled check of a converged fit (``identify/settled.py``) takes the Jacobian back to the
+    physical parameters through ``z_ba``'s fraction map, which needs the solution's ``theta``:
+    residuals orthogonal to the Jacobian (the minimum) report nothing; residuals that a step in
+    ``sigma1`` alone removes (no other parameter's map involves it) report ``sigma1`` alone."""
+    from types import SimpleNamespace
+
+    from prefriction.identify.fit import _short_of_minimum
+    from prefriction.identify.parameters import ParameterSpace
+
+    space = ParameterSpace(pf.ElastoPlastic(**EP), None, None, None, mass=MASS, offset=1.0)
+    theta = space.theta0 * np.array([1.1, 0.9, 1.2, 0.6, 1.3, 1.1, 1.4, 1.05, 1.0]) + np.r_[np.zeros(8), 0.2]
+    rng = np.random.default_rng(5)
+    J = rng.standard_normal((300, space.n_free))
+    e = rng.standard_normal(300)
+    e -= J @ np.linalg.lstsq(J, e, rcond=None)[0]
+    p = space.values(theta)
+    stats = SimpleNamespace(unidentifiable=(("vs", "not excited"),),
+                            stderr=np.array([1e-6 * abs(p[n]) for n in space.free]))
+    at_minimum = SimpleNamespace(success=True, jacobian=J, residuals=e, w=np.r_[theta, 0.0])
+    assert _short_of_minimum(space, at_minimum, stats, False) == ()
+    step = np.zeros(space.n_free)
+    step[space.free.index("sigma1")] = 1e-3 * theta[space.free.index("sigma1")]
+    off = SimpleNamespace(success=True, jacobian=J, residuals=e + J @ step, w=np.r_[theta, 0.0])
+    assert [n for n, _ in _short_of_minimum(space, off, stats, False)] == ["sigma1"]

@@ -367,11 +367,12 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
                 said += ", the first fit's result kept"
             start = dataclasses.replace(start, steps=start.steps + (
                 f"the fit from these start values ended with {why}; second start from {second[3]}: {said}",))
-    short = _short_of_minimum(space, sol, stats, held_of(space) is not None)
+    held = bool(held_first(space.model, space))
+    short = _short_of_minimum(space, sol, stats, held)
     from prefriction.identify.shooting import WINDOW
 
     # once more, the held stage from where it stopped (a long record: its cost, and the flag, instead)
-    if short and held_of(space) is not None and len(data) <= 2 * WINDOW:
+    if short and held and len(data) <= 2 * WINDOW:
         model2 = space.build(values)
         sol2, space2, err2 = _fit_from((model2, values.get("mass"), values.get("offset", 0.0),
                                         "the estimates where the fit stopped short of its minimum"),
@@ -425,7 +426,7 @@ def _short_of_minimum(space: ParameterSpace, sol: Any, stats: Any, valley: bool)
         return ()
     from prefriction.identify.settled import unsettled
 
-    J, scale = space.physical_jacobian(sol.jacobian)
+    J, scale = space.physical_jacobian(sol.jacobian, sol.w[: space.n_free])
     return unsettled(J, sol.residuals, space.free, scale, stats.stderr, np.array([n not in loose for n in space.free]))
 
 

@@ -497,7 +497,7 @@ def _settled_without(at: FrictionModel, data: Motion, space: ParameterSpace, bef
                                                             atol=1e-9 * float(np.max(np.abs(stage.residuals))))):
         return None    # not the stage's motion (flags of a polished chain): run the free stage
     J = prob.reduced_jacobian(w)
-    Jp, sc = space.physical_jacobian(J * xs)
+    Jp, sc = space.physical_jacobian(J * xs, theta)
     stats = gauss_newton(Jp, r * xs, space.free, np.array([after[n] for n in space.free]), sc, limit=0.5,
                          covariance="hac")
     loose = {n for n, _ in stats.unidentifiable}
