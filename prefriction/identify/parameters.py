@@ -332,12 +332,12 @@ class ParameterSpace:
             high[name] = values[num] / values[den]
         return low, high
 
-    def physical_jacobian(self, J: np.ndarray, theta: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """``J`` (columns: the scaled free entries first) with respect to ``p / s`` instead,
-        ``s`` the start values (the offset's force scale), and ``s``: what the statistics of the
-        physical parameters need when a related pair is moved as an excess, or an entry bounded
-        by a ratio as its fraction (then ``theta``, the scaled free entries where ``J`` was taken,
-        is required)."""
+    def physical_jacobian(self, J: np.ndarray, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``J`` (columns: the scaled free entries first), taken at the scaled free entries
+        ``theta``, with respect to ``p / s`` instead, ``s`` the start values (the offset's force
+        scale), and ``s``: what the statistics of the physical parameters need when a related pair
+        is moved as an excess, or an entry bounded by a ratio as its fraction (whose derivative
+        depends on ``theta``)."""
         s = np.array([abs(self.start[n]) if n in self.excess else self._scale[n] for n in self.free])
         if not self.excess and not self.fraction:
             return J, s
@@ -350,8 +350,6 @@ class ParameterSpace:
             M[i, j] = -s[j] / sc[i]      # d theta_excess / d (p_low / s_low)
             M[j, j] = s[j] / sc[j]
         if self.fraction:
-            if theta is None:
-                raise ValueError(f"physical_jacobian needs theta: {sorted(self.fraction)} moved as fractions")
             p = self.values(theta)
             for name, (num, den) in self.fraction.items():
                 i = self.free.index(name)
