@@ -133,6 +133,7 @@ def test_every_point_of_the_fit_box_is_a_valid_elasto_plastic_model():
         return np.array([raw[n] for n in space.free]) / space.scale
 
     assert np.allclose(theta_of(p), theta, rtol=1e-12, atol=1e-12)
+    assert np.allclose(space.theta_of(p), theta, rtol=1e-12, atol=1e-12)   # the fit's own inverse map
     for j, name in enumerate(space.free):
         h = 1e-6 * s[j]
         up, down = dict(p), dict(p)

@@ -278,8 +278,18 @@ class ParameterSpace:
     @property
     def theta0(self) -> np.ndarray:
         """The scaled start values (1, or ``offset0 / scale``, or the start excess over its scale)."""
-        return np.array([(self.start[n] - self.start[self.excess[n]]) / self._scale[n] if n in self.excess
-                         else self.start[n] / self._scale[n] for n in self.free])
+        return self.theta_of(self.start)
+
+    def theta_of(self, values: dict[str, float]) -> np.ndarray:
+        """The scaled free entries at the physical ``values`` (by name, every free entry and the
+        partners of its relations): the inverse of :meth:`values` inside the bounds (an excess
+        over its partner, a fraction of its ratio bound)."""
+        raw = dict(values)
+        for hi_name, lo_name in self.excess.items():
+            raw[hi_name] = values[hi_name] - values[lo_name]
+        for name, (num, den) in self.fraction.items():
+            raw[name] = values[name] * (values[den] / values[num]) * (self.start[num] / self.start[den])
+        return np.array([raw[n] / self._scale[n] for n in self.free])
 
     def theta_bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """Bounds of the scaled free entries (an excess: ``[0, inf)``)."""

@@ -439,7 +439,7 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
     vals, least, weight, moved = dict(space.start), 1, 0.01, False
     for head, sp_k, given, name in stages:   # continuation (module notes, identify/held_first.py)
         at = sp_k.build(vals) if moved else model
-        stage = _solve(at, head, sp_k, _theta_of(sp_k, vals), n_sub, max_iter, tol, given, progress, weight, steps,
+        stage = _solve(at, head, sp_k, sp_k.theta_of(vals), n_sub, max_iter, tol, given, progress, weight, steps,
                        least)
         if long and head is data and stage.success:  # the full record with the held parameters held
             done = _settled_without(at, data, space, vals, dict(vals, **sp_k.values(stage.w[: sp_k.n_free])),
@@ -456,7 +456,7 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
         steps.append(f"continuation: {name} fitted ({stage.message}); the next stage started from these estimates "
                      f"({_at(sp_k, stage.w)})")
     # the sub-steps of the full record from the last stage's estimates
-    sol = _solve(space.build(vals) if moved else model, data, space, _theta_of(space, vals), n_sub, max_iter, tol,
+    sol = _solve(space.build(vals) if moved else model, data, space, space.theta_of(vals), n_sub, max_iter, tol,
                  reversals, progress, weight, steps, least)
     return dataclasses.replace(sol, steps=tuple(steps))
 
@@ -487,7 +487,7 @@ def _settled_without(at: FrictionModel, data: Motion, space: ParameterSpace, bef
         return None
     xs = max(float(np.ptp(data.x)) * 1e-3, 1e-300)
     prob = _Problem(at, space, data, lay, stage.n_sub, mass_free, mass, xs)
-    theta = _theta_of(space, after)
+    theta = space.theta_of(after)
     _w0, first = _start(at, data, theta, lay, xsm, v, a, mass, before.get("offset", 0.0), 0.5)
     if prob.args["m0"].size:
         prob.args["m0"][:, 0] = first
@@ -509,12 +509,6 @@ def _settled_without(at: FrictionModel, data: Motion, space: ParameterSpace, bef
             f"continuation: the fit of {name} is the solution: with every parameter free the record does not pin "
             f"{', '.join(sorted(loose))} there either, and the other estimates sit within "
             f"{SETTLED:g} standard errors of the linearised minimum (identify/settled.py), so no free stage was run")
-
-
-def _theta_of(space: ParameterSpace, values: dict[str, float]) -> np.ndarray:
-    """The scaled free entries of ``space`` at the physical ``values`` (:attr:`ParameterSpace.scale`)."""
-    return np.array([(values[n] - values[space.excess[n]]) / sc if n in space.excess else values[n] / sc
-                     for n, sc in zip(space.free, space.scale)])
 
 
 def _solve(model: FrictionModel, data: Motion, space: ParameterSpace, theta0: np.ndarray, n_sub: int | None,
