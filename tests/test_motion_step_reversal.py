@@ -4,9 +4,9 @@ A reversal is cut at the Euler-predicted zero of the velocity inside an RK4 sub-
 (``prefriction/identify/motion_step.py``). When that zero falls at the end of a sub-step, the
 Runge-Kutta velocity at the cut may be left a little on the old side of zero. A step that took
 that velocity for a turn back ran the next sub-step on the old branch with the new velocity: the
-bristle of LuGre and of the elasto-plastic model (saturated, ``w ~ 1``) then grew at a rate near 0
-instead of near ``v``, and the end state jumped by ``1e-3`` of ``Fc`` as the start moved the
-reversal across a sub-step boundary. That jump made the continuity defects of the 25,000-sample
+bristle of LuGre and of the elasto-plastic model (loaded, ``w = 1``) then grew at a fraction of
+``v`` (LuGre: a third) instead of at ``v``, and the end state jumped by up to ``2.6e-3`` of ``Fc``
+as the start moved the reversal across a sub-step boundary. That jump made the continuity defects of the 25,000-sample
 ElastoPlastic fit of ``python -m prefriction.identify._success_events`` unresolvable.
 
 Reference: scipy's DOP853 on the equations written out here (LuGre, Canudas de Wit et al. 1995;
