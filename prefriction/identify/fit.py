@@ -24,7 +24,8 @@ from prefriction.models.base import FrictionModel
 __all__ = ["EVENT_MAX_ITER", "fit"]
 
 EVENT_MAX_ITER = 500
-"""Default ``max_iter`` of a Motion fit of a model with in-branch events (:func:`fit`)."""
+"""Default ``max_iter`` of a Motion fit of a model with in-branch events or a free Dahl ``gamma``
+(:func:`fit`)."""
 
 def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequence[str] | None = None,
         fixed: Sequence[str] | None = None, bounds: dict[str, tuple[float, float]] | None = None,
@@ -97,7 +98,9 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
         evaluations for force-displacement data), 1 to 100 000. Default 200, and
         :data:`EVENT_MAX_ITER` (500) for a :class:`Motion` fit of a model with in-branch events
         (Dahl ``gamma < 1``, Maxwell-slip, GMS): its motion is only piecewise smooth in the
-        parameters and a fit from a factor-2 start takes 150 to 300 (``docs/identify_motion.md#limits``).
+        parameters and a fit from a factor-2 start takes 150 to 300 (``docs/identify_motion.md#limits``);
+        also 500 with a free Dahl ``gamma``: ``gamma`` and the stiffness trade off along a long
+        valley, and a 1,000-sample ``gamma = 2`` fit from a factor-2 start took 415.
         A fit that stops there returns with ``success = False`` and a :class:`ConvergenceWarning`.
     tol : float, default 1e-10
         Solver tolerance (relative), ``1e-14 <= tol <= 1e-6``: looser tolerances stop before the
@@ -167,7 +170,8 @@ def fit(model: FrictionModel, data: ForceDisplacement | Motion, *, free: Sequenc
     from prefriction.identify.static_map import StaticFriction
 
     if max_iter is None:
-        max_iter = EVENT_MAX_ITER if isinstance(data, Motion) and getattr(model, "n_events", 0) else 200
+        max_iter = EVENT_MAX_ITER if isinstance(data, Motion) and (getattr(model, "n_events", 0) or
+                                                                   _gamma_free(model, free, fixed)) else 200
     if isinstance(model, StaticFriction) and isinstance(data, Motion):  # the inverse model (identify/inverse.py)
         from prefriction.identify.inverse import fit_inverse
 
@@ -245,6 +249,16 @@ def _fit_prescribed(model: FrictionModel, data: ForceDisplacement, free: Any, fi
     nuisance = {"initial force F0 [N]": float(sol.prediction[0])}
     return _finish(space, values, est, stats, -sol.residuals, sol.prediction, data, None, nuisance, sol.message,
                    sol.success, level=6, limit=limit)
+
+
+def _gamma_free(model: FrictionModel, free: Sequence[str] | None, fixed: Sequence[str] | None) -> bool:
+    """Whether the fit frees the model's Dahl ``gamma`` (:func:`prefriction.identify.structures.gamma_entry`)."""
+    from prefriction.identify.structures import gamma_entry
+
+    name = gamma_entry(model)
+    if name is None:
+        return False
+    return name in free if free is not None else name not in (fixed or ())
 
 
 def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bounds: Any, mass0: Any, offset0: Any,
