@@ -261,3 +261,13 @@ def test_dahl_gamma_two_fits_1000_samples_from_a_factor_two_start():
     the data and the continuation in ``gamma`` each stopped at the cap (415 were needed)."""
     rows = success_table((STAGES[2],), (2.0,), fits=1, samples=1000, seed=0)
     assert rows[0].successes == 1, table_text(rows)
+
+
+def test_a_failed_fit_with_free_gamma_says_what_helps(dahl_record):
+    """A Motion fit with Dahl's ``gamma`` free that stops short says that fixing ``gamma`` (or a
+    larger ``max_iter``) helps."""
+    start, m0, off0 = start_model(DAHL_OPEN, np.random.default_rng(6), 2.0)
+    with pytest.warns(ConvergenceWarning, match="did not converge"):
+        res = identify.fit(start, dahl_record, offset=True, mass0=m0, offset0=off0, max_iter=1)
+    assert not res.success and "gamma" in res.names
+    assert "fixed=['gamma']" in res.message and "max_iter" in res.message

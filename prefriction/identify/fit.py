@@ -410,6 +410,10 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
     if not sol.success:
         advice = _route_advice(data, sol)
         message = f"{message}; {advice}" if advice else message
+        if gamma in space.free:  # measured: docs/identify_motion.md (the Dahl gamma = 2 stage)
+            message += (f"; {gamma} was free: it trades off with the stiffness along a long valley, and a fit with "
+                        f"it fixed (fixed=[{gamma!r}]) at a value from the branch shape (a ForceDisplacement fit) "
+                        f"converges in far fewer evaluations; or give max_iter more")
     mass = values["mass"] if data.mass is None else data.mass
     return _finish(space, values, est, stats, -sol.residuals, sol.prediction, data, mass, sol.nuisance, message,
                    success, start=start.steps + sol.steps, limit=limit)
