@@ -524,60 +524,61 @@ def _settled_without(at: FrictionModel, data: Motion, space: ParameterSpace, bef
 def _valley_secant(prob: _Problem, w: np.ndarray, J: np.ndarray, r: np.ndarray, space: ParameterSpace,
                    at: FrictionModel, n_sub: int, mass_free: bool, stats: Any) -> dict[str, float]:
     """How much wider than the linearisation the sum of squares puts the valley parameters
-    (:func:`prefriction.identify.held_first.valley`) at ``w``: ``{name: factor > 1}``.
+    (:func:`prefriction.identify.held_first.valley`: ``C`` and ``Fs``) at ``w``: ``{name: factor > 1}``.
 
-    The linearisation says that moving a parameter by ``t`` of its standard errors (``t`` the
-    95 % Student quantile), the others following along their regression on it (the conditional
-    direction ``(J^T J)^-1 e_i``), raises ``|r|^2`` by ``t^2 s^2``. The single-shooting chain is
-    evaluated there, on both sides; where the actual rise ``a`` is smaller (a curved, flat valley),
-    the secant standard error is ``sqrt(t^2 s^2 / a)`` times the linear one (the parabola through
-    the two points). Measured on the 25,000-sample GMS(2) record of seed 1 of
-    :mod:`prefriction.identify._success_events`, held at ``C = 27.8``: the sum of squares at the truth
-    ``C = 50`` (the others refitted) lies 0.35 residual variances above, while the linear standard
-    error of ``C`` was 36 % (the truth 2.2 of them away, outside the interval).
+    The linearisation says that ``C`` held ``t`` of its standard errors away (``t`` the 95 % Student
+    quantile), the others refitted, raises ``|r|^2`` by ``t^2 s^2``. The profile is computed at both
+    ends (``C`` held, the others and the first node refitted by the Levenberg-Marquardt steps of
+    :func:`_polish`); where the actual rise ``a`` is smaller (a curved, flat valley), ``C``'s secant
+    standard error is ``sqrt(t^2 s^2 / a)`` times the linear one (the parabola through the points),
+    and ``Fs``'s is widened to reach the ``Fs`` of the profile's ends, scaled alike. Measured on the
+    25,000-sample GMS(2) record of seed 1 of :mod:`prefriction.identify._success_events`, held at
+    ``C = 27.8``: the profile at the truth ``C = 50`` lies 0.35 residual variances above, while the
+    linear standard error of ``C`` was 36 % (the truth 2.2 of them away, outside the interval); the
+    others following linearly (no refit) rise by more than ``t^2 s^2``.
     """
     from prefriction.identify.held_first import valley
     from scipy.stats import t as student_t
 
-    names = [n for n in valley(at, space) if n in space.free]
-    if not names:
+    names = valley(at, space)
+    if not names or names[0] not in space.free:
         return {}
     single = segment_functions(at, space, prob.lay.K, n_sub, mass_free, prob.native)[0]
     lo, hi = space.theta_bounds()
-    nth = prob.nth
     wc = prob.carry_states(w, single, everything=True)
     rc, gc = prob.plain_eval(wc)
     if not (np.all(np.isfinite(rc)) and np.all(np.isfinite(gc))):
         prob.clear_flags()
         return {}
-    k = space.n_free
-    M = space.physical_jacobian(np.eye(k), w[:k])[0]          # theta = M z, z = p / s
-    Jz = J.copy()
-    Jz[:, :k] = J[:, :k] @ M
-    P = np.linalg.pinv(Jz.T @ Jz)
-    s2 = float(rc @ rc) / max(rc.size - Jz.shape[1], 1)
+    s2 = float(rc @ rc) / max(rc.size - J.shape[1], 1)
     tq = float(student_t.ppf(0.975, stats.dof))
-    where = prob.columns()
-    out: dict[str, float] = {}
-    for name in names:
-        i = space.free.index(name)
-        if not P[i, i] > 0.0:
+    i = space.free.index(names[0])
+    se_i = float(stats.stderr[i]) / abs(float(space.scale[i]))       # in theta
+    base = space.values(wc[: prob.nth])
+    factor, partner = 1.0, 1.0
+    for sign in (1.0, -1.0):
+        trial = wc.copy()
+        trial[i] = min(max(wc[i] * math.exp(sign * tq * se_i / wc[i]), lo[i]), hi[i])   # C > 0: compounded
+        trial = prob.carry_states(trial, single, everything=True)
+        prof, _note = _polish(prob, trial, single, lo, hi, valley=True, hold=(i,))
+        rt, gt = prob.plain_eval(prob.carry_states(prof, single, everything=True))
+        if not (np.all(np.isfinite(rt)) and np.all(np.isfinite(gt))):
             continue
-        step = P[:, i] / math.sqrt(P[i, i]) * tq * math.sqrt(s2)
-        rise = math.inf
-        for sign in (1.0, -1.0):
-            dz = sign * step
-            trial = wc.copy()
-            trial[where] += np.r_[M @ dz[:k], dz[k:]]
-            trial[:nth] = np.clip(trial[:nth], lo, hi)
-            trial = prob.carry_states(trial, single, everything=True)
-            rt, gt = prob.plain_eval(trial)
-            if np.all(np.isfinite(rt)) and np.all(np.isfinite(gt)):
-                rise = min(rise, max(float(rt @ rt - rc @ rc), 0.0))
-        if math.isfinite(rise) and rise < tq * tq * s2:
-            out[name] = min(math.sqrt(tq * tq * s2 / max(rise, 1e-12 * s2)), 1e6)
+        rise = max(float(rt @ rt - rc @ rc), 1e-12 * s2)
+        if rise >= tq * tq * s2:
+            continue
+        f = math.sqrt(tq * tq * s2 / rise)
+        reach = abs(math.log(prof[i] / wc[i])) * wc[i] / (tq * se_i)   # the distance held, in t se
+        factor = max(factor, f * reach)
+        if len(names) > 1 and names[1] in space.free:
+            j = space.free.index(names[1])
+            moved = abs(space.values(prof[: prob.nth])[names[1]] - base[names[1]])
+            partner = max(partner, f * moved / (tq * float(stats.stderr[j])))
     prob.carry_states(w, single, everything=True)
     prob.clear_flags()
+    out = {names[0]: factor} if factor > 1.0 else {}
+    if partner > 1.0:
+        out[names[1]] = partner
     return out
 
 
@@ -837,7 +838,7 @@ def _damped(J: np.ndarray, r: np.ndarray, lam: float) -> np.ndarray:
 
 
 def _polish(prob: _Problem, w: np.ndarray, single: ca.Function, lo: np.ndarray,
-            hi: np.ndarray, valley: bool = False) -> tuple[np.ndarray, str]:
+            hi: np.ndarray, valley: bool = False, hold: tuple[int, ...] = ()) -> tuple[np.ndarray, str]:
     """Gauss-Newton steps on the single-shooting problem from the multiple-shooting solution ``w``.
 
     The multiple-shooting solution meets the continuity of the segments to :data:`GTOL` of the
@@ -864,6 +865,8 @@ def _polish(prob: _Problem, w: np.ndarray, single: ca.Function, lo: np.ndarray,
     about ``c s^2``; a polished chain whose ``|r|^2`` exceeds the segments' by more drifts from the
     data (an open-loop replay of a long record) and the multiple-shooting solution is kept.
 
+    ``hold``: indices of parameters held at their values in ``w`` (a profile of the sum of squares).
+
     Returns
     -------
     (numpy.ndarray, str)
@@ -882,6 +885,7 @@ def _polish(prob: _Problem, w: np.ndarray, single: ca.Function, lo: np.ndarray,
         margin = 1e-9 * np.maximum(1.0, np.abs(w[:nth]))
     where = prob.columns()
     inside = np.r_[(w[:nth] - lo > margin) & (hi - w[:nth] > margin), np.ones(where.size - nth, dtype=bool)]
+    inside[list(hold)] = False   # held at their values in w (a profile, _valley_secant)
     cols = np.flatnonzero(inside)
     taken, largest, lam = 0, 0.0, 1e-3
     for _ in range(VALLEY_STEPS if valley else POLISH_STEPS):
