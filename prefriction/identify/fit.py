@@ -394,7 +394,7 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
                                               for n in held_first(space.model, space))
         message, success = f"{unsettled_message(short, loose)}; solver: {message}", False
     if not sol.success:
-        advice = _route_advice(data)
+        advice = _route_advice(data, sol)
         message = f"{message}; {advice}" if advice else message
     mass = values["mass"] if data.mass is None else data.mass
     return _finish(space, values, est, stats, -sol.residuals, sol.prediction, data, mass, sol.nuisance, message,
@@ -523,14 +523,23 @@ def _start_error(error: Any, model: FrictionModel, data: Motion, space: Paramete
         return math.inf
 
 
-def _route_advice(data: Motion) -> str:
+def _route_advice(data: Motion, sol: Any = None) -> str:
     """The route :func:`prefriction.identify.recommend` advises when it is not this open-loop fit
-    (a long closed-loop record on which an open-loop replay drifts), else ``""``."""
+    (a long closed-loop record on which an open-loop replay drifts), else ``""``; also ``""``
+    where the failed fit ``sol``'s own chain from the first sample (``MotionSolution.chain``)
+    follows the record by the route's own test (within its tolerance for an eighth of the
+    record): the static inverse model's replay drifts on a record ruled by pre-sliding, open
+    loop or not."""
     from prefriction.identify.routes import recommend
 
     rec = recommend(data)
     if rec.route == "motion":
         return ""
+    chain = getattr(sol, "chain", None)
+    if chain is not None:
+        left = np.flatnonzero(~(np.abs(chain) <= rec.tolerance))
+        if (int(left[0]) if left.size else chain.size) >= len(data) // 8:
+            return ""
     call = "identify.fit_inverse" if rec.route == "inverse" else "identify.fit_closed_loop"
     return f"this record suits another route ({rec}): use {call} (docs/identify_closed_loop.md)"
 

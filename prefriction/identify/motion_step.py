@@ -89,7 +89,9 @@ def step_function(model: FrictionModel, n_sub: int) -> ca.Function:
         tau = k * h
         a0 = rhs(s, fl)(yl, tau)[1]
         v0, v1 = yl[1], yl[1] + h * a0
-        turn = ca.logic_or(s * v0 < 0.0, s * v1 < 0.0)
+        # a velocity the last cut left a little on the old side of zero (s v0 < 0, s v1 > 0) is no turn: taken for
+        # one, the next sub-step ran on the old branch and the end state jumped as the cut crossed a boundary
+        turn = s * v1 < 0.0
         frac = ca.if_else(turn, ca.if_else(s * v0 > 0.0, v0 / (v0 - v1), 0.0), 1.0)
         if passes:
             ya, fa = _branch(model, rhs, yl, fl, s, tau, frac * h, passes, V, q)

@@ -90,6 +90,10 @@ class MotionSolution:
     n_sub: int = 0
     widen: dict | None = None
     """``{name: factor}``: standard errors the statistics widen (:func:`_valley_secant`)."""
+    chain: np.ndarray | None = None
+    """Of a fit that did not converge: the position residuals [m] of the single-shooting chain
+    from the first node at ``w`` (each piece of the chain from its own start), for the route
+    check of :func:`prefriction.identify.fit`."""
 
 
 @dataclass(frozen=True)
@@ -748,7 +752,16 @@ def _solve_record(model: FrictionModel, data: Motion, space: ParameterSpace, the
                           f"multiple shooting, {lay.J} segments of {lay.K} samples, {n_sub} RK4 sub-steps per "
                           f"sample{_pieces(lay)}, scipy least_squares in an augmented Lagrangian: "
                           f"{out.message}{polished}",
-                          out.success, n_sub=n_sub)
+                          out.success, n_sub=n_sub, chain=None if out.success else _chain(prob, w, single) * xs)
+
+
+def _chain(prob: _Problem, w: np.ndarray, single: ca.Function) -> np.ndarray:
+    """Scaled position residuals of the single-shooting chain from the first node at ``w`` (the
+    nodes' flags restored after)."""
+    saved = prob.args["m0"].copy()
+    r, _g = prob.plain_eval(prob.carry_states(w, single, everything=True))
+    prob.args["m0"][...] = saved
+    return r
 
 
 def _refine_substeps(prob: _Problem, single: ca.Function, out: Any, w: np.ndarray, n_sub: int, lo: np.ndarray,
