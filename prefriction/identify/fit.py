@@ -513,8 +513,13 @@ def _motion_statistics(space: ParameterSpace, sol: Any, limit: float) -> tuple[d
     values = space.values(sol.w[: space.n_free])
     est = np.array([values[n] for n in space.free])
     J, scale = space.physical_jacobian(sol.jacobian, sol.w[: space.n_free])
-    return values, est, gauss_newton(J, sol.residuals, space.free, est, scale, constraints=sol.constraints,
-                                     limit=limit, covariance="hac")
+    stats = gauss_newton(J, sol.residuals, space.free, est, scale, constraints=sol.constraints, limit=limit,
+                         covariance="hac")
+    if getattr(sol, "widen", None):   # a curved valley's secant check (identify/shooting.py _valley_secant)
+        from prefriction.identify.statistics import widen_statistics
+
+        stats = widen_statistics(stats, space.free, est, sol.widen, limit)
+    return values, est, stats
 
 
 def _unpinned(space: ParameterSpace, values: dict, est: np.ndarray, stats: Any,

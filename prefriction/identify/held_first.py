@@ -26,7 +26,7 @@ from prefriction.identify.parameters import ParameterSpace
 from prefriction.models.base import FrictionModel
 from prefriction.models.gms import GMS
 
-__all__ = ["held_first"]
+__all__ = ["held_first", "valley"]
 
 
 def held_first(model: FrictionModel, space: ParameterSpace) -> tuple[str, ...]:
@@ -35,3 +35,9 @@ def held_first(model: FrictionModel, space: ParameterSpace) -> tuple[str, ...]:
     if isinstance(model, GMS) and "C" in space.free and "Fs" in space.free:
         return ("C",)
     return ()
+
+
+def valley(model: FrictionModel, space: ParameterSpace) -> tuple[str, ...]:
+    """The free parameters of ``space`` along the curved valley (module notes) whose intervals the
+    linearisation may understate: ``("C", "Fs")`` for a :class:`prefriction.GMS` with both free."""
+    return ("C", "Fs") if held_first(model, space) == ("C",) else ()

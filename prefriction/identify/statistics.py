@@ -328,3 +328,25 @@ class NoisyPositionsWarning(UserWarning):
     """The positions of :class:`prefriction.identify.ForceDisplacement` data turn far more often
     than the motion reverses, and no ``x_noise`` or ``quantum`` was declared: the fit integrates
     the model along the noise and its estimates are biased (``docs/identify.md#positions``)."""
+
+
+def widen_statistics(stats: Statistics, names: list[str], estimates: np.ndarray, factors: dict[str, float],
+                     limit: float) -> Statistics:
+    """``stats`` with the standard errors of ``factors`` (``{name: factor}``) multiplied, their 95 %
+    intervals widened to match, and each whose relative standard error then exceeds ``limit``
+    reported as not identifiable (a secant check of a curved valley,
+    :func:`prefriction.identify.shooting._valley_secant`)."""
+    import dataclasses
+
+    se, low, high = stats.stderr.copy(), stats.low.copy(), stats.high.copy()
+    tq = float(student_t.ppf(0.975, stats.dof))
+    loose = dict(stats.unidentifiable)
+    for name, f in factors.items():
+        i = names.index(name)
+        se[i] *= f
+        low[i], high[i] = estimates[i] - tq * se[i], estimates[i] + tq * se[i]
+        if name not in loose and not se[i] <= limit * abs(estimates[i]):
+            loose[name] = (f"relative standard error {100.0 * se[i] / abs(estimates[i]):.3g} % > {100.0 * limit:.3g} % "
+                           f"(the secant of the sum of squares along the valley, {f:.3g} times the linearisation's)")
+    return dataclasses.replace(stats, stderr=se, low=low, high=high,
+                               unidentifiable=tuple((n, loose[n]) for n in names if n in loose))
