@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from scipy.stats import t as student_t
 
-from prefriction.identify.shooting import _damped
+from prefriction.identify.polish import damped as _damped
 from prefriction.identify.statistics import gauss_newton, widen_statistics
 
 

@@ -335,7 +335,7 @@ def widen_statistics(stats: Statistics, names: list[str], estimates: np.ndarray,
     """``stats`` with the standard errors of ``factors`` (``{name: factor}``) multiplied, their 95 %
     intervals widened to match, and each whose relative standard error then exceeds ``limit``
     reported as not identifiable (a secant check of a curved valley,
-    :func:`prefriction.identify.shooting._valley_secant`)."""
+    :func:`prefriction.identify.polish.valley_secant`)."""
     import dataclasses
 
     se, low, high = stats.stderr.copy(), stats.low.copy(), stats.high.copy()
