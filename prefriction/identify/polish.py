@@ -5,14 +5,15 @@ squares) on the single-shooting problem from the multiple-shooting solution of
 :mod:`prefriction.identify.shooting`, so the estimates and their statistics are those of the
 single-shooting problem; :func:`valley_secant` profiles the valley parameters
 (:func:`prefriction.identify.held_first.valley`) at a held solution and says how much wider than
-the linearisation their intervals must be. ``prob`` is the shooting module's problem (its
-residuals, reduced Jacobian and node chaining).
+the linearisation their intervals must be. ``prob`` is the shooting module's problem
+(``prefriction.identify.shooting._Problem``: its residuals, reduced Jacobian and node chaining),
+typed ``Any`` here so that the two modules do not import each other.
 """
 
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import casadi as ca
 import numpy as np
@@ -21,9 +22,6 @@ from prefriction.identify.held_first import valley
 from prefriction.identify.motion_step import segment_functions
 from prefriction.identify.parameters import ParameterSpace
 from prefriction.models.base import FrictionModel
-
-if TYPE_CHECKING:
-    from prefriction.identify.shooting import _Problem
 
 __all__ = ["POLISH_FRACTIONS", "POLISH_STEPS", "POLISH_TOL", "VALLEY_GAP", "VALLEY_STEPS", "damped", "polish",
            "valley_secant"]
@@ -52,7 +50,7 @@ def damped(J: np.ndarray, r: np.ndarray, lam: float) -> np.ndarray:
     return np.linalg.lstsq(A, np.r_[-r, np.zeros(J.shape[1])], rcond=None)[0]
 
 
-def polish(prob: _Problem, w: np.ndarray, single: ca.Function, lo: np.ndarray,
+def polish(prob: Any, w: np.ndarray, single: ca.Function, lo: np.ndarray,
             hi: np.ndarray, valley: bool = False, hold: tuple[int, ...] = ()) -> tuple[np.ndarray, str]:
     """Gauss-Newton steps on the single-shooting problem from the multiple-shooting solution ``w``.
 
@@ -147,7 +145,7 @@ def polish(prob: _Problem, w: np.ndarray, single: ca.Function, lo: np.ndarray,
 
 
 
-def valley_secant(prob: _Problem, w: np.ndarray, J: np.ndarray, r: np.ndarray, space: ParameterSpace,
+def valley_secant(prob: Any, w: np.ndarray, J: np.ndarray, r: np.ndarray, space: ParameterSpace,
                    at: FrictionModel, n_sub: int, mass_free: bool, stats: Any) -> dict[str, float]:
     """How much wider than the linearisation the sum of squares puts the valley parameters
     (:func:`prefriction.identify.held_first.valley`: ``C`` and ``Fs``) at ``w``: ``{name: factor > 1}``.
