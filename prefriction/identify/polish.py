@@ -89,11 +89,11 @@ def polish(prob: Any, w: np.ndarray, single: ca.Function, lo: np.ndarray,
     w_ms = w
     r_ms, g_ms = prob.plain_eval(w)
     rss_ms = float(r_ms @ r_ms)
-    w = prob.carry_states(w, single, everything=True)
-    r, g = prob.plain_eval(w)
-    if not (np.all(np.isfinite(r)) and np.all(np.isfinite(g))):
+    chain = prob.chain_eval(w, single)
+    if chain is None:
         prob.clear_flags()
         return w_ms, "; the single-shooting chain is not finite at the solution: not polished"
+    w, r = chain
     with np.errstate(invalid="ignore"):
         margin = 1e-9 * np.maximum(1.0, np.abs(w[:nth]))
     where = prob.columns()
@@ -117,9 +117,9 @@ def polish(prob: Any, w: np.ndarray, single: ca.Function, lo: np.ndarray,
             trial = w.copy()
             trial[where[cols]] += step
             trial[:nth] = np.clip(trial[:nth], lo, hi)
-            trial = prob.carry_states(trial, single, everything=True)
-            rt, gt = prob.plain_eval(trial)
-            if np.all(np.isfinite(rt)) and np.all(np.isfinite(gt)) and float(rt @ rt) < float(r @ r):
+            chain = prob.chain_eval(trial, single)
+            if chain is not None and float(chain[1] @ chain[1]) < float(r @ r):
+                trial, rt = chain
                 if damp is not None:   # the ratio of actual to predicted decrease sets the next damping
                     pred = float(r @ r) - float(np.sum(np.square(r + J @ step)))
                     rho = (float(r @ r) - float(rt @ rt)) / max(pred, 1e-300)
@@ -168,11 +168,11 @@ def valley_secant(prob: Any, w: np.ndarray, J: np.ndarray, r: np.ndarray, space:
         return {}
     single = segment_functions(at, space, prob.lay.K, n_sub, mass_free, prob.native)[0]
     lo, hi = space.theta_bounds()
-    wc = prob.carry_states(w, single, everything=True)
-    rc, gc = prob.plain_eval(wc)
-    if not (np.all(np.isfinite(rc)) and np.all(np.isfinite(gc))):
+    chain = prob.chain_eval(w, single)
+    if chain is None:
         prob.clear_flags()
         return {}
+    wc, rc = chain
     s2 = float(rc @ rc) / max(rc.size - J.shape[1], 1)
     tq = float(student_t.ppf(0.975, stats.dof))
     i = space.free.index(names[0])
@@ -184,9 +184,10 @@ def valley_secant(prob: Any, w: np.ndarray, J: np.ndarray, r: np.ndarray, space:
         trial[i] = min(max(wc[i] * math.exp(sign * tq * se_i / wc[i]), lo[i]), hi[i])   # C > 0: compounded
         trial = prob.carry_states(trial, single, everything=True)
         prof, _note = polish(prob, trial, single, lo, hi, valley=True, hold=(i,))
-        rt, gt = prob.plain_eval(prob.carry_states(prof, single, everything=True))
-        if not (np.all(np.isfinite(rt)) and np.all(np.isfinite(gt))):
+        chain = prob.chain_eval(prof, single)
+        if chain is None:
             continue
+        rt = chain[1]
         rise = max(float(rt @ rt - rc @ rc), 1e-12 * s2)
         if rise >= tq * tq * s2:
             continue

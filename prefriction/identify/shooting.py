@@ -95,6 +95,9 @@ class MotionSolution:
     """Of a fit that did not converge: the position residuals [m] of the single-shooting chain
     from the first node at ``w`` (each piece of the chain from its own start), for the route
     check of :func:`prefriction.identify.fit`."""
+    problem: Any = dataclasses.field(default=None, repr=False, compare=False)
+    """The :class:`_Problem` the solution was solved on (its layout, node scales, sub-steps and
+    first flags): ``w``'s nodes are in its scales."""
 
 
 @dataclass(frozen=True)
@@ -261,6 +264,14 @@ class _Problem:
                 a["m0"][:, j + 1] = np.asarray(out["Me"]).ravel()
         w[self.nth:] = nodes.T.ravel()
         return w
+
+    def chain_eval(self, w: np.ndarray, single: ca.Function) -> tuple[np.ndarray, np.ndarray] | None:
+        """The single-shooting chain from the first node at ``w`` (:meth:`carry_states` with
+        ``everything``) and its scaled position residuals, or ``None`` where the residuals or the
+        continuity defects are not finite."""
+        wc = self.carry_states(w, single, everything=True)
+        r, g = self.plain_eval(wc)
+        return (wc, r) if np.all(np.isfinite(r)) and np.all(np.isfinite(g)) else None
 
     def clear_flags(self) -> None:
         """Back to the multiple-shooting convention: no flag set at the nodes after the first."""
@@ -450,8 +461,8 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
         stage = _solve(at, head, sp_k, sp_k.theta_of(vals), n_sub, max_iter, tol, given, progress, weight, steps,
                        least)
         if long and head is data and stage.success:  # the full record with the held parameters held
-            done = _settled_without(at, data, space, vals, dict(vals, **sp_k.values(stage.w[: sp_k.n_free])),
-                                    stage, reversals, name)
+            done = _settled_without(at, data, space, dict(vals, **sp_k.values(stage.w[: sp_k.n_free])), stage,
+                                    name)
             if done is not None:
                 steps.append(done[1])
                 return dataclasses.replace(done[0], steps=tuple(steps))
@@ -469,10 +480,10 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
     return dataclasses.replace(sol, steps=tuple(steps))
 
 
-def _settled_without(at: FrictionModel, data: Motion, space: ParameterSpace, before: dict, after: dict,
-                     stage: MotionSolution, reversals: Any, name: str) -> tuple[MotionSolution, str] | None:
+def _settled_without(at: FrictionModel, data: Motion, space: ParameterSpace, after: dict,
+                     stage: MotionSolution, name: str) -> tuple[MotionSolution, str] | None:
     """The solution ``stage`` of a long record with the held parameters held (started at the model
-    ``at`` and the values ``before``, ended at ``after``) as a solution of ``space`` (every
+    ``at``, ended at the values ``after``, its nodes in the scales of ``stage.problem``) as a solution of ``space`` (every
     parameter free), when the record does not pin every parameter there and the pinned estimates
     sit within :data:`prefriction.identify.settled.SETTLED` standard errors of the minimum of the
     linearised problem with every parameter free: ``(solution, note)``, else ``None`` (the free
@@ -485,42 +496,36 @@ def _settled_without(at: FrictionModel, data: Motion, space: ParameterSpace, bef
     from prefriction.identify.settled import SETTLED, unsettled
     from prefriction.identify.statistics import gauss_newton, widen_statistics
 
-    mass_free = "mass" in space.start and "mass" in space.free
-    mass = before["mass"] if mass_free else float(data.mass)   # the stage's node scales (_solve_record)
-    xsm, v, a = derivatives(data.t, data.x, _NODE_WINDOW)
-    X, V = at.Fc / at.sigma, at.Fc / math.sqrt(mass * at.sigma)
-    lay = _layout(data, min(SEGMENT, len(data) - 1), _directions(data.t, data.x, v, reversals), np.array([X, V]))
-    ny = 2 + at.n_states
-    if stage.w.size < lay.J * ny or "pieces of the chain" in stage.message:
+    held = stage.problem
+    if held is None:
         return None
-    xs = max(float(np.ptp(data.x)) * 1e-3, 1e-300)
-    prob = _Problem(at, space, data, lay, stage.n_sub, mass_free, mass, xs)
+    mass_free = "mass" in space.start and "mass" in space.free
+    prob = _Problem(at, space, data, held.lay, stage.n_sub, mass_free, held.mass, held.xs, held.native)
+    prob.first_flags, prob.gw = list(held.first_flags), held.gw
+    prob.args["m0"] = held.args["m0"].copy()
+    xs, mass = held.xs, held.mass
     theta = space.theta_of(after)
-    _w0, first = _start(at, data, theta, lay, xsm, v, a, mass, before.get("offset", 0.0), 0.5)
-    prob.first_flags = list(first)
-    if prob.args["m0"].size:
-        prob.args["m0"][:, 0] = first
-    w = np.r_[theta, stage.w[-lay.J * ny:]]
+    w = np.r_[theta, stage.w[held.nth:]]
     r, _g, out = prob.residuals(w)
     if not (r.size == stage.residuals.size and np.allclose(r * xs, stage.residuals, rtol=1e-6,
                                                             atol=1e-9 * float(np.max(np.abs(stage.residuals))))):
-        return None    # not the stage's motion (flags of a polished chain): run the free stage
+        return None    # the held values do not give the stage's motion in the free space: run the free stage
     J = prob.reduced_jacobian(w)
     Jp, sc = space.physical_jacobian(J * xs, theta)
-    stats = gauss_newton(Jp, r * xs, space.free, np.array([after[n] for n in space.free]), sc, limit=0.5,
-                         covariance="hac")
+    est = np.array([after[n] for n in space.free])
+    stats = gauss_newton(Jp, r * xs, space.free, est, sc, limit=0.5, covariance="hac")
     widen = valley_secant(prob, w, J, r, space, at, stage.n_sub, mass_free, stats)
     if widen:
-        stats = widen_statistics(stats, space.free, np.array([after[n] for n in space.free]), widen, 0.5)
+        stats = widen_statistics(stats, space.free, est, widen, 0.5)
     loose = {n for n, _ in stats.unidentifiable}
     if not loose or unsettled(Jp, r * xs, space.free, sc, stats.stderr, np.array([n not in loose for n in space.free])):
         return None
     pred, vel = out["X"][0, prob.rows], out["X"][1, prob.rows]
     said = "" if not widen else (" (" + ", ".join(f"{n}'s standard error widened {f:.3g} times" for n, f in widen.items())
                                  + ": along the valley the sum of squares rises less than its linearisation says, "
-                                 "identify/held_first.py)")
+                                 "identify/polish.py)")
     return (MotionSolution(w, r * xs, J * xs, None, pred, _nuisance(at, space, w, prob, data, vel, mass_free, mass),
-                           stage.message, True, n_sub=stage.n_sub, widen=widen),
+                           stage.message, True, n_sub=stage.n_sub, widen=widen, problem=prob),
             f"continuation: the fit of {name} is the solution: with every parameter free the record does not pin "
             f"{', '.join(sorted(loose))} there either{said}, and the other estimates sit within "
             f"{SETTLED:g} standard errors of the linearised minimum (identify/settled.py), so no free stage was run")
@@ -692,7 +697,8 @@ def _solve_record(model: FrictionModel, data: Motion, space: ParameterSpace, the
                           f"multiple shooting, {lay.J} segments of {lay.K} samples, {n_sub} RK4 sub-steps per "
                           f"sample{_pieces(lay)}, scipy least_squares in an augmented Lagrangian: "
                           f"{out.message}{polished}",
-                          out.success, n_sub=n_sub, chain=None if out.success else _chain(prob, w, single) * xs)
+                          out.success, n_sub=n_sub, chain=None if out.success else _chain(prob, w, single) * xs,
+                          problem=prob)
 
 
 def _chain(prob: _Problem, w: np.ndarray, single: ca.Function) -> np.ndarray:

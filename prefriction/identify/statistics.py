@@ -32,6 +32,7 @@ measured in ``docs/identify.md#coverage``.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from typing import Callable
 
@@ -336,8 +337,6 @@ def widen_statistics(stats: Statistics, names: list[str], estimates: np.ndarray,
     intervals widened to match, and each whose relative standard error then exceeds ``limit``
     reported as not identifiable (a secant check of a curved valley,
     :func:`prefriction.identify.polish.valley_secant`)."""
-    import dataclasses
-
     se, low, high = stats.stderr.copy(), stats.low.copy(), stats.high.copy()
     tq = float(student_t.ppf(0.975, stats.dof))
     loose = dict(stats.unidentifiable)
