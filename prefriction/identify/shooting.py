@@ -456,16 +456,18 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
     if held is not None:
         stages.append((data, held, reversals, f"the record{what}"))
     vals, least, weight, moved = dict(space.start), 1, 0.01, False
+    fallback = None   # a short record's held stage: the solution if the free stage does not converge
     for head, sp_k, given, name in stages:   # continuation (module notes, identify/held_first.py)
         at = sp_k.build(vals) if moved else model
         stage = _solve(at, head, sp_k, sp_k.theta_of(vals), n_sub, max_iter, tol, given, progress, weight, steps,
                        least)
-        if long and head is data and stage.success:  # the full record with the held parameters held
-            done = _settled_without(at, data, space, dict(vals, **sp_k.values(stage.w[: sp_k.n_free])), stage,
-                                    name)
+        if head is data and stage.success:  # the full record with the held parameters held
+            held_stage = (at, data, space, dict(vals, **sp_k.values(stage.w[: sp_k.n_free])), stage, name)
+            done = _settled_without(*held_stage) if long else None
             if done is not None:
                 steps.append(done[1])
                 return dataclasses.replace(done[0], steps=tuple(steps))
+            fallback = None if long else held_stage
         if not stage.success:
             steps.append(f"continuation: the fit of {name} did not converge ({stage.message}); the next stage "
                          f"started from the values before it")
@@ -477,6 +479,9 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
     # the sub-steps of the full record from the last stage's estimates
     sol = _solve(space.build(vals) if moved else model, data, space, space.theta_of(vals), n_sub, max_iter, tol,
                  reversals, progress, weight, steps, least)
+    if not sol.success and fallback is not None and (done := _settled_without(*fallback)) is not None:
+        steps.append(f"the fit with every parameter free did not converge ({sol.message[-160:]}); {done[1]}")
+        return dataclasses.replace(done[0], steps=tuple(steps))
     return dataclasses.replace(sol, steps=tuple(steps))
 
 
