@@ -54,60 +54,56 @@ def test_widen_statistics_scales_the_standard_error_and_interval():
     assert "a" in dict(huge.unidentifiable) and "secant" in dict(huge.unidentifiable)["a"]
 
 
+def _fit_gms(samples: int, seed: int):
+    """The GMS(2) + offset stage of prefriction.identify._success_events: its quantised noisy
+    scipy record (DOP853, every reversal and slip an event) of ``samples`` samples and seed
+    ``seed``, fitted from the bench's factor-2 start of that seed; ``(result, truth)``."""
+    import warnings
+
+    from prefriction.identify._success_events import EVENT_STAGES, MASS, OFFSET, _start, event_record_quantised
+    from prefriction.identify.fit import fit
+
+    stage = next(s for s in EVENT_STAGES if s.name.startswith("GMS"))
+    truth = {"k[0]": 6e4, "k[1]": 4e4, "Fc": 1.0, "Fs": 1.3, "C": 50.0, "mass": MASS, "offset": OFFSET}
+    data = event_record_quantised(stage.friction, samples, seed)
+    start, mass0 = _start(stage, 2.0, np.random.default_rng(1000 + seed))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return fit(start, data, fixed=list(stage.fixed), offset=True, mass0=mass0), truth
+
+
+def _assert_honest(res, truth: dict) -> None:
+    """Every 95 % interval holds the truth, and every estimate but C and Fs (the valley) is within
+    5 % of it (the offset within 5 % of Fc)."""
+    T = np.array([truth[k] for k in res.names])
+    assert np.all((res.low <= T) & (T <= res.high)), dict(zip(res.names, zip(res.low, res.high)))
+    for name, est, true in zip(res.names, res.estimates, T):
+        if name not in ("C", "Fs"):
+            assert abs(est - true) <= 0.05 * (truth["Fc"] if name == "offset" else abs(true)), (name, est)
+
+
 @pytest.mark.slow
 def test_long_gms_record_with_a_flat_valley_reports_c_and_holds_the_truth():
-    """GMS(2) + offset, the 25,000-sample quantised noisy record of seed 1 (scipy DOP853 with
-    every reversal and slip an event, prefriction.identify._success_events), every free parameter
+    """GMS(2) + offset, the 25,000-sample record of seed 1 (:func:`_fit_gms`), every free parameter
     started up to 2x off (about 4 min of CPU: slow). The record pins C only in a combination with
     Fs, and the linearisation at the held solution says C's relative standard error is 36 %, its
     interval excluding the truth C = 50; the profile along the valley is flat, so C is reported not
     identifiable, every 95 % interval holds the truth, and every other estimate but Fs (in the
-    valley) lands within 5 % of it (the offset within 5 % of Fc)."""
-    import warnings
-
-    from prefriction.identify._success_events import EVENT_STAGES, MASS, OFFSET, _start, event_record_quantised
-    from prefriction.identify.fit import fit
-
-    stage = next(s for s in EVENT_STAGES if s.name.startswith("GMS"))
-    truth = {"k[0]": 6e4, "k[1]": 4e4, "Fc": 1.0, "Fs": 1.3, "C": 50.0, "mass": MASS, "offset": OFFSET}
-    data = event_record_quantised(stage.friction, 25_000, 1)
-    start, mass0 = _start(stage, 2.0, np.random.default_rng(1001))
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        res = fit(start, data, fixed=list(stage.fixed), offset=True, mass0=mass0)
+    valley) lands within 5 % of it."""
+    res, truth = _fit_gms(25_000, 1)
     assert res.success, res.message
     assert "C" in res.unidentifiable
-    T = np.array([truth[k] for k in res.names])
-    assert np.all((res.low <= T) & (T <= res.high)), dict(zip(res.names, zip(res.low, res.high)))
-    for name, est, true in zip(res.names, res.estimates, T):
-        if name not in ("C", "Fs"):
-            assert abs(est - true) <= 0.05 * (truth["Fc"] if name == "offset" else abs(true)), (name, est)
+    _assert_honest(res, truth)
 
 
 @pytest.mark.slow
 def test_short_gms_record_takes_the_held_point_when_the_free_stage_stalls():
-    """GMS(2) + offset, the 1,000-sample quantised noisy record of seed 7 (scipy DOP853, every
-    reversal and slip an event), every free parameter started up to 2x off (about 20 s: slow). The
-    stage with C held lands on the valley floor; the free stage from there stops with continuity
-    defects, so the fit checks the held point with every parameter free and returns it: converged,
-    every interval holds the truth, every estimate but C and Fs (the valley) within 5 %, and the
-    start report says the held point is the solution."""
-    import warnings
-
-    from prefriction.identify._success_events import EVENT_STAGES, MASS, OFFSET, _start, event_record_quantised
-    from prefriction.identify.fit import fit
-
-    stage = next(s for s in EVENT_STAGES if s.name.startswith("GMS"))
-    truth = {"k[0]": 6e4, "k[1]": 4e4, "Fc": 1.0, "Fs": 1.3, "C": 50.0, "mass": MASS, "offset": OFFSET}
-    data = event_record_quantised(stage.friction, 1000, 7)
-    start, mass0 = _start(stage, 2.0, np.random.default_rng(1007))
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        res = fit(start, data, fixed=list(stage.fixed), offset=True, mass0=mass0)
+    """GMS(2) + offset, the 1,000-sample record of seed 7 (:func:`_fit_gms`), every free parameter
+    started up to 2x off (about 20 s: slow). The stage with C held lands on the valley floor; the
+    free stage from there stops with continuity defects, so the fit checks the held point with
+    every parameter free and returns it: converged, every interval holds the truth, every estimate
+    but C and Fs within 5 %, and the start report says the held point is the solution."""
+    res, truth = _fit_gms(1000, 7)
     assert res.success, res.message
     assert any("every parameter free did not converge" in line and "is the solution" in line for line in res.start)
-    T = np.array([truth[k] for k in res.names])
-    assert np.all((res.low <= T) & (T <= res.high)), dict(zip(res.names, zip(res.low, res.high)))
-    for name, est, true in zip(res.names, res.estimates, T):
-        if name not in ("C", "Fs"):
-            assert abs(est - true) <= 0.05 * (truth["Fc"] if name == "offset" else abs(true)), (name, est)
+    _assert_honest(res, truth)
