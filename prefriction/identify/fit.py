@@ -515,7 +515,7 @@ def _motion_statistics(space: ParameterSpace, sol: Any, limit: float) -> tuple[d
     J, scale = space.physical_jacobian(sol.jacobian, sol.w[: space.n_free])
     stats = gauss_newton(J, sol.residuals, space.free, est, scale, constraints=sol.constraints, limit=limit,
                          covariance="hac")
-    if getattr(sol, "widen", None):   # a curved valley's secant check (identify/polish.py valley_secant)
+    if sol.widen:   # a curved valley's secant check (identify/polish.py valley_secant)
         from prefriction.identify.statistics import widen_statistics
 
         stats = widen_statistics(stats, space.free, est, sol.widen, limit)

@@ -198,8 +198,7 @@ def valley_secant(prob: Any, w: np.ndarray, J: np.ndarray, r: np.ndarray, space:
             j = space.free.index(names[1])
             moved = abs(space.values(prof[: prob.nth])[names[1]] - base[names[1]])
             partner = max(partner, f * moved / (tq * float(stats.stderr[j])))
-    prob.carry_states(w, single, everything=True)
-    prob.clear_flags()
+    prob.clear_flags()   # back to the multiple-shooting flags (the first node's are kept by every chain)
     out = {names[0]: factor} if factor > 1.0 else {}
     if partner > 1.0:
         out[names[1]] = partner
