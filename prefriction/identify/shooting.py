@@ -40,6 +40,7 @@ from prefriction.identify.held_first import held_first
 from prefriction.identify.motion_start import derivatives
 from prefriction.identify.motion_step import STATE_CAP, segment_functions
 from prefriction.identify.parameters import ParameterSpace
+from prefriction.identify.pieces import Pieces, breaks_of, derivatives_of, describe, passes_on, piece_window
 from prefriction.identify.polish import polish, valley_secant
 from prefriction.identify.reversals import locate_reversals
 from prefriction.identify.substep_rule import follows_data, rates_along
@@ -113,6 +114,10 @@ class _Layout:
     scl: np.ndarray
     n: int
     free: np.ndarray
+    s_to: np.ndarray
+    """Direction of each segment's end state: the next node's, at a junction of pieces the segment's own."""
+    breaks: int = 0
+    """Junctions of a :class:`prefriction.identify.pieces.Pieces` record among the chain's starts."""
 
     @property
     def J(self) -> int:
@@ -134,7 +139,9 @@ class _Layout:
 
 def _layout(data: Motion, K: int, directions: np.ndarray, scl: np.ndarray, speed: np.ndarray | None = None) -> _Layout:
     """Segments of ``K`` samples; with the smoothed speed of the data, the nodes after hovering
-    segments (:func:`_hover_nodes`) start pieces of the chain."""
+    segments (:func:`_hover_nodes`) start pieces of the chain. The first node of every piece of a
+    :class:`prefriction.identify.pieces.Pieces` record starts a piece of the chain too, and the
+    step into it from the sample before (the junction) has a zero time step: not simulated."""
     n = len(data)
     J = max(1, math.ceil((n - 1) / K))
     nodes = np.arange(J) * K
@@ -148,7 +155,16 @@ def _layout(data: Motion, K: int, directions: np.ndarray, scl: np.ndarray, speed
         u1[: n - 1] = data.u[1:]
     free = _hover_nodes(speed, nodes, K) if speed is not None else np.zeros(J, dtype=bool)
     free[0] = True
-    return _Layout(K, nodes, u0, u1, dt, directions[nodes], scl, n, free)
+    breaks = breaks_of(data)
+    if np.any(breaks % K):
+        raise ValueError(f"the pieces of a record start at samples {breaks.tolist()}: each must be a multiple of "
+                         f"the segment's {K} samples")
+    dt[breaks - 1] = 0.0
+    free[breaks // K] = True
+    s = directions[nodes]
+    s_to = np.r_[s[1:], s[-1]]
+    s_to[breaks // K - 1] = directions[breaks - 1]
+    return _Layout(K, nodes, u0, u1, dt, s, scl, n, free, s_to, int(breaks.size))
 
 
 HOVER = 0.02
@@ -234,7 +250,7 @@ class _Problem:
         self.keep = np.repeat(~lay.free[1:], self.ny)   # continuity rows (none into a piece's start)
         self.gw = np.ones(int(self.keep.sum()))
         s = lay.s
-        self.args = dict(s0=s, s_to=np.r_[s[1:], s[-1]], scale=space.scale, fixed=self.fixed, mass=mass,
+        self.args = dict(s0=s, s_to=lay.s_to, scale=space.scale, fixed=self.fixed, mass=mass,
                          U0=lay.U0[None, :], U1=lay.U1[None, :], DT=lay.DT[None, :], scl=lay.scl,
                          m0=np.zeros((model.n_flags, lay.J)))
         self.first_flags: list[float] = [0.0] * model.n_flags
@@ -449,10 +465,17 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
     if long:
         k0 = _busiest_window(data)
         part = slice(k0, k0 + WINDOW)
-        stages.append((Motion(data.t[part], data.x[part], data.u[part], data.mass, data.hold),
-                       space if held is None else held,
-                       None if reversals is None else [r for r in reversals if data.t[k0] < r < data.t[k0 + WINDOW - 1]],
-                       f"samples {k0} to {k0 + WINDOW - 1}{what}"))
+        pieces = piece_window(data, k0, WINDOW, SEGMENT)
+        if pieces is not None:
+            stages.append((pieces, space if held is None else held,
+                           None if reversals is None else pieces.to_piece_times(reversals),
+                           f"{describe(pieces)}{what}"))
+        else:
+            stages.append((Motion(data.t[part], data.x[part], data.u[part], data.mass, data.hold),
+                           space if held is None else held,
+                           None if reversals is None else [r for r in reversals
+                                                           if data.t[k0] < r < data.t[k0 + WINDOW - 1]],
+                           f"samples {k0} to {k0 + WINDOW - 1}{what}"))
     if held is not None:
         stages.append((data, held, reversals, f"the record{what}"))
     vals, least, weight, moved = dict(space.start), 1, 0.01, False
@@ -468,14 +491,15 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
                 steps.append(done[1])
                 return dataclasses.replace(done[0], steps=tuple(steps))
             fallback = None if long else held_stage
-        if not stage.success:
+        passed = "" if stage.success or not isinstance(head, Pieces) else passes_on(stage.problem, stage.w)
+        if not stage.success and not passed:
             steps.append(f"continuation: the fit of {name} did not converge ({stage.message}); the next stage "
                          f"started from the values before it")
             continue
         least, weight, moved = stage.n_sub, 10.0, True
         vals = dict(vals, **sp_k.values(stage.w[: sp_k.n_free]))
-        steps.append(f"continuation: {name} fitted ({stage.message}); the next stage started from these estimates "
-                     f"({_at(sp_k, stage.w)})")
+        steps.append(f"continuation: {name} fitted ({stage.message}{passed}); the next stage started from these "
+                     f"estimates ({_at(sp_k, stage.w)})")
     # the sub-steps of the full record from the last stage's estimates
     sol = _solve(space.build(vals) if moved else model, data, space, space.theta_of(vals), n_sub, max_iter, tol,
                  reversals, progress, weight, steps, least)
@@ -550,7 +574,7 @@ def _solve(model: FrictionModel, data: Motion, space: ParameterSpace, theta0: np
         sol = _event_substeps(data, space, sol, max_iter, tol, reversals, progress, steps)
     if sol.success:
         return sol
-    _x, v, _a = derivatives(data.t, data.x, _NODE_WINDOW)
+    _x, v, _a = derivatives_of(data, _NODE_WINDOW)
     K = min(SEGMENT, len(data) - 1)
     cut = int(_hover_nodes(np.abs(v), np.arange(max(1, math.ceil((len(data) - 1) / K))) * K, K).sum())
     theta = sol.w[: space.n_free]
@@ -575,7 +599,7 @@ def _event_substeps(data: Motion, space: ParameterSpace, sol: MotionSolution, ma
         return sol
     vals = space.values(theta)
     fitted = space.build(vals)
-    _x, v, _a = derivatives(data.t, data.x, _NODE_WINDOW)
+    _x, v, _a = derivatives_of(data, _NODE_WINDOW)
     need = _substeps(fitted, data, vals["mass"] if "mass" in space.free else float(data.mass), v, None)
     if need <= sol.n_sub:
         return sol
@@ -600,7 +624,7 @@ def start_error(model: FrictionModel, data: Motion, space: ParameterSpace) -> fl
     vals = space.values(theta0)
     mass_free = "mass" in space.start and "mass" in space.free
     mass = vals["mass"] if mass_free else float(data.mass)
-    xsm, v, a = derivatives(data.t, data.x, _NODE_WINDOW)
+    xsm, v, a = derivatives_of(data, _NODE_WINDOW)
     n_sub = _substeps(model, data, mass, v, None)
     lay = _layout(data, min(SEGMENT, len(data) - 1), _directions(data.t, data.x, v, None),
                   np.array([model.Fc / model.sigma, model.Fc / math.sqrt(mass * model.sigma)]))
@@ -640,7 +664,7 @@ def _solve_record(model: FrictionModel, data: Motion, space: ParameterSpace, the
     of its standard error (:func:`_refine_substeps`)."""
     mass_free = "mass" in space.start and "mass" in space.free
     mass = space.values(theta0)["mass"] if mass_free else float(data.mass)
-    xsm, v, a = derivatives(data.t, data.x, _NODE_WINDOW)
+    xsm, v, a = derivatives_of(data, _NODE_WINDOW)
     directions = _directions(data.t, data.x, v, reversals)
     requested = n_sub
     n_sub = max(_substeps(model, data, mass, v, n_sub), 1 if requested else least_sub)
@@ -774,8 +798,9 @@ def _refine_substeps(prob: _Problem, single: ca.Function, out: Any, w: np.ndarra
 
 
 def _pieces(lay: _Layout) -> str:
-    cut = int(lay.starts.size) - 1
-    return f" ({cut} nodes after hovering segments start pieces of the chain)" if cut else ""
+    cut = int(lay.starts.size) - 1 - lay.breaks
+    joins = f" ({lay.breaks} junctions of the record's pieces start pieces of the chain)" if lay.breaks else ""
+    return joins + (f" ({cut} nodes after hovering segments start pieces of the chain)" if cut else "")
 
 
 def _at(space: ParameterSpace, w: np.ndarray) -> str:

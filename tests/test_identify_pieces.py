@@ -1,0 +1,127 @@
+"""The piece window of a long Motion fit (identify/pieces.py) against an independent scipy record.
+
+The record: a 2.5 kg mass with Dahl friction (``gamma = 1``: ``dF/dt = sigma (v - |v| F / Fc)``,
+Dahl (3.2)) and a force offset, driven open loop by a two-tone force held over each sample
+(``m x'' = u - F - F_off``), integrated sample by sample by scipy's ``solve_ivp`` at tight
+tolerances. Five reversals in 1,500 samples: a contiguous 600-sample window holds at most two.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+from scipy.signal import savgol_filter
+
+from prefriction import Dahl
+from prefriction.identify import Motion
+from prefriction.identify.parameters import ParameterSpace
+from prefriction.identify.pieces import derivatives_of, piece_window
+from prefriction.identify.shooting import _directions, _layout, _Problem
+from prefriction.identify.motion_step import segment_functions
+
+MASS, SIGMA, FC, OFFSET = 2.5, 2e6, 3.0, 0.2
+DT, N, WIDTH, K = 4e-4, 1_500, 600, 50
+
+
+def _rhs(_t: float, y: np.ndarray, u: float) -> list[float]:
+    x, v, F = y
+    return [v, (u - F - OFFSET) / MASS, SIGMA * (v - abs(v) * F / FC)]
+
+
+@pytest.fixture(scope="module")
+def record() -> tuple[Motion, np.ndarray]:
+    """The record (known mass) and the true ``[x, v, F]`` at every sample."""
+    t = np.arange(N) * DT
+    w = 2.0 * math.pi * 2.5 / (N * DT)
+    u = 2.0 * FC * (np.sin(w * t) + 0.4 * np.sin(2.7 * w * t + 1.0))
+    y = np.zeros((N, 3))
+    for k in range(N - 1):
+        sol = solve_ivp(_rhs, (t[k], t[k + 1]), y[k], args=(u[k],), rtol=1e-11, atol=[1e-15, 1e-12, 1e-9],
+                        method="DOP853")
+        y[k + 1] = sol.y[:, -1]
+    return Motion(t, y[:, 0], u, MASS, "zoh"), y
+
+
+def _reversals(v: np.ndarray) -> np.ndarray:
+    return np.flatnonzero(np.sign(v[1:]) * np.sign(v[:-1]) < 0) + 1
+
+
+def test_piece_window_cuts_whole_segments_around_reversals_of_both_directions(record):
+    data, y = record
+    rev = _reversals(y[:, 1])
+    assert rev.size >= 4
+    pieces = piece_window(data, 0, WIDTH, K)
+    assert pieces is not None
+    edges = np.r_[0, pieces.breaks, len(pieces)]
+    assert len(pieces) <= WIDTH and np.all(np.asarray(pieces.breaks) % K == 0)
+    dirs = set()
+    for a, b, src, shift in zip(edges[:-1], edges[1:], pieces.source, pieces.shift):
+        orig = np.arange(src, src + b - a)
+        np.testing.assert_array_equal(pieces.x[a:b], data.x[orig])
+        np.testing.assert_array_equal(pieces.u[a:b], data.u[orig])
+        np.testing.assert_allclose(pieces.t[a:b] + shift, data.t[orig], rtol=0, atol=1e-12)
+        inside = rev[(rev > src) & (rev < src + b - a)]
+        assert inside.size >= 1                                    # every piece turns
+        dirs |= {float(np.sign(y[r, 1])) for r in inside}
+        if a:                                                      # one ordinary interval at the junction
+            assert pieces.t[a] - pieces.t[a - 1] == pytest.approx(DT, rel=1e-9)
+    assert dirs == {1.0, -1.0}
+
+
+def test_piece_window_not_cut_when_the_contiguous_window_turns_often(record):
+    data, _y = record
+    assert piece_window(data, 0, len(data), K) is None           # the whole record as the window: all its reversals
+
+
+def test_node_values_are_smoothed_within_each_piece(record):
+    data, _y = record
+    pieces = piece_window(data, 0, WIDTH, K)
+    xs, v, a = derivatives_of(pieces, 7)
+    edges = np.r_[0, pieces.breaks, len(pieces)]
+    for lo, hi in zip(edges[:-1], edges[1:]):
+        h = float(np.mean(np.diff(pieces.t[lo:hi])))
+        np.testing.assert_allclose(v[lo:hi], savgol_filter(pieces.x[lo:hi], 7, 3, deriv=1, delta=h), rtol=1e-12)
+        np.testing.assert_allclose(a[lo:hi], savgol_filter(pieces.x[lo:hi], 7, 3, deriv=2, delta=h), rtol=1e-12)
+
+
+def test_each_piece_is_simulated_from_its_own_start_and_the_junction_carries_no_constraint(record):
+    data, y = record
+    pieces = piece_window(data, 0, WIDTH, K)
+    model = Dahl(sigma=SIGMA, Fc=FC, gamma=1.0)
+    space = ParameterSpace(model, None, ["gamma"], None, mass=None, offset=FC, offset0=OFFSET)
+    _x, v, _a = derivatives_of(pieces, 7)
+    X, V = FC / SIGMA, FC / math.sqrt(MASS * SIGMA)
+    lay = _layout(pieces, K, _directions(pieces.t, pieces.x, v, None), np.array([X, V]))
+    prob = _Problem(model, space, pieces, lay, 8, False, MASS, 1e-9, native=False)
+    single = segment_functions(model, space, K, 8, False, False)[0]
+    # the true state at every node (scipy), the log-gap z = -ln(1 - s F / Fc) of Dahl (3.2)
+    orig = np.concatenate([np.arange(s, s + b - a) for s, a, b in
+                           zip(pieces.source, np.r_[0, pieces.breaks], np.r_[pieces.breaks, len(pieces)])])
+    nodes = []
+    for k, s in zip(lay.nodes, lay.s):
+        xt, vt, Ft = y[orig[k]]
+        nodes += [xt / X, vt / V, -math.log(max(1.0 - s * Ft / FC, 1e-14))]
+    w = np.r_[space.theta0, nodes]
+    # every node after a piece's start from the segment before (single shooting within each piece)
+    w = prob.carry_states(w, single, everything=True)
+    r, g = prob.plain_eval(w)
+    n_breaks = len(pieces.breaks)
+    assert g.size == prob.ny * (lay.J - 1 - n_breaks)             # no continuity rows into a piece's start
+    np.testing.assert_array_less(np.abs(g), 1e-9)
+    # the positions of each piece against scipy's, from the piece's own true start
+    assert np.max(np.abs(r * prob.xs)) < 1e-3 * X
+    # a residual of one piece does not depend on another piece's start state
+    J = prob.reduced_jacobian(w)
+    piece_of_row = np.searchsorted(np.asarray(pieces.breaks), pieces_samples(prob), side="right")
+    for p in range(n_breaks + 1):
+        cols = prob.nth + prob.ny * p + np.arange(prob.ny)
+        assert np.all(J[piece_of_row != p][:, cols] == 0.0)
+        assert np.any(J[piece_of_row == p][:, cols] != 0.0)
+
+
+def pieces_samples(prob: _Problem) -> np.ndarray:
+    """The sample (in the concatenation) of every residual row of ``prob``."""
+    return prob.samples[prob.rows]
