@@ -9,7 +9,9 @@ minimised subject to the continuity of the segments by scipy's trust-region leas
 augmented Lagrangian on sparse matrices (:mod:`prefriction.identify.constrained_lsq`), with
 forward sensitivities propagated sample by sample. A record longer than ``2 WINDOW`` samples
 fits its :data:`WINDOW` samples with the most reversals first and starts the full record from
-their estimates (continuation); parameters the record pins only together with another
+their estimates (continuation; where that window does not converge and holds fewer than two
+reversals each way, a window cut from pieces of the record around its reversals,
+:mod:`prefriction.identify.pieces`); parameters the record pins only together with another
 (:mod:`prefriction.identify.held_first`) are held at their start values in the window and in a
 first fit of the full record, and freed in the last. Nothing holds more than a few numbers per sample and sensitivity column, so the
 time and the memory of a fit grow linearly with the samples (measured:
@@ -40,7 +42,7 @@ from prefriction.identify.held_first import held_first
 from prefriction.identify.motion_start import derivatives
 from prefriction.identify.motion_step import STATE_CAP, segment_functions
 from prefriction.identify.parameters import ParameterSpace
-from prefriction.identify.pieces import Pieces, breaks_of, derivatives_of, describe, passes_on, piece_window
+from prefriction.identify.pieces import FEWEST, Pieces, breaks_of, derivatives_of, describe, passes_on, piece_window
 from prefriction.identify.polish import polish, valley_secant
 from prefriction.identify.reversals import locate_reversals
 from prefriction.identify.substep_rule import follows_data, rates_along
@@ -465,25 +467,25 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
     if long:
         k0 = _busiest_window(data)
         part = slice(k0, k0 + WINDOW)
-        pieces = piece_window(data, k0, WINDOW, SEGMENT)
-        if pieces is not None:
-            stages.append((pieces, space if held is None else held,
-                           None if reversals is None else pieces.to_piece_times(reversals),
-                           f"{describe(pieces)}{what}"))
-        else:
-            stages.append((Motion(data.t[part], data.x[part], data.u[part], data.mass, data.hold),
-                           space if held is None else held,
-                           None if reversals is None else [r for r in reversals
-                                                           if data.t[k0] < r < data.t[k0 + WINDOW - 1]],
-                           f"samples {k0} to {k0 + WINDOW - 1}{what}"))
+        stages.append((Motion(data.t[part], data.x[part], data.u[part], data.mass, data.hold),
+                       space if held is None else held,
+                       None if reversals is None else [r for r in reversals if data.t[k0] < r < data.t[k0 + WINDOW - 1]],
+                       f"samples {k0} to {k0 + WINDOW - 1}{what}"))
     if held is not None:
         stages.append((data, held, reversals, f"the record{what}"))
     vals, least, weight, moved = dict(space.start), 1, 0.01, False
     fallback = None   # a short record's held stage: the solution if the free stage does not converge
-    for head, sp_k, given, name in stages:   # continuation (module notes, identify/held_first.py)
+    for i, (head, sp_k, given, name) in enumerate(stages):   # continuation (module notes, identify/held_first.py)
         at = sp_k.build(vals) if moved else model
         stage = _solve(at, head, sp_k, sp_k.theta_of(vals), n_sub, max_iter, tol, given, progress, weight, steps,
                        least)
+        if long and i == 0 and not stage.success and (pieces := piece_window(data, k0, WINDOW, SEGMENT)) is not None:
+            steps.append(f"continuation: the fit of {name} did not converge ({stage.message[-160:]}); it holds "
+                         f"fewer than {FEWEST} reversals each way: the window is cut from {describe(pieces)} instead")
+            head, name = pieces, f"{describe(pieces)}{what}"
+            stage = _solve(at, head, sp_k, sp_k.theta_of(vals), n_sub, max_iter, tol,
+                           None if reversals is None else pieces.to_piece_times(reversals), progress, weight, steps,
+                           least)
         if head is data and stage.success:  # the full record with the held parameters held
             held_stage = (at, data, space, dict(vals, **sp_k.values(stage.w[: sp_k.n_free])), stage, name)
             done = _settled_without(*held_stage) if long else None
