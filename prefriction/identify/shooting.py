@@ -116,10 +116,15 @@ class _Layout:
     scl: np.ndarray
     n: int
     free: np.ndarray
-    s_to: np.ndarray
-    """Direction of each segment's end state: the next node's, at a junction of pieces the segment's own."""
+    s_to: np.ndarray | None = None
+    """Direction of each segment's end state: the next node's (the default), at a junction of
+    pieces the segment's own."""
     breaks: int = 0
     """Junctions of a :class:`prefriction.identify.pieces.Pieces` record among the chain's starts."""
+
+    def __post_init__(self) -> None:
+        if self.s_to is None:
+            object.__setattr__(self, "s_to", np.r_[self.s[1:], self.s[-1]])
 
     @property
     def J(self) -> int:
