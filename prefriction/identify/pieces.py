@@ -33,8 +33,8 @@ import numpy as np
 from prefriction.identify.data import Motion
 from prefriction.identify.motion_start import derivatives
 
-__all__ = ["FEWEST", "MOST_PIECES", "Pieces", "breaks_of", "derivatives_of", "describe", "direction_counts", "passes_on", "piece_window",
-           "reversal_samples"]
+__all__ = ["FEWEST", "MOST_PIECES", "PASS_ON", "Pieces", "breaks_of", "derivatives_of", "describe",
+           "direction_counts", "passes_on", "piece_window", "reversal_samples"]
 
 FEWEST = 2
 """Fewest reversals in each direction in the busiest contiguous window below which the first window
@@ -129,9 +129,10 @@ def direction_counts(directions: np.ndarray) -> tuple[int, int]:
 
 def piece_window(data: Motion, first: int, width: int, K: int) -> Pieces | None:
     """The first window of a long fit from pieces of ``data`` around its reversals (for a record
-    whose contiguous window did not converge), or ``None`` when the contiguous window ``data[first:first + width]`` (the busiest) holds at least
-    :data:`FEWEST` reversals in each direction, or the record holds no more than it in the rarer
-    direction (module notes).
+    whose contiguous window did not converge), or ``None`` when the contiguous window
+    ``data[first:first + width]`` (the busiest) holds at least :data:`FEWEST` reversals in each
+    direction, the record holds no more than it in the rarer direction (module notes), or fewer
+    than two pieces of :data:`LEAST_SEGMENTS` segments fit in ``width``.
 
     Parameters
     ----------
@@ -155,6 +156,8 @@ def piece_window(data: Motion, first: int, width: int, K: int) -> Pieces | None:
     if min(direction_counts(to[inside])) >= FEWEST or min(direction_counts(to)) <= min(direction_counts(to[inside])):
         return None
     n_pieces = min(MOST_PIECES, at.size, width // (LEAST_SEGMENTS * K))
+    if n_pieces < 2:
+        return None
     length = K * (width // (n_pieces * K))
     chosen: list[int] = []
     ups, downs = np.flatnonzero(to > 0), np.flatnonzero(to < 0)
@@ -167,7 +170,7 @@ def piece_window(data: Motion, first: int, width: int, K: int) -> Pieces | None:
     pieces: list[tuple[int, int]] = []
     for a in starts:
         a = max(a, pieces[-1][1]) if pieces else a
-        b = min(a + length, n)
+        b = a + K * ((min(a + length, n) - a) // K)   # whole segments: every junction on a node
         if b - a >= LEAST_SEGMENTS * K:
             pieces.append((a, b))
     if len(pieces) < 2:
