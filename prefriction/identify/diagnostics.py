@@ -24,12 +24,14 @@ twice the white-residual one (its information comes from stretches of correlated
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
-from prefriction.identify.positions import reversal_indices
+from prefriction.identify.data import ForceDisplacement, Motion
+from prefriction.identify.positions import noise_sd, reversal_indices
 
-__all__ = ["ResidualDiagnostics", "diagnose"]
+__all__ = ["ResidualDiagnostics", "diagnose", "diagnose_fit"]
 
 RUNS_Z = -4.0
 """Runs z-score below which the runs are too few (eq. D1)."""
@@ -191,3 +193,25 @@ def diagnose(residuals: np.ndarray, x: np.ndarray, names: tuple[str, ...] | list
             if why:
                 distrust.append((name, "; ".join(why)))
     return ResidualDiagnostics(R, mean, z, acf, rev, window, ratio, tuple(findings), tuple(distrust))
+
+
+def diagnose_fit(res: Any) -> ResidualDiagnostics:
+    """:func:`diagnose` of a :class:`prefriction.identify.FitResult` (its :attr:`diagnostics`):
+    the positions of the record (the estimated path of :class:`ForceDisplacement` data), the
+    fitted reversal times if any, and the position noise of :class:`Motion` data.
+
+    Raises
+    ------
+    TypeError
+        If the fit's data are not a record in time (``ForceDisplacement`` or ``Motion``).
+    """
+    data = res.data
+    if not isinstance(data, (ForceDisplacement, Motion)):
+        raise TypeError(f"residual diagnostics need a fit of ForceDisplacement or Motion data (records in time), "
+                        f"got {type(data).__name__}")
+    x = data.path if isinstance(data, ForceDisplacement) else data.x
+    st = res.statistics
+    times = next((np.atleast_1d(v) for k, v in res.nuisance.items() if k.startswith("reversal times")), None)
+    rev = None if times is None else np.clip(np.searchsorted(data.t, times), 0, len(data.t) - 1)
+    noise = noise_sd(data.x_noise, data.quantum) if isinstance(data, Motion) else 0.0
+    return diagnose(res.residuals, x, res.names, res.stderr, st.stderr_iid, st.influence, rev, noise)

@@ -12,11 +12,32 @@ import numpy as np
 from prefriction.identify.data import ForceDisplacement, ForceVelocity, Motion
 from prefriction.identify.validation import check_directory, model_name
 
-__all__ = ["plot_fit", "plot_residuals", "report_text"]
+__all__ = ["plot_fit", "plot_residuals", "report_text", "summary_text"]
 
 
 def _flag(res: Any, i: int) -> str:
     return f"  ({res.flags[i]})" if i < len(res.flags) and res.flags[i] else ""
+
+
+def summary_text(res: Any) -> str:
+    """The text of :meth:`FitResult.summary`."""
+    st = res.statistics
+    unit = "m" if isinstance(res.data, Motion) else "N"
+    lines = [f"{model_name(res.model)} fitted to {len(res.residuals)} samples of "
+             f"{type(res.data).__name__}: residual sd {st.sigma_hat:.4g} {unit}, {st.dof} dof"]
+    for i, (n, u, v, lo, hi) in enumerate(zip(res.names, res.units, res.estimates, res.low, res.high)):
+        lines.append(f"  {n:<14} {v:< 12.6g} [{lo:.6g}, {hi:.6g}] {u}" + _flag(res, i))
+    for n, why in st.unidentifiable:
+        lines.append(f"  not identifiable: {n} ({why})")
+    lines.extend(f"  start: {step}" for step in res.start)
+    if isinstance(res.data, (ForceDisplacement, Motion)):
+        diag = res.diagnostics
+        lines.extend(f"  residual structure: {f}" for f in diag.findings)
+        lines.extend(f"  distrust {n}: {why}" for n, why in diag.distrust)
+    lines.extend(f"  {note}" for note in res.notes)
+    if not res.success:
+        lines.append(f"  NOT CONVERGED: {res.message}")
+    return "\n".join(lines)
 
 
 def report_text(res: Any, held_out: Any = None) -> str:

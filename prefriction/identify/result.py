@@ -91,21 +91,9 @@ class FitResult:
     def diagnostics(self) -> "ResidualDiagnostics":
         """Residual diagnostics: runs, autocorrelation, spikes at reversals and the estimates to
         distrust (:mod:`prefriction.identify.diagnostics`, ``docs/identify.md#diagnostics``)."""
-        from prefriction.identify.diagnostics import diagnose
+        from prefriction.identify.diagnostics import diagnose_fit
 
-        if not isinstance(self.data, (ForceDisplacement, Motion)):
-            raise TypeError(f"residual diagnostics need a fit of ForceDisplacement or Motion data (records in time), "
-                            f"got {type(self.data).__name__}")
-        x = self.data.path if isinstance(self.data, ForceDisplacement) else self.data.x
-        st = self.statistics
-        times = next((np.atleast_1d(v) for k, v in self.nuisance.items() if k.startswith("reversal times")), None)
-        rev = None if times is None else np.clip(np.searchsorted(self.data.t, times), 0, len(self.data.t) - 1)
-        noise = 0.0
-        if isinstance(self.data, Motion):
-            from prefriction.identify.positions import noise_sd
-
-            noise = noise_sd(self.data.x_noise, self.data.quantum)
-        return diagnose(self.residuals, x, self.names, self.stderr, st.stderr_iid, st.influence, rev, noise)
+        return diagnose_fit(self)
 
     @property
     def unidentifiable(self) -> tuple[str, ...]:
@@ -195,27 +183,9 @@ class FitResult:
         """A few lines: the fitted model, the residual level, estimates with intervals and bound
         flags, any unidentifiable parameter, the start pipeline's steps (Motion fits), residual
         structure and the estimates to distrust, what was compared, and non-convergence."""
-        st = self.statistics
-        unit = "m" if isinstance(self.data, Motion) else "N"
-        lines = [f"{model_name(self.model)} fitted to {len(self.residuals)} samples of "
-                 f"{type(self.data).__name__}: residual sd {st.sigma_hat:.4g} {unit}, {st.dof} dof"]
-        for i, (n, u, v, lo, hi) in enumerate(zip(self.names, self.units, self.estimates, self.low, self.high)):
-            lines.append(f"  {n:<14} {v:< 12.6g} [{lo:.6g}, {hi:.6g}] {u}" + self._flag(i, "  "))
-        for n, why in st.unidentifiable:
-            lines.append(f"  not identifiable: {n} ({why})")
-        lines.extend(f"  start: {step}" for step in getattr(self, "start", ()))
-        if isinstance(self.data, (ForceDisplacement, Motion)):
-            diag = self.diagnostics
-            lines.extend(f"  residual structure: {f}" for f in diag.findings)
-            lines.extend(f"  distrust {n}: {why}" for n, why in diag.distrust)
-        lines.extend(f"  {note}" for note in self.notes)
-        if not self.success:
-            lines.append(f"  NOT CONVERGED: {self.message}")
-        return "\n".join(lines)
+        from prefriction.identify.report import summary_text
 
-    def _flag(self, i: int, sep: str) -> str:
-        return f"{sep}({self.flags[i]})" if i < len(self.flags) and self.flags[i] else ""
-
+        return summary_text(self)
 
     def report(self, held_out: "ForceDisplacement | Motion | Validation | None" = None) -> str:
         """What the fit did and how sure it is: the start pipeline's steps, a table of estimates,

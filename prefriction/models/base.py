@@ -6,9 +6,9 @@ Everything else has a default here (template-method style): the reversal keeps t
 structure key is the class and its sizes, the run-time numbers are the declared parameters in
 normalised units, the units come from the parameters named or measured in ``N/m`` and ``N``,
 rate independence is read off ``rate`` and ``force``, and the branch energy of a one-state model
-is a quadrature (:mod:`prefriction.models.defaults`). Closed forms (``advance``,
-``free_branch``, ``branch_energy_of_force``, ...) are optional overrides that make a model
-faster. See ``docs/models.md#add-a-model``.
+is a quadrature (:mod:`prefriction.models.defaults`). Closed forms of a branch (``advance``,
+``free_branch``, ``branch_energy_of_force``, ...: :mod:`prefriction.models.branch_hooks`) are
+optional overrides that make a model faster. See ``docs/models.md#add-a-model``.
 """
 
 from __future__ import annotations
@@ -16,14 +16,14 @@ from __future__ import annotations
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
 from functools import cached_property
-from typing import TYPE_CHECKING, Any, ClassVar, Hashable, Optional, Sequence
+from typing import TYPE_CHECKING, Any, ClassVar, Hashable, Sequence
 
 import casadi as ca
 import numpy as np
 
 from prefriction._validation import check_nonnegative, check_positive, check_real
-from prefriction.models.defaults import (branch_energy_by_quadrature, detect_rate_independent, normalised_parameters,
-                                         state_of_force)
+from prefriction.models.branch_hooks import BranchHooks
+from prefriction.models.defaults import detect_rate_independent, normalised_parameters, state_of_force
 
 if TYPE_CHECKING:  # prefriction.units imports the models
     from prefriction.units import Scales
@@ -72,7 +72,7 @@ def unit_of(par: Parameter) -> str:
     return " ".join(par.unit.split())
 
 
-class FrictionModel(ABC):
+class FrictionModel(BranchHooks, ABC):
     """Contract of a friction model for the simulator, the sweeps and the energy analysis.
 
     **Required** (the mathematics): :attr:`parameters`, :attr:`n_states`, :meth:`rate`,
@@ -277,19 +277,6 @@ class FrictionModel(ABC):
         """
         return list(z), [0.0 * f for f in m]
 
-    def advance(self, z: Sequence[Any], m: Sequence[Any], v: Any, dt: Any, s: Any,
-                q: Any) -> Optional[tuple[list[Any], list[Any]]]:
-        """Exact state after ``dt`` time units at the constant velocity ``v`` on a branch of
-        direction ``s`` (floats and CasADi ``SX`` alike), in-branch events included.
-
-        The optional hook of :func:`prefriction.friction_along` and the force-displacement fit
-        (:func:`prefriction.identify.stepping.interval_function`): a closed form over one
-        sample interval of a prescribed piecewise-linear motion. Every event that falls inside
-        the interval is applied where it occurs (``docs/along.md#exact-steps``). ``None`` (the
-        default): the interval is integrated with Runge-Kutta sub-steps instead.
-        """
-        return None
-
     _sum: ClassVar[Any] = None
     """``Parallel.of``, set by :mod:`prefriction.models.parallel` (which subclasses this class)."""
 
@@ -299,72 +286,3 @@ class FrictionModel(ABC):
         if not isinstance(other, FrictionModel):
             return NotImplemented
         return FrictionModel._sum(self, other)
-
-    @property
-    def has_free_branch(self) -> bool:
-        """True if :meth:`free_branch` may give closed-form branches for this instance (default:
-        if the class overrides it); the unforced simulation then keeps the compact CasADi loop,
-        which takes them, instead of the native driver (``docs/simulator.md#native``)."""
-        return type(self).free_branch is not FrictionModel.free_branch
-
-    def free_branch(self, z: Sequence[float], m: Sequence[float], v: float, s: float, q: Any,
-                    horizon: float) -> Optional[tuple[float, float, list[float], list[float], float, int]]:
-        """Closed-form unforced motion on the current branch, if the model has one (floats).
-
-        The normalised oscillator ``x~'' = -F~`` (unit mass, no input) from the state
-        ``(z, m)``, velocity ``v`` and direction ``s``, followed for at most ``horizon`` time
-        units and no further than the next reversal. The unforced simulation (compact model)
-        takes this instead of integrating: a motion without truncation error, e.g. a linear
-        branch, whose integration error would otherwise accumulate over the cycles, or one
-        across a singular point that a Runge-Kutta step would cross at a reduced order.
-
-        Returns
-        -------
-        tuple or None
-            ``(dt, v1, z1, m1, dx, events)``: the time taken (``dt < horizon``: a reversal at
-            ``dt``, ``v1 = 0``, the state before :meth:`reverse`), the velocity, the state and
-            the displacement at its end, and the number of model events on the way (counted as
-            the simulator counts them: the flags they change). ``None`` (the default) if there
-            is no closed form for this state: the simulator integrates.
-        """
-        return None
-
-    def branch_potential(self, z: Sequence[Any], m: Sequence[Any], s: Any, q: Any) -> Any:
-        """Potential of the friction force along the current branch up to its next model event
-        (floats and CasADi symbols alike), for models whose branch is elastic until then.
-
-        On such a stretch the force depends on the position along the branch alone, so
-        ``v~^2 / 2 + branch_potential - W~`` (``W~`` the input's work) is conserved, and the
-        simulator sets the speed at each model event from it: the event is located on the
-        integrator's dense output, which is of low order next to a singular point such as
-        Dahl's saturation for gamma < 1. ``None`` (the default): no such correction.
-        """
-        return None
-
-    def travel(self, z0: Sequence[float], z1: Sequence[float], s: float, q: Any) -> float:
-        """Normalised displacement between states ``z0`` and ``z1`` of one branch (if
-        :attr:`tracks_position`)."""
-        raise NotImplementedError(f"{type(self).__name__} does not track the position")
-
-    # --- energy (rate-independent models) -------------------------------------------------
-    def branch_energy(self, z: Sequence[float], m: Sequence[float], s: float, q: Any) -> float:
-        """Normalised energy stored on the current branch (direction ``s``) in state ``(z, m)``.
-
-        The area between the branch and the displacement axis from the state back to the
-        branch's force zero crossing: the potential energy ``E_p`` (3.9) when taken just after
-        a reversal. The default uses :meth:`branch_energy_of_force` with the state's force.
-        """
-        return float(self.branch_energy_of_force(np.array([float(self.force(z, m, 0.0, s, q))]), s)[0])
-
-    def branch_energy_of_force(self, F: np.ndarray, s: Any) -> np.ndarray:
-        """Normalised stored energy on a branch of direction ``s`` at forces ``F~`` (numpy),
-        for models whose branch energy depends on the force alone (Dahl); the sample-based
-        energy analysis needs it. Default for a one-state model: ``-int F dx`` from the state of
-        force ``F~`` to the force's zero crossing, by quadrature (:mod:`prefriction.models.defaults`);
-        other models raise ``NotImplementedError``."""
-        if self.n_states != 1:
-            raise NotImplementedError(
-                f"{type(self).__name__} gives no branch energy as a function of the force alone "
-                f"(define branch_energy_of_force(F, s); the quadrature default serves one-state models)"
-            )
-        return branch_energy_by_quadrature(self, F, s)
