@@ -42,7 +42,7 @@ from prefriction.identify.held_first import held_first
 from prefriction.identify.motion_start import derivatives
 from prefriction.identify.motion_step import STATE_CAP, segment_functions
 from prefriction.identify.parameters import ParameterSpace
-from prefriction.identify.pieces import FEWEST, Pieces, breaks_of, derivatives_of, describe, passes_on, piece_window
+from prefriction.identify.pieces import FEWEST, PIECE_TOL, breaks_of, derivatives_of, describe, piece_window
 from prefriction.identify.polish import polish, valley_secant
 from prefriction.identify.reversals import locate_reversals
 from prefriction.identify.substep_rule import follows_data, rates_along
@@ -488,7 +488,7 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
             steps.append(f"continuation: the fit of {name} did not converge ({stage.message[-160:]}); it holds "
                          f"fewer than {FEWEST} reversals each way: the window is cut from {describe(pieces)} instead")
             head, name = pieces, f"{describe(pieces)}{what}"
-            stage = _solve(at, head, sp_k, sp_k.theta_of(vals), n_sub, max_iter, tol,
+            stage = _solve(at, head, sp_k, sp_k.theta_of(vals), n_sub, max_iter, max(tol, PIECE_TOL),
                            None if reversals is None else pieces.to_piece_times(reversals), progress, weight, steps,
                            least)
         if head is data and stage.success:  # the full record with the held parameters held
@@ -498,15 +498,14 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
                 steps.append(done[1])
                 return dataclasses.replace(done[0], steps=tuple(steps))
             fallback = None if long else held_stage
-        passed = "" if stage.success or not isinstance(head, Pieces) else passes_on(stage.problem, stage.w)
-        if not stage.success and not passed:
+        if not stage.success:
             steps.append(f"continuation: the fit of {name} did not converge ({stage.message}); the next stage "
                          f"started from the values before it")
             continue
         least, weight, moved = stage.n_sub, 10.0, True
         vals = dict(vals, **sp_k.values(stage.w[: sp_k.n_free]))
-        steps.append(f"continuation: {name} fitted ({stage.message}{passed}); the next stage started from these "
-                     f"estimates ({_at(sp_k, stage.w)})")
+        steps.append(f"continuation: {name} fitted ({stage.message}); the next stage started from these estimates "
+                     f"({_at(sp_k, stage.w)})")
     # the sub-steps of the full record from the last stage's estimates
     sol = _solve(space.build(vals) if moved else model, data, space, space.theta_of(vals), n_sub, max_iter, tol,
                  reversals, progress, weight, steps, least)
