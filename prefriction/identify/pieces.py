@@ -49,9 +49,8 @@ PIECE_TOL = 1e-8
 :func:`prefriction.identify.constrained_lsq.solve`) of a piece window: a continuation stage, whose
 estimates only start the fit of the whole record (solved to the user's ``tol``). Measured on the
 five-reversal open-loop record of the module notes: at ``tol = 1e-10`` the dense solve of the
-2,000-sample piece window stops at its 200 evaluations with continuity defects of 5e-6 and every
-estimate within 1e-4 of the truth, from a factor-2 start and from the truth alike (its trust region
-cannot lower the sum of squares by a relative 1e-10 per step); at ``1e-8`` it converges from both
+2,000-sample piece window stops at its 200 evaluations with every estimate within 1e-4 of the
+truth, from a factor-2 start (continuity defects of 5e-6) and from the truth alike; at ``1e-8`` it converges from both
 (52 and 50 s of CPU, the chain cut at the long hovers of the slow turns)."""
 MOVING = 0.05
 """Fraction of the top smoothed speed above which a sample counts as moving for the reversal count
