@@ -9,6 +9,7 @@ central finite differences of the chained simulation.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import warnings
 
@@ -94,7 +95,7 @@ def test_piecewise_jacobian_matches_finite_differences_of_the_chain():
     lay = shooting._layout(data, K, shooting._directions(data.t, data.x, vs, None), np.array([X, V]))
     free = np.zeros(lay.J, dtype=bool)
     free[[0, 4, 7]] = True                                          # three pieces
-    lay = shooting._Layout(lay.K, lay.nodes, lay.U0, lay.U1, lay.DT, lay.s, lay.scl, lay.n, free)
+    lay = dataclasses.replace(lay, free=free)
     n_sub = shooting._substeps(model, data, USER.mass, float(np.max(np.abs(state[1]))), None)  # RK4 stable
     prob = shooting._Problem(model, space, data, lay, n_sub, True, USER.mass, 1e-6)
     single = segment_functions(model, space, K, n_sub, True)[0]

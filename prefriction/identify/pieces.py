@@ -35,7 +35,7 @@ from prefriction.identify.data import Motion
 from prefriction.identify.motion_start import derivatives
 
 __all__ = ["FEWEST", "MOST_PIECES", "PIECE_TOL", "Pieces", "breaks_of", "derivatives_of", "describe",
-           "direction_counts", "piece_window", "reversal_samples"]
+           "direction_counts", "moving_flips", "piece_window", "reversal_samples"]
 
 FEWEST = 2
 """Fewest reversals in each direction in the busiest contiguous window below which the first window
@@ -54,7 +54,7 @@ truth, from a factor-2 start (continuity defects of 5e-6) and from the truth ali
 (52 and 50 s of CPU, the chain cut at the long hovers of the slow turns)."""
 MOVING = 0.05
 """Fraction of the top smoothed speed above which a sample counts as moving for the reversal count
-(as :func:`prefriction.identify.shooting._busiest_window`)."""
+(:func:`moving_flips`, also for :func:`prefriction.identify.shooting._busiest_window`)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -104,6 +104,17 @@ def derivatives_of(data: Motion, window: int) -> tuple[np.ndarray, np.ndarray, n
     return tuple(np.concatenate([p[i] for p in parts]) for i in range(3))  # type: ignore[return-value]
 
 
+def moving_flips(v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Changes of direction of a smoothed velocity ``v`` [m/s] counting only samples that move
+    (``|v|`` above :data:`MOVING` of its top): the last moving sample before each change, the
+    first moving sample after it, and the moving directions (+1, -1, 0 where not moving)."""
+    moving = np.abs(v) > MOVING * float(np.max(np.abs(v)))
+    sv = np.where(moving, np.sign(v), 0.0)
+    nz = np.flatnonzero(sv)
+    change = sv[nz[1:]] != sv[nz[:-1]]
+    return nz[:-1][change], nz[1:][change], sv
+
+
 def reversal_samples(data: Motion) -> tuple[np.ndarray, np.ndarray]:
     """Velocity reversals of a record: the sample of each zero crossing of the smoothed velocity
     (the last one before the speed exceeds :data:`MOVING` of its top in the new direction) and
@@ -115,11 +126,7 @@ def reversal_samples(data: Motion) -> tuple[np.ndarray, np.ndarray]:
         ``(samples, directions)``, both of one entry per reversal.
     """
     _x, v, _a = derivatives(data.t, data.x)
-    moving = np.abs(v) > MOVING * float(np.max(np.abs(v)))
-    sv = np.where(moving, np.sign(v), 0.0)
-    nz = np.flatnonzero(sv)
-    flips = nz[1:][sv[nz[1:]] != sv[nz[:-1]]]
-    prev = nz[:-1][sv[nz[1:]] != sv[nz[:-1]]]
+    prev, flips, sv = moving_flips(v)
     samples = []
     for a, b in zip(prev, flips):  # the last sign change of v between leaving one direction and entering the other
         s = np.sign(v[a:b + 1])

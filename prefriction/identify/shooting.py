@@ -42,7 +42,8 @@ from prefriction.identify.held_first import held_first
 from prefriction.identify.motion_start import derivatives
 from prefriction.identify.motion_step import STATE_CAP, segment_functions
 from prefriction.identify.parameters import ParameterSpace
-from prefriction.identify.pieces import FEWEST, PIECE_TOL, breaks_of, derivatives_of, describe, piece_window
+from prefriction.identify.pieces import (FEWEST, PIECE_TOL, breaks_of, derivatives_of, describe, moving_flips,
+                                        piece_window)
 from prefriction.identify.polish import polish, valley_secant
 from prefriction.identify.reversals import locate_reversals
 from prefriction.identify.substep_rule import follows_data, rates_along
@@ -116,15 +117,11 @@ class _Layout:
     scl: np.ndarray
     n: int
     free: np.ndarray
-    s_to: np.ndarray | None = None
-    """Direction of each segment's end state: the next node's (the default), at a junction of
-    pieces the segment's own."""
+    s_to: np.ndarray
+    """Direction of each segment's end state: the next node's, at a junction of pieces the
+    segment's own."""
     breaks: int = 0
     """Junctions of a :class:`prefriction.identify.pieces.Pieces` record among the chain's starts."""
-
-    def __post_init__(self) -> None:
-        if self.s_to is None:
-            object.__setattr__(self, "s_to", np.r_[self.s[1:], self.s[-1]])
 
     @property
     def J(self) -> int:
@@ -646,11 +643,8 @@ def _busiest_window(data: Motion) -> int:
     the most velocity reversals of the smoothed positions, then the most travel: the part of the
     record that excites the friction most."""
     _x, v, _a = derivatives(data.t, data.x)
-    moving = np.abs(v) > 0.05 * float(np.max(np.abs(v)))
-    sv = np.where(moving, np.sign(v), 0.0)
-    nz = np.flatnonzero(sv)
     flips = np.zeros(len(data))
-    flips[nz[1:][sv[nz[1:]] != sv[nz[:-1]]]] = 1.0
+    flips[moving_flips(v)[1]] = 1.0
     travel = np.abs(np.diff(data.x, prepend=data.x[0]))
     best, key = 0, (-1.0, -1.0)
     for k in range(0, len(data) - WINDOW + 1, WINDOW // 4):
