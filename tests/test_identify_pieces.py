@@ -76,6 +76,24 @@ def test_piece_window_not_cut_when_the_contiguous_window_turns_often(record):
     assert piece_window(data, 0, len(data), K) is None           # the whole record as the window: all its reversals
 
 
+def test_piece_window_not_cut_for_a_stage_resting_between_moves():
+    """A point-to-point record (smoothstep moves of 300 samples, alternating, with rests of
+    ``rest`` samples between them, as a closed loop's set-point changes): a 600-sample window's
+    half (300 samples) cannot slide a 50-sample segment on both sides of a 400-sample rest, so no
+    window of pieces is cut; with rests of 100 samples the same moves turn within it, and one is."""
+    def moves(rest: int) -> Motion:
+        s = np.linspace(0.0, 1.0, 300)
+        up = 3.0 * s**2 - 2.0 * s**3
+        x = np.concatenate([np.concatenate([1e-4 * (up if k % 2 == 0 else 1.0 - up), np.full(rest, 1e-4 * (k % 2 == 0))])
+                            for k in range(8)])
+        t = np.arange(x.size) * DT
+        return Motion(t, x, np.zeros_like(x), MASS, "zoh")
+
+    assert piece_window(moves(400), 0, WIDTH, K) is None
+    pieces = piece_window(moves(100), 0, WIDTH, K)
+    assert pieces is not None and len(pieces.breaks) >= 1
+
+
 def test_node_values_are_smoothed_within_each_piece(record):
     data, _y = record
     pieces = piece_window(data, 0, WIDTH, K)

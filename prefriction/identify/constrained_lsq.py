@@ -172,11 +172,12 @@ def solve(full: Callable, plain: Callable, w0: np.ndarray, lo: np.ndarray, hi: n
             message = f"max_iter = {max_iter} Jacobian evaluations reached"
             break
         final = outer > 1 and gmax_prev <= 10.0 * gtol
-        sol = least_squares(fun, w, jac=jac, bounds=(lower, upper), method="trf",
-                            tr_solver="exact" if dense else "lsmr",
-                            x_scale="jac", xtol=max(tol, final_tol) if final else max(tol, 1e-8),
-                            ftol=max(tol, final_tol) if final else inner_tol,
-                            gtol=1e-12, max_nfev=max(min(budget, _INNER) * 2, 2))
+        with np.errstate(over="ignore"):  # a trial step whose residuals overflow is rejected, not an error
+            sol = least_squares(fun, w, jac=jac, bounds=(lower, upper), method="trf",
+                                tr_solver="exact" if dense else "lsmr",
+                                x_scale="jac", xtol=max(tol, final_tol) if final else max(tol, 1e-8),
+                                ftol=max(tol, final_tol) if final else inner_tol,
+                                gtol=1e-12, max_nfev=max(min(budget, _INNER) * 2, 2))
         stalled = np.array_equal(sol.x, w) or sol.nfev <= 1
         w = sol.x
         r, g = plain(w)

@@ -9,19 +9,24 @@ the viscous coefficient act through the same slow accelerations, so a window wit
 pins these only in combination (measured: that window's fit from a factor-2 start stopped at
 ``Fc = 0.65 N``, offset -2.1 N against 3 N and 0.2 N).
 
-When the fit of the busiest contiguous window does not converge, that window holds fewer than
-:data:`FEWEST` reversals in each direction and the record holds more, the window is cut instead
-from up to :data:`MOST_PIECES` pieces of the record, each centred on a velocity reversal, about
-half in each direction (:func:`piece_window`): each piece slides one way, turns through its
-pre-sliding transient and slides the other way. A record whose contiguous window converges keeps
-that path (measured at 25,000 samples from factor-2 starts: the closed-loop records of the success
-harness, EMPS-like LuGre, the user stage's LuGre and Dahl, each with one reversal in that window,
-converge there in 11 to 18 s of CPU; the event records hold 20 reversals each way in it). The
-pieces are concatenated as a :class:`Pieces` record; each piece starts its own piece of the
-multiple-shooting chain (a node with its own free position, velocity and state, no continuity
-constraint into it), the step across the junction is not simulated (its time step is zero) and
-the smoothed node start values are computed within each piece (:func:`derivatives_of`); it is
-solved to :data:`PIECE_TOL`.
+When the busiest contiguous window holds fewer than :data:`FEWEST` reversals in each direction, the
+record holds more, and at least two of its turns are short (the stage slides again within half a
+window: an open-loop record that turns while sliding, not a closed loop resting at its set points
+between moves), the first window is cut from up to :data:`MOST_PIECES` pieces of the record, each
+centred on a velocity reversal, about half in each direction (:func:`piece_window`), and fitted
+before the contiguous one (:func:`prefriction.identify.shooting.fit_motion`): each piece slides
+one way, turns through its pre-sliding transient and slides the other way. Measured at 25,000
+samples from factor-2 starts: on the slow open-loop records of the success harness the
+contiguous window either stops (the 10 kg LuGre stage: 850 s of CPU before the pieces ran) or
+converges without pinning the stiffness (the 0.3 kg Dahl stage, no reversal each way), where the
+pieces converge in 20 to 30 s; on the closed-loop records (EMPS-like LuGre, the user stage's
+LuGre and Dahl), whose turns are rests of 840 to 1,460 samples, the contiguous window converges
+in 6 to 18 s and pieces cut around their rests did not converge in 75 to 85 s, so they keep the
+contiguous window. The pieces are concatenated as a :class:`Pieces` record; each piece starts its
+own piece of the multiple-shooting chain (a node with its own free position, velocity and state,
+no continuity constraint into it), the step across the junction is not simulated (its time step
+is zero) and the smoothed node start values are computed within each piece
+(:func:`derivatives_of`); it is solved to :data:`PIECE_TOL`.
 """
 
 from __future__ import annotations
@@ -115,15 +120,16 @@ def moving_flips(v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return nz[:-1][change], nz[1:][change], sv
 
 
-def reversal_samples(data: Motion) -> tuple[np.ndarray, np.ndarray]:
+def reversal_samples(data: Motion) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Velocity reversals of a record: the sample of each zero crossing of the smoothed velocity
-    (the last one before the speed exceeds :data:`MOVING` of its top in the new direction) and
-    the new direction (+1 or -1).
+    (the last one before the speed exceeds :data:`MOVING` of its top in the new direction), the
+    new direction (+1 or -1) and the turn's length in samples (from the last moving sample before
+    it to the first after it: long where the stage rests between moves).
 
     Returns
     -------
     tuple of numpy.ndarray
-        ``(samples, directions)``, both of one entry per reversal.
+        ``(samples, directions, turns)``, each of one entry per reversal.
     """
     _x, v, _a = derivatives(data.t, data.x)
     prev, flips, sv = moving_flips(v)
@@ -132,7 +138,7 @@ def reversal_samples(data: Motion) -> tuple[np.ndarray, np.ndarray]:
         s = np.sign(v[a:b + 1])
         change = np.flatnonzero(s[1:] * s[:-1] <= 0.0)
         samples.append(a + 1 + int(change[-1]) if change.size else (a + b) // 2)
-    return np.asarray(samples, dtype=int), sv[flips]
+    return np.asarray(samples, dtype=int), sv[flips], flips - prev
 
 
 def direction_counts(directions: np.ndarray) -> tuple[int, int]:
@@ -141,11 +147,13 @@ def direction_counts(directions: np.ndarray) -> tuple[int, int]:
 
 
 def piece_window(data: Motion, first: int, width: int, K: int) -> Pieces | None:
-    """The first window of a long fit from pieces of ``data`` around its reversals (for a record
-    whose contiguous window did not converge), or ``None`` when the contiguous window
-    ``data[first:first + width]`` (the busiest) holds at least :data:`FEWEST` reversals in each
-    direction, the record holds no more than it in the rarer direction (module notes), or fewer
-    than two pieces of :data:`LEAST_SEGMENTS` segments fit in ``width``.
+    """The first window of a long fit from pieces of ``data`` around its reversals, or ``None``
+    when the contiguous window ``data[first:first + width]`` (the busiest) holds at least
+    :data:`FEWEST` reversals in each direction, the record holds no more than it in the rarer
+    direction, fewer than two of the record's turns (from the last moving sample before a reversal
+    to the first after it) are shorter than half of ``width`` less two segments (a stage resting
+    between moves, module notes), or fewer than two pieces of :data:`LEAST_SEGMENTS` segments fit
+    in ``width``.
 
     Parameters
     ----------
@@ -164,13 +172,13 @@ def piece_window(data: Motion, first: int, width: int, K: int) -> Pieces | None:
         reversal (moved inwards at the ends of the record), chosen evenly over the record and
         about half in each direction; pieces that would overlap are joined end to start.
     """
-    at, to = reversal_samples(data)
+    at, to, turns = reversal_samples(data)
     inside = (at >= first) & (at < first + width)
     if min(direction_counts(to[inside])) >= FEWEST or min(direction_counts(to)) <= min(direction_counts(to[inside])):
         return None
     n_pieces = min(MOST_PIECES, at.size, width // (LEAST_SEGMENTS * K))
-    if n_pieces < 2:
-        return None
+    if n_pieces < 2 or np.count_nonzero(turns + 2 * K <= K * (width // (2 * K))) < 2:
+        return None   # fewer than two turns within half a window of sliding both ways: a stage resting between moves
     length = K * (width // (n_pieces * K))
     chosen: list[int] = []
     ups, downs = np.flatnonzero(to > 0), np.flatnonzero(to < 0)

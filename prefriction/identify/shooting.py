@@ -9,9 +9,9 @@ minimised subject to the continuity of the segments by scipy's trust-region leas
 augmented Lagrangian on sparse matrices (:mod:`prefriction.identify.constrained_lsq`), with
 forward sensitivities propagated sample by sample. A record longer than ``2 WINDOW`` samples
 fits its :data:`WINDOW` samples with the most reversals first and starts the full record from
-their estimates (continuation; where that window does not converge and holds fewer than two
-reversals each way, a window cut from pieces of the record around its reversals,
-:mod:`prefriction.identify.pieces`); parameters the record pins only together with another
+their estimates (continuation; where that window holds fewer than two reversals each way and
+the record turns while sliding, a window cut from pieces of the record around its reversals
+first, :mod:`prefriction.identify.pieces`, :func:`_first_window`); parameters the record pins only together with another
 (:mod:`prefriction.identify.held_first`) are held at their start values in the window and in a
 first fit of the full record, and freed in the last. Nothing holds more than a few numbers per sample and sensitivity column, so the
 time and the memory of a fit grow linearly with the samples (measured:
@@ -27,6 +27,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import sys
+import time
 from dataclasses import dataclass
 from typing import Any
 
@@ -436,6 +437,14 @@ def _progress(line: str) -> None:
     print(f"motion fit: {line}", file=sys.stderr, flush=True)
 
 
+def _tag(progress: Any, name: str, t0: float) -> Any:
+    """``progress`` (or ``None``) with each line prefixed by the stage ``name`` and the wall-clock
+    seconds since ``t0`` (:func:`time.perf_counter`)."""
+    if progress is None:
+        return None
+    return lambda line: progress(f"{name}, {time.perf_counter() - t0:.0f} s: {line}")
+
+
 @with_one_blas_thread
 def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_sub: int | None, max_iter: int,
                tol: float, reversals: Any = None, verbose: bool = False,
@@ -462,32 +471,24 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
         with ``success = False`` instead).
     """
     steps: list[str] = []
-    progress = _progress if verbose or len(data) >= LONG else None
-    stages: list[tuple[Motion, ParameterSpace, Any, str]] = []
+    progress, t0 = (_progress if verbose or len(data) >= LONG else None), time.perf_counter()
+    stages: list[tuple[Motion | None, ParameterSpace, Any, str]] = []   # None: the first window
     long = len(data) > 2 * WINDOW
     what = "" if held is None else f" with {', '.join(n for n in space.free if n not in held.free)} held"
     if long:
-        k0 = _busiest_window(data)
-        part = slice(k0, k0 + WINDOW)
-        stages.append((Motion(data.t[part], data.x[part], data.u[part], data.mass, data.hold),
-                       space if held is None else held,
-                       None if reversals is None else [r for r in reversals if data.t[k0] < r < data.t[k0 + WINDOW - 1]],
-                       f"samples {k0} to {k0 + WINDOW - 1}{what}"))
+        stages.append((None, space if held is None else held, reversals, "the first window"))
     if held is not None:
         stages.append((data, held, reversals, f"the record{what}"))
     vals, least, weight, moved = dict(space.start), 1, 0.01, False
     fallback = None   # a short record's held stage: the solution if the free stage does not converge
     for i, (head, sp_k, given, name) in enumerate(stages):   # continuation (module notes, identify/held_first.py)
         at = sp_k.build(vals) if moved else model
-        stage = _solve(at, head, sp_k, sp_k.theta_of(vals), n_sub, max_iter, tol, given, progress, weight, steps,
-                       least)
-        if long and i == 0 and not stage.success and (pieces := piece_window(data, k0, WINDOW, SEGMENT)) is not None:
-            steps.append(f"continuation: the fit of {name} did not converge ({stage.message[-160:]}); it holds "
-                         f"fewer than {FEWEST} reversals each way: the window is cut from {describe(pieces)} instead")
-            head, name = pieces, f"{describe(pieces)}{what}"
-            stage = _solve(at, head, sp_k, sp_k.theta_of(vals), n_sub, max_iter, max(tol, PIECE_TOL),
-                           None if reversals is None else pieces.to_piece_times(reversals), progress, weight, steps,
-                           least)
+        if long and i == 0:
+            stage, head, name = _first_window(at, data, sp_k, sp_k.theta_of(vals), n_sub, max_iter, tol, reversals,
+                                              progress, t0, weight, steps, what)
+        else:
+            stage = _solve(at, head, sp_k, sp_k.theta_of(vals), n_sub, max_iter, tol, given, _tag(progress, name, t0),
+                           weight, steps, least)
         if head is data and stage.success:  # the full record with the held parameters held
             held_stage = (at, data, space, dict(vals, **sp_k.values(stage.w[: sp_k.n_free])), stage, name)
             done = _settled_without(*held_stage) if long else None
@@ -505,11 +506,67 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
                      f"({_at(sp_k, stage.w)})")
     # the sub-steps of the full record from the last stage's estimates
     sol = _solve(space.build(vals) if moved else model, data, space, space.theta_of(vals), n_sub, max_iter, tol,
-                 reversals, progress, weight, steps, least)
+                 reversals, _tag(progress, "the record", t0), weight, steps, least)
     if not sol.success and fallback is not None and (done := _settled_without(*fallback)) is not None:
         steps.append(f"the fit with every parameter free did not converge ({sol.message[-160:]}); {done[1]}")
         return dataclasses.replace(done[0], steps=tuple(steps))
     return dataclasses.replace(sol, steps=tuple(steps))
+
+
+def _first_window(model: FrictionModel, data: Motion, space: ParameterSpace, theta0: np.ndarray, n_sub: int | None,
+                  max_iter: int, tol: float, reversals: Any, progress: Any, t0: float, weight: float,
+                  steps: list[str], what: str) -> tuple[MotionSolution, Motion, str]:
+    """The fit of a long record's first window (continuation): ``(solution, window, name)``.
+
+    The window is the busiest contiguous :data:`WINDOW` samples, or, when those hold fewer than
+    :data:`prefriction.identify.pieces.FEWEST` reversals each way and the record more, one cut
+    from pieces of the record around its reversals (:func:`prefriction.identify.pieces.piece_window`,
+    solved to at least :data:`prefriction.identify.pieces.PIECE_TOL`). When the first choice
+    cannot start the record (:func:`_window_weak`) the other is fitted from the same start and
+    taken if it converges. Notes go to ``steps``; ``what`` names held parameters."""
+    k0 = _busiest_window(data)
+    part = slice(k0, k0 + WINDOW)
+    inside = None if reversals is None else [r for r in reversals if data.t[k0] < r < data.t[k0 + WINDOW - 1]]
+    choices: list[tuple[Motion, Any, str, str, float]] = [
+        (Motion(data.t[part], data.x[part], data.u[part], data.mass, data.hold), inside,
+         f"samples {k0} to {k0 + WINDOW - 1}{what}", f"samples {k0} to {k0 + WINDOW - 1}", tol)]
+    pieces = piece_window(data, k0, WINDOW, SEGMENT)
+    if pieces is not None:
+        choices.insert(0, (pieces, None if reversals is None else pieces.to_piece_times(reversals),
+                           f"{describe(pieces)}{what}", f"{len(pieces.source)} pieces around reversals",
+                           max(tol, PIECE_TOL)))
+    kept = None
+    for k, (window, given, name, short, tol_k) in enumerate(choices):
+        stage = _solve(model, window, space, theta0, n_sub, max_iter, tol_k, given, _tag(progress, short, t0), weight,
+                       steps)
+        weak = _window_weak(stage, space)
+        if kept is None or (stage.success and not kept[0].success):
+            kept = (stage, window, name)
+        if not weak:
+            return stage, window, name
+        if k + 1 < len(choices):
+            steps.append(f"continuation: the fit of {name} {weak}: the first window is {choices[k + 1][2]} instead"
+                         + (f" (the busiest contiguous window holds fewer than {FEWEST} reversals each way)"
+                            if k == 0 else ""))
+    return kept
+
+
+def _window_weak(stage: MotionSolution, space: ParameterSpace) -> str:
+    """Why the fit ``stage`` of a long record's first window cannot start the record: it did not
+    converge, or it leaves a free parameter of ``space`` unpinned (relative standard error above
+    50 % under white residuals, :func:`prefriction.identify.statistics.gauss_newton`; measured: a
+    0.3 kg open-loop Dahl + viscous + offset window without a reversal each way pins only
+    ``Fc + offset``, and the record started from it ends at a stiffness 99 % low); ``""`` when it can."""
+    from prefriction.identify.statistics import gauss_newton
+
+    if not stage.success:
+        return f"did not converge ({stage.message[-160:]})"
+    theta = stage.w[: space.n_free]
+    at = space.values(theta)
+    Jp, sc = space.physical_jacobian(stage.jacobian, theta)
+    stats = gauss_newton(Jp, stage.residuals, space.free, np.array([at[n] for n in space.free]), sc, limit=0.5)
+    loose = "; ".join(f"{n}: {why}" for n, why in stats.unidentifiable)
+    return f"converged without pinning every parameter ({loose})" if loose else ""
 
 
 def _settled_without(at: FrictionModel, data: Motion, space: ParameterSpace, after: dict,
