@@ -143,3 +143,27 @@ def test_each_piece_is_simulated_from_its_own_start_and_the_junction_carries_no_
 def pieces_samples(prob: _Problem) -> np.ndarray:
     """The sample (in the concatenation) of every residual row of ``prob``."""
     return prob.samples[prob.rows]
+
+
+def test_window_weak_names_an_unpinned_parameter_and_a_stopped_fit():
+    """``_window_weak``: a converged window whose residuals do not move with ``sigma`` (its
+    Jacobian column zero, the other columns random) leaves ``sigma`` unpinned; with every column
+    random it can start the record; a fit that did not converge cannot."""
+    from prefriction.identify.shooting import MotionSolution, _window_weak
+
+    space = ParameterSpace(Dahl(sigma=SIGMA, Fc=FC, gamma=1.0), None, ["gamma"], None, mass=None, offset=FC,
+                           offset0=OFFSET)
+    rng = np.random.default_rng(3)
+    J = rng.standard_normal((400, space.n_free + 3))
+    w = np.r_[space.theta0, np.zeros(3)]
+    r = 1e-3 * rng.standard_normal(400)
+
+    def solution(jac: np.ndarray, success: bool) -> MotionSolution:
+        return MotionSolution(w, r, jac, None, np.zeros(400), {}, "stopped at max_iter", success)
+
+    assert _window_weak(solution(J, True), space) == ""
+    loose = J.copy()
+    loose[:, space.free.index("sigma")] = 0.0
+    weak = _window_weak(solution(loose, True), space)
+    assert "sigma" in weak and "Fc" not in weak
+    assert _window_weak(solution(J, False), space).startswith("did not converge (stopped at max_iter")
