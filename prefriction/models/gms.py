@@ -21,8 +21,20 @@ slips far below its curve); formulations in element deflections ``d_i' = sgn(v) 
 k_i d_i / (alpha_i s(v)))`` have ``C' = C / k_i`` [m/s] instead. The Stribeck curve with
 the shape exponent ``delta`` (2 by default, the Gaussian form) is the usual one of GMS.
 
+**Normalised numbers** (``docs/models.md``). The units are ``sigma = sum k_i`` (the rest
+stiffness: every element sticks after a reversal) and ``Fc``. With the velocity unit ``V = Fc /
+sqrt(m sigma)`` (it holds the mass ``m``) the run-time numbers are
+(:meth:`GMS.runtime_params_for`)::
+
+    q = (kappa_1..N, alpha_1..N, mu_1..N, Fs/Fc - 1, V/vs, delta/2, C~, sigma2~)
+
+with ``kappa_i = k_i / sigma``, ``mu_i = sigma_i V / (Fc kappa_i)``, ``C~ = C / (sigma V)``
+(``C`` times the time unit ``sqrt(m / sigma)`` over ``Fc``) and ``sigma2~ = sigma2 V / Fc``.
+The structure is ``N`` alone: one compiled plant serves every GMS with ``N`` elements, whatever
+its numbers or mass.
+
 **Protocol** (the normalised numbers ``kappa_i``, ``mu_i``, ``C~``, ``sigma2~`` and the velocity
-unit ``V`` of the class notes). States ``z_i = F_i / Fc`` and the retrace guard ``r`` of
+unit ``V`` above). States ``z_i = F_i / Fc`` and the retrace guard ``r`` of
 :mod:`prefriction.models.elements` (``r' = 2 max(-s v~, 0)``, zero on every branch); flags
 ``m_i`` (element ``i`` slips). With ``S~(v~) = 1 + (Fs/Fc - 1) exp(-((v~ V/vs)^2)^(delta/2))``::
 
@@ -47,6 +59,10 @@ slip forces ``alpha_i Fc`` (elements at their limit slip if they move along ``f0
 F_i' / k_i`` at a slip, and at a reversal a slipping element's ``F_i'`` does not vanish at ``v =
 0`` (after the reversal it sticks); the reversal table of unforced runs records the force after
 the model's reset, that of forced runs the force before it.
+
+**Equal to Maxwell-slip.** With ``Fs = Fc`` and no damping (``damping``, ``sigma2`` zero) the
+model *is* :class:`prefriction.MaxwellSlip` with ``W_i = alpha_i Fc`` for every ``C`` and
+``vs``: a slipping element starts on its equilibrium ``s alpha_i Fc`` and stays there.
 """
 
 from __future__ import annotations
@@ -76,27 +92,16 @@ ALPHA_SUM_TOL = 1e-9
 class GMS(StribeckCurve, ParallelElements):
     """Generalised Maxwell-slip friction (Al-Bender, Lampaert and Swevers 2005).
 
-    F. Al-Bender, V. Lampaert, J. Swevers, "The generalized Maxwell-slip model: a novel model
-    for friction simulation and compensation", IEEE Transactions on Automatic Control 50(11),
-    1883-1887, 2005.
-
-    ``N`` elements in parallel. Element ``i`` is a spring ``k_i`` (deflection ``d_i``, force
-    ``F_i = k_i d_i``) whose slip force is the fraction ``alpha_i`` of the Stribeck curve
-
-        ``S(v) = Fc + (Fs - Fc) exp(-|v / vs|^delta)``   (a magnitude, ``S > 0``).
-
-    On a branch of direction ``s = sign(v)``:
-
-    - **sticking**: ``F_i' = k_i v`` (``d_i' = v``), until ``s F_i`` reaches ``alpha_i S(v)``
-      (a slip event);
-    - **slipping**: ``F_i' = s C (1 - s F_i / (alpha_i S(v)))``, i.e. ``F_i`` relaxes towards
-      ``s alpha_i S(v)`` at the rate ``C / (alpha_i S(v))``, until the velocity reverses;
-      then every element sticks again.
-
-    The friction force is ``F = sum_i (F_i + sigma_i d_i') + sigma2 v`` with the micro-damping
-    ``sigma_i`` (argument ``damping``, default 0) acting on the element deflection rates
-    ``d_i' = F_i' / k_i``. In steady sliding every element slips at ``s alpha_i S(v)``:
-    ``F = sign(v) S(v) + sigma2 v`` (:meth:`steady_force`).
+    ``N`` elements in parallel; element ``i`` is a spring ``k_i`` (force ``F_i = k_i d_i``) whose
+    slip force is the fraction ``alpha_i`` of the Stribeck curve ``S(v) = Fc + (Fs - Fc)
+    exp(-|v / vs|^delta)``. On a branch of direction ``s = sign(v)`` it sticks, ``F_i' = k_i v``,
+    until ``s F_i`` reaches ``alpha_i S(v)`` (a slip event), then slips, ``F_i' = s C (1 - s F_i
+    / (alpha_i S(v)))`` (towards ``s alpha_i S(v)`` at the rate ``C / (alpha_i S(v))``), until
+    the velocity reverses. The force is ``F = sum_i (F_i + sigma_i F_i' / k_i) + sigma2 v``
+    (micro-damping ``sigma_i``, argument ``damping``); in steady sliding ``F = sign(v) S(v) +
+    sigma2 v`` (:meth:`steady_force`). Source, slipping law as written here, normalised numbers
+    ``q``, states, events and reversal map: module notes of :mod:`prefriction.models.gms` and
+    ``docs/models.md#other-models``.
 
     Parameters
     ----------
@@ -132,30 +137,12 @@ class GMS(StribeckCurve, ParallelElements):
 
     Notes
     -----
-    Normalised units (``docs/models.md``): ``sigma = sum k_i`` (the rest stiffness: every
-    element sticks after a reversal) and ``Fc``. With the velocity unit ``V = Fc / sqrt(m
-    sigma)`` (it holds the mass ``m``) the run-time numbers are (:meth:`runtime_params_for`)::
-
-        q = (kappa_1..N, alpha_1..N, mu_1..N, Fs/Fc - 1, V/vs, delta/2, C~, sigma2~)
-
-    with ``kappa_i = k_i / sigma``, ``mu_i = sigma_i V / (Fc kappa_i)``, ``C~ = C / (sigma V)``
-    (``C`` times the time unit ``sqrt(m / sigma)`` over ``Fc``) and ``sigma2~ = sigma2 V /
-    Fc``. The structure is ``N`` alone: one compiled plant serves every GMS with ``N``
-    elements, whatever its numbers or mass.
-
-    The slipping law as quoted from the paper, and the states, rates, events and reversal map
-    of the protocol: module notes.
-
-    ``F0`` of :func:`prefriction.simulate` is the elastic force ``sum F_i`` at the start; with
-    micro-damping the force jumps at slips and reversals (module notes). Rate-dependent
-    (``rate_independent = False``): the table's ``E_p`` is NaN; the energy analysis
-    (:mod:`prefriction.energy`) analyses the model as the equal Maxwell-slip model when ``Fs =
-    Fc`` and there is no damping (next paragraph), and refuses any other configuration with a
-    ``TypeError``.
-
-    With ``Fs = Fc`` and no damping (``damping``, ``sigma2`` zero) the model *is*
-    :class:`prefriction.MaxwellSlip` with ``W_i = alpha_i Fc`` for every ``C`` and ``vs``: a
-    slipping element starts on its equilibrium ``s alpha_i Fc`` and stays there.
+    Normalised units ``sigma = sum k_i`` (the rest stiffness) and ``Fc``; the run-time numbers
+    contain the mass (:meth:`runtime_params_for`). ``F0`` of :func:`prefriction.simulate` is the
+    elastic force ``sum F_i`` at the start. Rate-dependent: the table's ``E_p`` is NaN. With ``Fs
+    = Fc`` and no damping (``damping``, ``sigma2`` zero) the model *is*
+    :class:`prefriction.MaxwellSlip` with ``W_i = alpha_i Fc``, as which the energy analysis
+    (:mod:`prefriction.energy`) analyses it; it refuses any other GMS with a ``TypeError``.
 
     Examples
     --------
@@ -213,7 +200,7 @@ class GMS(StribeckCurve, ParallelElements):
     # --- structure and numbers ------------------------------------------------------------
     def runtime_params_for(self, scales: "Scales") -> np.ndarray:
         """``q = (kappa_i, alpha_i, mu_i, Fs/Fc - 1, V/vs, delta/2, C/(sigma V), sigma2 V/Fc)``
-        with the velocity unit ``V = scales.v = Fc / sqrt(m sigma)`` of the system (class notes)."""
+        with the velocity unit ``V = scales.v = Fc / sqrt(m sigma)`` of the system (module notes)."""
         V, sig, Fc = scales.v, self.sigma, self.Fc
         kappa = self.k / sig
         mu = self.damping * V / Fc / kappa
