@@ -3,18 +3,16 @@ analytic kinds, whose numbers are named float fields."""
 
 from __future__ import annotations
 
-import math
 import warnings
 from abc import ABC, abstractmethod
 from collections.abc import Hashable
-from typing import Any, Optional, Union
+from typing import Any, Optional
 
-import casadi
 import numpy as np
 
-from prefriction._validation import check_real_array
 from prefriction.signals._checks import is_real
-from prefriction.signals._ops import CASADI_TYPES, CasadiOps, MathOps, NumpyOps, vector
+from prefriction.signals._ops import CASADI_TYPES, CasadiOps, NumpyOps, vector
+from prefriction.signals.values import SignalValues
 
 def _rebuild(cls: type, state: dict) -> "Signal":
     """Inverse of :meth:`Signal.__reduce__`."""
@@ -23,7 +21,7 @@ def _rebuild(cls: type, state: dict) -> "Signal":
     return obj
 
 
-class Signal(ABC):
+class Signal(SignalValues, ABC):
     """Scalar signal of time: structure (:attr:`key`) compiled once, numbers given at run time.
 
     Subclasses are immutable. Signals add with ``+`` (to a signal or a plain number), giving a
@@ -139,60 +137,6 @@ class Signal(ABC):
         """Value at ``t`` with validated ``theta``, ``piece`` and the operations ``ops``."""
 
     # --- numeric -----------------------------------------------------------------------------
-
-    def __call__(self, t: Any) -> Union[float, np.ndarray]:
-        """Numeric value, vectorised.
-
-        Parameters
-        ----------
-        t : float or array_like
-            Time(s) [s].
-
-        Returns
-        -------
-        float or numpy.ndarray
-            The value(s), shaped like ``t`` (a float for a scalar ``t``).
-        """
-        if isinstance(t, float) and self.n_piece == 0 and math.isfinite(t):  # one time: no numpy (~30 us)
-            return float(self._expr(t, self.params().tolist(), (), MathOps))
-        return self.expr(check_real_array("t", t, "s"), self.params())
-
-    def velocity(self, t: Any) -> Union[float, np.ndarray]:
-        """Time derivative of the signal [signal units / s] at the time(s) ``t`` [s], vectorised.
-
-        Exact: CasADi's derivative of :meth:`expr` for the analytic kinds, the slope of the
-        current line for piecewise-linear ones (:meth:`linear_piece`). At a kink (a break, the
-        end of a ramp) the slope just after ``t``; a jump (:class:`Step`, :class:`ZeroOrderHold`)
-        counts 0. A position reference's velocity [m/s], e.g. for a compensator or exported code.
-
-        Parameters
-        ----------
-        t : float or array_like
-            Time(s) [s].
-
-        Returns
-        -------
-        float or numpy.ndarray
-            The derivative(s), shaped like ``t`` (a float for a scalar ``t``).
-        """
-        tt = np.asarray(check_real_array("t", t, "s"), dtype=float)
-        breaks = self.breaks()
-        after = np.append(breaks, np.inf)[np.searchsorted(breaks, tt, side="right")]  # next break after t
-        value = np.full(tt.shape, np.nan)
-        for i, ti in np.ndenumerate(tt):  # piecewise-linear kinds: the slope of the line after ti
-            piece = self.linear_piece(float(ti), float(after[i]) if np.isfinite(after[i]) else float(ti) + 1.0)
-            if piece is None:
-                break
-            value[i] = piece[1]
-        rest = np.isnan(value)
-        if rest.any() and self.n_piece > 0:  # a kind with per-interval numbers is piecewise linear
-            value[rest] = 0.0
-        elif rest.any():  # analytic: CasADi's derivative of the expression
-            ts, th = casadi.SX.sym("t"), casadi.SX.sym("theta", self.n_params)
-            d = casadi.Function("velocity", [ts, th], [casadi.jacobian(self.expr(ts, th), ts)])
-            flat = tt[rest]
-            value[rest] = np.array(d.map(flat.size)(flat.reshape(1, -1), self.params()), dtype=float).ravel()
-        return float(value) if value.ndim == 0 else value
 
     def breaks(self) -> np.ndarray:
         """Times at which the signal or its first derivative jumps.
