@@ -8,7 +8,8 @@ normalised units, the units come from the parameters named or measured in ``N/m`
 rate independence is read off ``rate`` and ``force``, and the branch energy of a one-state model
 is a quadrature (:mod:`prefriction.models.defaults`). Closed forms of a branch (``advance``,
 ``free_branch``, ``branch_energy_of_force``, ...: :mod:`prefriction.models.branch_hooks`) are
-optional overrides that make a model faster. See ``docs/models.md#add-a-model``.
+optional overrides that make a model faster; the defaults of ``events``, ``on_event`` and
+``reverse`` are in :mod:`prefriction.models.event_hooks`. See ``docs/models.md#add-a-model``.
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ import numpy as np
 from prefriction._validation import check_nonnegative, check_positive, check_real
 from prefriction.models.branch_hooks import BranchHooks
 from prefriction.models.defaults import detect_rate_independent, normalised_parameters, state_of_force
+from prefriction.models.event_hooks import EventHooks
 
 if TYPE_CHECKING:  # prefriction.units imports the models
     from prefriction.units import Scales
@@ -72,7 +74,7 @@ def unit_of(par: Parameter) -> str:
     return " ".join(par.unit.split())
 
 
-class FrictionModel(BranchHooks, ABC):
+class FrictionModel(EventHooks, BranchHooks, ABC):
     """Contract of a friction model for the simulator, the sweeps and the energy analysis.
 
     **Required** (the mathematics): :attr:`parameters`, :attr:`n_states`, :meth:`rate`,
@@ -244,14 +246,6 @@ class FrictionModel(BranchHooks, ABC):
     def force(self, z: Sequence[Any], m: Sequence[Any], v: Any, s: Any, q: Any) -> Any:
         """Normalised friction force ``F~``."""
 
-    def events(self, z: Sequence[Any], m: Sequence[Any], v: Any, s: Any, q: Any) -> list[Any]:
-        """In-branch event indicators: positive before the event, the event where one turns negative.
-
-        An indicator that must not fire (e.g. its element already slips) returns a positive
-        constant. The list has :attr:`n_events` entries.
-        """
-        return []
-
     def velocity_scale(self, q: Any) -> Any:
         """Normalised velocity below which the force changes sharply with the speed (a Stribeck
         velocity ``vs~``), or ``None`` (the default: no such scale).
@@ -263,19 +257,6 @@ class FrictionModel(BranchHooks, ABC):
         CasADi symbols).
         """
         return None
-
-    def on_event(self, k: int, z: Sequence[Any], m: Sequence[Any], s: Any, q: Any) -> tuple[list[Any], list[Any]]:
-        """State ``(z, m)`` just after in-branch event ``k``."""
-        raise NotImplementedError(f"{type(self).__name__} has no in-branch events")
-
-    def reverse(self, z: Sequence[Any], m: Sequence[Any], s_new: Any, q: Any, snap: Any) -> tuple[list[Any], list[Any]]:
-        """State ``(z, m)`` just after a velocity reversal into direction ``s_new``.
-
-        ``snap`` is the relative tolerance of the run: an event whose indicator is within
-        ``snap`` of zero at the reversal may be taken as coinciding with it. Default: the
-        state carries over and the flags clear (the modes end with the motion).
-        """
-        return list(z), [0.0 * f for f in m]
 
     _sum: ClassVar[Any] = None
     """``Parallel.of``, set by :mod:`prefriction.models.parallel` (which subclasses this class)."""
