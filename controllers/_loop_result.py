@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Optional
@@ -10,20 +9,21 @@ from typing import Optional
 import control
 import numpy as np
 
-from prefriction._validation import check_count, check_positive
+from prefriction._validation import check_count
 from prefriction.models import Oscillator
 from prefriction.reversals import ReversalTable
 from prefriction.simulation.loops import LoopStats
 from prefriction.simulation.simulate import SimulationResult
 
 from ._friction_loop import friction_curve
+from ._loop_settling import LoopSettling
 
 MAX_CURVE_POINTS = 10_000_000
 """Most points of :meth:`LoopResult.friction_loop` (160 MB of positions and forces)."""
 
 
 @dataclass(frozen=True, eq=False)
-class LoopResult:
+class LoopResult(LoopSettling):
     """Result of :func:`simulate_loop`, SI units.
 
     The energy balance of the run, with the work of the controller's force counted, is
@@ -101,20 +101,6 @@ class LoopResult:
         Maxwell-slip: the sum of the slip forces)."""
         return self.system.friction.Fc
 
-    @property
-    def residual_error(self) -> float:
-        """Error ``r - x`` at the last output time [m]."""
-        return float(self.error[-1])
-
-    @property
-    def error_bound(self) -> Optional[float]:
-        """``F_max / kp`` [m], the bound of the residual error of a PD loop at rest; ``None`` otherwise.
-
-        At rest the control force ``kp e`` balances the friction force, at most the model's
-        largest force at rest ``F_max`` (``max_hysteretic_force``: ``Fc`` for Dahl and
-        Maxwell-slip, the static force ``Fs`` for LuGre)."""
-        return None if self.kp is None else self.system.friction.max_hysteretic_force / self.kp
-
     def friction_loop(self, points_per_branch: int = 200) -> tuple[np.ndarray, np.ndarray]:
         """Friction force-displacement curve ``F(x)`` [m, N] from the first output sample through
         every reversal to the last one.
@@ -149,43 +135,6 @@ class LoopResult:
         points_per_branch = check_count("points_per_branch", points_per_branch, 2,
                                         max(MAX_CURVE_POINTS // branches, 2), why=f"memory: {branches} branches")
         return friction_curve(self.system, self.t, self.x, self.F, self.reversals, points_per_branch)
-
-    @property
-    def settling_time(self) -> float:
-        """Settling time [s] into a 2 % band of the reference's travel (:meth:`settling_time_within`
-        with ``band = 0.02``)."""
-        return self.settling_time_within(0.02)
-
-    def settling_time_within(self, band: float) -> float:
-        """First time [s] after which the error ``|r - x|`` stays within ``band`` of the reference's travel.
-
-        Measured against the reference, not the final position: the travel is
-        ``max |r(t) - x(0)|`` over the run (a step's height, a move's distance, a sine's peak
-        excursion from the start), and the loop has settled once ``|r - x| <= band * travel`` at
-        every later output sample. A PD loop that stops short of the target by more than the
-        band never settles; a tracking loop settles once its error stays small.
-
-        Parameters
-        ----------
-        band : float
-            Relative band [-], ``0 < band < inf`` (0.02 for the usual 2 % settling time).
-
-        Returns
-        -------
-        float
-            The time [s]; ``inf`` if the error is outside the band at the last output sample
-            (not settled within the run), ``nan`` if the reference never leaves ``x(0)``.
-        """
-        band = check_positive("band", band)
-        travel = float(np.max(np.abs(self.reference - self.x[0])))
-        if travel == 0.0:
-            return math.nan
-        outside = np.nonzero(np.abs(self.error) > band * travel)[0]
-        if outside.size == 0:
-            return float(self.t[0])
-        if outside[-1] == len(self.t) - 1:
-            return math.inf
-        return float(self.t[outside[-1] + 1])
 
     def plot(self, path: "str | Path" = "loop.png") -> Path:
         """Reference and position, the tracking error and the forces against time, saved to ``path``.
