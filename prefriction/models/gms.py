@@ -71,12 +71,12 @@ import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar, Sequence
 
-import casadi as ca
 import numpy as np
 
 from prefriction.models.base import Parameter
 from prefriction.models.closed_form import exp, pick
-from prefriction.models.elements import TIE, ParallelElements, nonnegative_array, symbolic
+from prefriction.models.elements import TIE, ParallelElements, nonnegative_array
+from prefriction.models.gms_slips import GMSSlips
 from prefriction.models.stribeck import StribeckCurve
 
 if TYPE_CHECKING:  # units imports the models
@@ -89,7 +89,7 @@ ALPHA_SUM_TOL = 1e-9
 
 
 @dataclass(frozen=True, eq=False)
-class GMS(StribeckCurve, ParallelElements):
+class GMS(GMSSlips, StribeckCurve, ParallelElements):
     """Generalised Maxwell-slip friction (Al-Bender, Lampaert and Swevers 2005).
 
     ``N`` elements in parallel; element ``i`` is a spring ``k_i`` (force ``F_i = k_i d_i``) whose
@@ -239,48 +239,6 @@ class GMS(StribeckCurve, ParallelElements):
         for i in range(1, n):
             total = total + z[i] + q[2 * n + i] * dz[i]
         return total + q[3 * n + 4] * v
-
-    def _indicator(self, j: int, z: Sequence[Any], v: Any, s: Any, q: Any) -> Any:
-        """Slip indicator of element ``j``: ``1 - s (z_j + kappa_j r) / (alpha_j S~(v))``."""
-        n = self.n_elements
-        return 1.0 - s * (z[j] + q[j] * z[n]) / (q[n + j] * self._S(v, q, 3 * n))
-
-    def on_event(self, k: int, z: Sequence[Any], m: Sequence[Any], s: Any, q: Any) -> tuple[list[Any], list[Any]]:
-        n = self.n_elements
-        sym = symbolic(z, m, s, q)
-        mn = list(m)
-        mn[k] = 1.0 + 0.0 * q[n + k]
-        # the firing element is at its limit: s (z_k + kappa_k r) / alpha_k = S~(v). A sticking
-        # element j at the same normalised force (within TIE) reaches its limit at this instant
-        gk = s * (z[k] + q[k] * z[n]) * (1.0 - TIE)
-        for j in range(n):
-            if j == k:
-                continue
-            hit = s * (z[j] + q[j] * z[n]) * q[n + k] >= gk * q[n + j]
-            if sym:
-                mn[j] = ca.if_else(ca.logic_and(m[j] < 0.5, hit), 1.0, m[j])
-            elif m[j] < 0.5 and hit:
-                mn[j] = 1.0
-        return list(z), mn
-
-    def _event_at(self, is_k: list, z: Sequence[Any], m: Sequence[Any], s: Any, q: Any) -> tuple[list[Any], list[Any]]:
-        """:meth:`on_event` for the symbolic index of :meth:`on_event_at`: the element that fired
-        starts to slip, and every sticking one at its normalised force (within ``TIE``)."""
-        n = self.n_elements
-        loads = [z[j] + q[j] * z[n] for j in range(n)]
-        alpha_k = self._selected(is_k, [q[n + j] for j in range(n)])
-        gk = s * self._selected(is_k, loads) * (1.0 - TIE)
-        mn = list(m)
-        for j in range(n):
-            hit = s * loads[j] * alpha_k >= gk * q[n + j]
-            mn[j] = ca.if_else(ca.logic_or(is_k[j], ca.logic_and(m[j] < 0.5, hit)), 1.0, m[j])
-        return list(z), mn
-
-    def reverse(self, z: Sequence[Any], m: Sequence[Any], s_new: Any, q: Any, snap: Any) -> tuple[list[Any], list[Any]]:
-        """A sticking element within ``snap`` of its limit ``alpha_j S~(0)`` is put on it."""
-        n = self.n_elements
-        S0 = 1.0 + q[3 * n]  # S~ at v = 0: Fs / Fc
-        return self._put_on_limits(z, m, s_new, q, snap, [q[n + j] * S0 for j in range(n)], sticking_only=True)
 
     def advance(self, z: Sequence[Any], m: Sequence[Any], v: Any, dt: Any, s: Any,
                 q: Any) -> tuple[list[Any], list[Any]]:
