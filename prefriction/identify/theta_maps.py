@@ -21,18 +21,8 @@ __all__ = ["ThetaMaps"]
 class ThetaMaps:
     """``theta`` to physical values and back, their bounds, and the Jacobian's change of variables
     (module notes); mixin of :class:`prefriction.identify.parameters.ParameterSpace`, which sets
-    ``free``, ``fixed``, ``start``, ``low``, ``high``, ``excess``, ``fraction`` and ``_scale``."""
-
-    free: list[str]
-    fixed: list[str]
-    start: dict[str, float]
-    low: dict[str, float]
-    high: dict[str, float]
-    excess: dict[str, str]
-    fraction: dict[str, tuple[str, str]]
-    _scale: dict[str, float]
-    scale: np.ndarray
-    n_free: int
+    ``free``, ``fixed``, ``start``, ``low``, ``high``, ``excess``, ``fraction`` and ``_scale``
+    and gives ``scale`` and ``n_free``."""
 
     def theta_of(self, values: dict[str, float]) -> np.ndarray:
         """The scaled free entries at the physical ``values`` (by name, every free entry and the
