@@ -6,8 +6,6 @@ import math
 from dataclasses import dataclass
 from typing import Any, Optional
 
-import numpy as np
-
 import prefriction as pf
 from prefriction.signals import PointToPoint, Sine
 

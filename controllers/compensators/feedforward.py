@@ -2,9 +2,8 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
-from typing import Any, Hashable
+from typing import Hashable
 
 import casadi as ca
 import numpy as np

@@ -13,7 +13,7 @@ import hashlib
 import math
 import time
 from dataclasses import dataclass
-from typing import Any, Hashable
+from typing import Hashable
 
 import casadi as ca
 import numpy as np

@@ -23,7 +23,7 @@ import casadi as ca
 import numpy as np
 
 from prefriction._safe_files import output_dir
-from prefriction._validation import check_finite, check_positive, check_real
+from prefriction._validation import check_finite, check_positive
 
 from ._codegen import c_text, check_name, check_sample_time, comment_text, work_sizes, write_export
 from .source import CSource

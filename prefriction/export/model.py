@@ -27,7 +27,7 @@ from typing import Any, Optional
 import casadi as ca
 
 from prefriction._safe_files import output_dir
-from prefriction._validation import check_count, check_positive
+from prefriction._validation import check_count
 from prefriction.along.step import has_exact_step, interval_function
 from prefriction.models.base import FrictionModel
 

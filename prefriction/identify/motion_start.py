@@ -192,7 +192,7 @@ def start_values(model: FrictionModel, data: Motion, mass0: float | None, offset
                     "force or viscous coefficient that comes out not positive)")
         steps.append(f"static least squares: none ({why})")
     else:
-        steps.append(f"static least squares of u = m a + Fc sign(v) + b v + F_off over the sliding samples: "
+        steps.append("static least squares of u = m a + Fc sign(v) + b v + F_off over the sliding samples: "
                      + (f"mass {fit.mass:.4g} kg, " if fit.mass is not None else "")
                      + f"Fc {fit.Fc:.4g} N, b {fit.b:.4g} N s/m, offset {fit.offset:.4g} N")
     if data.mass is not None:

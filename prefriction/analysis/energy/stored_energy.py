@@ -18,8 +18,6 @@ apply.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from prefriction.analysis.energy.sampled_reversals import SampledReversals

@@ -31,7 +31,7 @@ from prefriction.simulation.lazy_table import reversal_table
 from prefriction.simulation.plant import EPS_CAL as _CAL
 from prefriction.units import Scales
 
-from .compiled_loop import MAX_DELAY, NSTOP, LoopLayout, LoopSpec, NoCompensation, loop_function
+from .compiled_loop import NSTOP, LoopLayout, LoopSpec, NoCompensation, loop_function
 from .loop_inputs import loop_params, padded as _padded, sample_inputs
 from .native_loop import loop_driver, run_blocks
 from .records import collect, failure, finish_in_python, initial_state
