@@ -527,9 +527,9 @@ def _first_window(model: FrictionModel, data: Motion, space: ParameterSpace, the
     k0 = _busiest_window(data)
     part = slice(k0, k0 + WINDOW)
     inside = None if reversals is None else [r for r in reversals if data.t[k0] < r < data.t[k0 + WINDOW - 1]]
+    span = f"samples {k0} to {k0 + WINDOW - 1}"
     choices: list[tuple[Motion, Any, str, str, float]] = [
-        (Motion(data.t[part], data.x[part], data.u[part], data.mass, data.hold), inside,
-         f"samples {k0} to {k0 + WINDOW - 1}{what}", f"samples {k0} to {k0 + WINDOW - 1}", tol)]
+        (Motion(data.t[part], data.x[part], data.u[part], data.mass, data.hold), inside, f"{span}{what}", span, tol)]
     pieces = piece_window(data, k0, WINDOW, SEGMENT)
     if pieces is not None:
         choices.insert(0, (pieces, None if reversals is None else pieces.to_piece_times(reversals),
