@@ -167,3 +167,72 @@ def test_window_weak_names_an_unpinned_parameter_and_a_stopped_fit():
     weak = _window_weak(solution(loose, True), space)
     assert "sigma" in weak and "Fc" not in weak
     assert _window_weak(solution(J, False), space).startswith("did not converge (stopped at max_iter")
+
+
+def test_long_hovers_flag_runs_of_three_slow_segments_and_the_moves_keep_the_rest():
+    """A stage that moves (speed 1), rests for 200 samples (speed 0) and moves again: with
+    50-sample segments the rest covers segments 4 to 7 (each holds at least ten consecutive slow
+    samples; segment 3 ends on the rest's first sample), a run of four, so those are left out and
+    the moves are the samples 0 to 199 and 400 to the end, each a whole number of segments."""
+    from prefriction.identify.pieces import moves_of
+    from prefriction.identify.shooting import _hover_nodes, _long_hovers
+
+    n = 601
+    speed = np.ones(n)
+    speed[200:400] = 0.0
+    nodes = np.arange(12) * K
+    long = _long_hovers(speed, nodes, K)
+    assert np.flatnonzero(long).tolist() == [4, 5, 6, 7]
+    assert np.flatnonzero(_hover_nodes(speed, nodes, K)).tolist() == [5, 6, 7, 8]   # the nodes after them
+    short = speed.copy()
+    short[300:400] = 1.0                                          # a rest of 100 samples: two segments, kept
+    assert not np.any(_long_hovers(short, nodes, K))
+
+    t = np.arange(n) * DT
+    x = np.cumsum(speed) * 1e-8
+    data = Motion(t, x, np.sin(t), MASS, "zoh")
+    moves = moves_of(data, long, K)
+    assert moves.source == (0, 400) and moves.breaks == (200,) and len(moves) == 200 + 201
+    np.testing.assert_array_equal(moves.x, np.r_[x[:200], x[400:]])
+    np.testing.assert_array_equal(moves.u, np.r_[data.u[:200], data.u[400:]])
+    np.testing.assert_allclose(moves.t[200:] + moves.shift[1], t[400:], rtol=0, atol=1e-12)
+    assert moves.t[200] - moves.t[199] == pytest.approx(DT, rel=1e-9)   # one ordinary interval at the junction
+    assert moves_of(data, np.zeros(12, dtype=bool), K) is None          # nothing left out
+    assert moves_of(data, np.ones(12, dtype=bool), K) is None           # nothing left
+
+
+def test_moves_fit_is_the_result_only_where_its_misfit_is_of_the_noise(monkeypatch):
+    """``_without_hovers`` fits the moves of a record with a long rest and keeps that fit only if
+    its rms residual is within ``MOVES_MISFIT`` times the record's position noise (the noise
+    estimate of ``identify.derivatives``, here of Gaussian noise of 3 nm on smooth moves): a
+    solver stand-in returning residuals of 1 nm rms is kept, with the moves as its data; one
+    returning 100 nm rms (a local minimum) is not, and the note says why."""
+    from prefriction.identify import shooting
+    from prefriction.identify.pieces import Pieces
+
+    n = 1_201
+    t = np.arange(n) * DT
+    s = np.clip((t - t[100]) / (t[500] - t[100]), 0.0, 1.0)
+    x = 1e-4 * (3.0 * s**2 - 2.0 * s**3) + 3e-9 * np.random.default_rng(0).standard_normal(n)
+    x[700:] += 1e-4 * (3.0 * np.clip((t[700:] - t[700]) / (t[1100] - t[700]), 0, 1)**2
+                       - 2.0 * np.clip((t[700:] - t[700]) / (t[1100] - t[700]), 0, 1)**3)
+    data = Motion(t, x, np.zeros(n), MASS, "zoh")
+    space = ParameterSpace(Dahl(sigma=SIGMA, Fc=FC, gamma=1.0), None, ["gamma"], None, mass=None, offset=FC,
+                           offset0=OFFSET)
+    w = np.r_[space.theta0, np.zeros(3)]
+    whole = shooting.MotionSolution(w, np.zeros(n), np.zeros((n, w.size)), None, np.zeros(n), {}, "stopped", False)
+
+    def run(rms: float) -> tuple[shooting.MotionSolution, list[str]]:
+        def stand_in(model, moves, *args, **kwargs):
+            assert isinstance(moves, Pieces) and len(moves) < n        # the fit sees the moves alone
+            r = rms * np.where(np.arange(len(moves)) % 2, 1.0, -1.0)
+            return shooting.MotionSolution(w, r, np.zeros((r.size, w.size)), None, np.zeros(r.size), {}, "converged")
+        monkeypatch.setattr(shooting, "_solve_record", stand_in)
+        steps: list[str] = []
+        return shooting._without_hovers(data, space, whole, None, 200, 1e-10, None, None, steps, 1), steps
+
+    kept, steps = run(1e-9)
+    assert isinstance(kept.data, Pieces) and kept.success and "FitResult.data holds the moves" in steps[0]
+    assert kept.data.source == (0, 700) and kept.data.breaks == (500,)   # the 200-sample rest left out, not the short ones
+    dropped, steps = run(1e-7)
+    assert dropped is whole and "local minimum" in steps[0] and "whole chain's result kept" in steps[0]

@@ -415,7 +415,8 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
                         f"it fixed (fixed=[{gamma!r}]) at a value from the branch shape (a ForceDisplacement fit) "
                         f"converges in far fewer evaluations; or give max_iter more")
     mass = values["mass"] if data.mass is None else data.mass
-    return _finish(space, values, est, stats, -sol.residuals, sol.prediction, data, mass, sol.nuisance, message,
+    fitted = data if getattr(sol, "data", None) is None else sol.data   # the moves, where the hovers were left out
+    return _finish(space, values, est, stats, -sol.residuals, sol.prediction, fitted, mass, sol.nuisance, message,
                    success, start=start.steps + sol.steps, limit=limit)
 
 
@@ -449,7 +450,9 @@ def _short_of_minimum(space: ParameterSpace, sol: Any, stats: Any, valley: bool)
 
 
 def _rss(sol: Any) -> float:
-    return float(np.sum(np.square(sol.residuals)))
+    """Mean square residual of a solution (per sample: a fit of the record's moves alone compares
+    with one of the whole record)."""
+    return float(np.mean(np.square(sol.residuals)))
 
 
 def _doubtful(space: ParameterSpace, sol: Any, limit: float, gamma: str) -> bool:

@@ -39,8 +39,8 @@ import numpy as np
 from prefriction.identify.data import Motion
 from prefriction.identify.motion_start import derivatives
 
-__all__ = ["FEWEST", "MOST_PIECES", "PIECE_TOL", "Pieces", "breaks_of", "derivatives_of", "describe",
-           "direction_counts", "moving_flips", "piece_window", "reversal_samples"]
+__all__ = ["FEWEST", "MOST_PIECES", "PIECE_TOL", "Pieces", "breaks_of", "concatenate", "derivatives_of", "describe",
+           "describe_moves", "direction_counts", "moves_of", "moving_flips", "piece_window", "reversal_samples"]
 
 FEWEST = 2
 """Fewest reversals in each direction in the busiest contiguous window below which the first window
@@ -196,10 +196,16 @@ def piece_window(data: Motion, first: int, width: int, K: int) -> Pieces | None:
             pieces.append((a, b))
     if len(pieces) < 2:
         return None
-    idx = np.concatenate([np.arange(a, b) for a, b in pieces])
+    return concatenate(data, pieces)
+
+
+def concatenate(data: Motion, spans: list[tuple[int, int]]) -> Pieces:
+    """The samples ``a`` to ``b - 1`` of ``data`` for every ``(a, b)`` of ``spans`` (increasing,
+    not overlapping) as one :class:`Pieces` record."""
+    idx = np.concatenate([np.arange(a, b) for a, b in spans])
     t = data.t[idx].copy()
     breaks, shift, pos = [], [], 0
-    for a, b in pieces:   # each piece's first interval after the last one's end: its own last interval
+    for a, b in spans:   # each piece's first interval after the last one's end: its own last interval
         d = float(data.t[a - 1] - t[pos - 1]) if pos else 0.0
         if pos:
             breaks.append(pos)
@@ -207,13 +213,38 @@ def piece_window(data: Motion, first: int, width: int, K: int) -> Pieces | None:
         t[pos:pos + b - a] = data.t[a:b] - d
         pos += b - a
     return Pieces(t, data.x[idx], data.u[idx], data.mass, data.hold, data.x_noise, data.quantum,
-                  breaks=tuple(breaks), source=tuple(a for a, _ in pieces), shift=tuple(shift))
+                  breaks=tuple(breaks), source=tuple(a for a, _ in spans), shift=tuple(shift))
+
+
+def moves_of(data: Motion, left_out: np.ndarray, K: int) -> Pieces | None:
+    """``data`` without the shooting segments of ``K`` samples flagged in ``left_out`` (the long
+    hovers of :func:`prefriction.identify.shooting._long_hovers`): the moves between them, one
+    piece each; ``None`` when no segment is left out or every one is."""
+    spans: list[tuple[int, int]] = []
+    for j in np.flatnonzero(~np.asarray(left_out, dtype=bool)):
+        a, b = int(j) * K, min((int(j) + 1) * K + 1, len(data))
+        if spans and spans[-1][1] >= a:
+            spans[-1] = (spans[-1][0], b)
+        else:
+            spans.append((a, b))
+    if not spans or not np.any(left_out):
+        return None
+    spans = [(a, b if b == len(data) else b - 1) for a, b in spans]   # a piece ends where the next segment starts
+    return concatenate(data, spans)
 
 
 def describe(window: Pieces) -> str:
     """One line for the fit's steps: the pieces' samples in the original record."""
-    edges = (0, *window.breaks, len(window))
-    spans = [f"{s} to {s + b - a - 1}" for s, a, b in zip(window.source, edges[:-1], edges[1:])]
-    return f"{len(spans)} pieces of the record around reversals (samples {', '.join(spans)})"
+    return f"{len(window.source)} pieces of the record around reversals (samples {_spans(window)})"
+
+
+def describe_moves(moves: Pieces) -> str:
+    """One line for the fit's steps: the moves' samples in the original record (:func:`moves_of`)."""
+    return f"{len(moves.source)} moves (samples {_spans(moves)})"
+
+
+def _spans(pieces: Pieces) -> str:
+    edges = (0, *pieces.breaks, len(pieces))
+    return ", ".join(f"{s} to {s + b - a - 1}" for s, a, b in zip(pieces.source, edges[:-1], edges[1:]))
 
 
