@@ -709,8 +709,9 @@ MOVES_MISFIT = 4.0
 record's position noise (:func:`prefriction.identify.derivatives.derivatives`: the standard
 deviation of the positions about their low-pass), for the fit to be the result. Measured on the
 2.5 kg, 2 kHz, 10 nm closed-loop Dahl ``gamma = 2`` stage at 2,500 samples (noise 3.2e-9 m): the
-fit with ``gamma`` held at the truth ends within 0.11 % of every true value at 7.9e-9 m, the fit
-with ``gamma`` free from the second start's estimates 10 % off at 2.1e-7 m."""
+fit with ``gamma`` held at the truth ends within 0.074 % of every true value at 7.8e-9 m; a fit
+with ``gamma`` free from the second start's estimates (at a constraint weight of 10) ended with
+every parameter up to 10 % off at 2.1e-7 m."""
 
 
 def _event_substeps(data: Motion, space: ParameterSpace, sol: MotionSolution, max_iter: int, tol: float,
