@@ -684,9 +684,9 @@ def _without_hovers(data: Motion, space: ParameterSpace, sol: MotionSolution, n_
     K = min(SEGMENT, len(data) - 1)
     left_out = _long_hovers(np.abs(v), np.arange(max(1, math.ceil((len(data) - 1) / K))) * K, K)
     moves = moves_of(data, left_out, K)
-    theta = sol.w[: space.n_free]
     if moves is None:
         return sol
+    theta = sol.w[: space.n_free]
     given = None if reversals is None else moves.to_piece_times(reversals)
     # the constraint weight of a fresh start: the moves' nodes start from the data, not from a converged chain
     # (measured from the whole chain's estimates at 2,500 samples: 0.01 converges in 119 evaluations, 10 does not)
