@@ -208,7 +208,7 @@ def test_moves_fit_is_the_result_only_where_its_misfit_is_of_the_noise(monkeypat
     solver stand-in returning residuals of 1 nm rms is kept, with the moves as its data; one
     returning 100 nm rms (a local minimum) is not, and the note says why."""
     from prefriction.identify import shooting
-    from prefriction.identify.pieces import Pieces
+    from prefriction.identify.pieces import Pieces, moves_of
 
     n = 1_201
     t = np.arange(n) * DT
@@ -229,7 +229,9 @@ def test_moves_fit_is_the_result_only_where_its_misfit_is_of_the_noise(monkeypat
             return shooting.MotionSolution(w, r, np.zeros((r.size, w.size)), None, np.zeros(r.size), {}, "converged")
         monkeypatch.setattr(shooting, "_solve_record", stand_in)
         steps: list[str] = []
-        return shooting._without_hovers(data, space, whole, None, 200, 1e-10, None, None, steps, 1), steps
+        _x, v, _a = derivatives_of(data, 7)
+        moves = moves_of(data, shooting._long_hovers(np.abs(v), np.arange(24) * K, K), K)
+        return shooting._without_hovers(data, moves, space, whole, None, 200, 1e-10, None, None, steps, 1), steps
 
     kept, steps = run(1e-9)
     assert isinstance(kept.data, Pieces) and kept.success and "FitResult.data holds the moves" in steps[0]

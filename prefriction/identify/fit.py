@@ -415,7 +415,7 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
                         f"it fixed (fixed=[{gamma!r}]) at a value from the branch shape (a ForceDisplacement fit) "
                         f"converges in far fewer evaluations; or give max_iter more")
     mass = values["mass"] if data.mass is None else data.mass
-    fitted = data if getattr(sol, "data", None) is None else sol.data   # the moves, where the hovers were left out
+    fitted = data if sol.data is None else sol.data   # the moves, where the hovers were left out
     return _finish(space, values, est, stats, -sol.residuals, sol.prediction, fitted, mass, sol.nuisance, message,
                    success, start=start.steps + sol.steps, limit=limit)
 

@@ -220,17 +220,13 @@ def moves_of(data: Motion, left_out: np.ndarray, K: int) -> Pieces | None:
     """``data`` without the shooting segments of ``K`` samples flagged in ``left_out`` (the long
     hovers of :func:`prefriction.identify.shooting._long_hovers`): the moves between them, one
     piece each; ``None`` when no segment is left out or every one is."""
-    spans: list[tuple[int, int]] = []
-    for j in np.flatnonzero(~np.asarray(left_out, dtype=bool)):
-        a, b = int(j) * K, min((int(j) + 1) * K + 1, len(data))
-        if spans and spans[-1][1] >= a:
-            spans[-1] = (spans[-1][0], b)
-        else:
-            spans.append((a, b))
-    if not spans or not np.any(left_out):
+    keep = ~np.asarray(left_out, dtype=bool)
+    if keep.all() or not keep.any():
         return None
-    spans = [(a, b if b == len(data) else b - 1) for a, b in spans]   # a piece ends where the next segment starts
-    return concatenate(data, spans)
+    edges = np.flatnonzero(np.diff(np.r_[0, keep.astype(int), 0]))   # runs of kept segments j..k-1
+    # a piece ends where the next segment starts; the last segment runs to the record's end
+    return concatenate(data, [(int(j) * K, len(data) if k == keep.size else int(k) * K)
+                              for j, k in zip(edges[::2], edges[1::2])])
 
 
 def describe(window: Pieces) -> str:

@@ -652,7 +652,8 @@ def _solve(model: FrictionModel, data: Motion, space: ParameterSpace, theta0: np
         return sol
     _x, v, _a = derivatives_of(data, _NODE_WINDOW)
     K = min(SEGMENT, len(data) - 1)
-    cut = int(_hover_nodes(np.abs(v), np.arange(max(1, math.ceil((len(data) - 1) / K))) * K, K).sum())
+    long = _long_hovers(np.abs(v), np.arange(max(1, math.ceil((len(data) - 1) / K))) * K, K)
+    cut = int(long[:-1].sum())     # the nodes after them (_hover_nodes)
     theta = sol.w[: space.n_free]
     if not cut or not np.all(np.isfinite(theta)):
         return sol
@@ -661,15 +662,19 @@ def _solve(model: FrictionModel, data: Motion, space: ParameterSpace, theta0: np
     steps.append(f"samples {len(data)}: the whole chain did not converge ({sol.message[-160:]}); the {cut} nodes after "
                  f"the segments of long hovers then started pieces of the chain, from its estimates: "
                  + ("converged" if again.success else "did not converge either"))
-    if again.success or breaks_of(data).size:
-        return again if again.success else sol
-    return _without_hovers(data, space, sol, n_sub, max_iter, tol, reversals, progress, steps, least_sub)
+    if again.success:
+        return again
+    if breaks_of(data).size:       # a window of pieces keeps its layout
+        return sol
+    return _without_hovers(data, moves_of(data, long, K), space, sol, n_sub, max_iter, tol, reversals, progress,
+                           steps, least_sub)
 
 
-def _without_hovers(data: Motion, space: ParameterSpace, sol: MotionSolution, n_sub: int | None, max_iter: int,
-                    tol: float, reversals: Any, progress: Any, steps: list[str], least_sub: int) -> MotionSolution:
-    """The fit of the record's moves alone (:func:`prefriction.identify.pieces.moves_of`), from the
-    estimates of ``sol``, which neither the whole chain nor the chain cut at the long hovers
+def _without_hovers(data: Motion, moves: Motion | None, space: ParameterSpace, sol: MotionSolution,
+                    n_sub: int | None, max_iter: int, tol: float, reversals: Any, progress: Any, steps: list[str],
+                    least_sub: int) -> MotionSolution:
+    """The fit of the record's ``moves`` alone (:func:`prefriction.identify.pieces.moves_of`; ``None``:
+    ``sol``), from the estimates of ``sol``, which neither the whole chain nor the chain cut at the long hovers
     brought to converge; kept if it converges (its :attr:`MotionSolution.data` the moves), else ``sol``.
 
     In a long hover a stage with a stiff reversal branch (Dahl ``gamma > 1``: ``2^gamma sigma``)
@@ -680,10 +685,6 @@ def _without_hovers(data: Motion, space: ParameterSpace, sol: MotionSolution, n_
     positions stay within the encoder step) and each move starts a piece of the chain with its own
     free position, velocity and state. Measured on the 2.5 kg, 2 kHz, 10 nm closed-loop Dahl
     ``gamma = 2`` stage at 2,500 samples (docs/identify_motion.md#limits)."""
-    _x, v, _a = derivatives_of(data, _NODE_WINDOW)
-    K = min(SEGMENT, len(data) - 1)
-    left_out = _long_hovers(np.abs(v), np.arange(max(1, math.ceil((len(data) - 1) / K))) * K, K)
-    moves = moves_of(data, left_out, K)
     if moves is None:
         return sol
     theta = sol.w[: space.n_free]
