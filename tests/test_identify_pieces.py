@@ -18,7 +18,8 @@ from scipy.signal import savgol_filter
 from prefriction import Dahl
 from prefriction.identify import Motion
 from prefriction.identify.parameters import ParameterSpace
-from prefriction.identify.pieces import derivatives_of, piece_window
+from prefriction.identify.motion_start import derivatives_of
+from prefriction.identify.pieces import piece_window
 from prefriction.identify.shooting import _directions, _layout, _Problem
 from prefriction.identify.motion_step import segment_functions
 
@@ -238,3 +239,23 @@ def test_moves_fit_is_the_result_only_where_its_misfit_is_of_the_noise(monkeypat
     assert kept.data.source == (0, 700) and kept.data.breaks == (500,)   # the 200-sample rest left out, not the short ones
     dropped, steps = run(1e-7)
     assert dropped is whole and "local minimum" in steps[0] and "whole chain's result kept" in steps[0]
+
+
+def test_static_start_of_pieces_stays_inside_each_piece() -> None:
+    """The static least squares of a Pieces record: no window of the integrated force balance and no
+    smoothing reaches across a junction, so the pieces of a seeded scipy record (Dahl ``gamma = 2`` +
+    viscous, open loop) give the true mass, Coulomb force and offset as the whole record does (the
+    windows across the junctions had made the estimates unphysical: ``None``)."""
+    import dataclasses
+
+    from prefriction.identify._success import STAGES, stage_record
+    from prefriction.identify.motion_start import static_start
+    from prefriction.identify.pieces import concatenate
+
+    stage = dataclasses.replace(STAGES[2], closed=False, stroke=2.0)
+    record = stage_record(stage, 1000, np.random.default_rng([0, 2]))
+    for spans in ([(0, 300), (450, 700), (820, 1000)], [(0, 200), (300, 500), (600, 800), (850, 1000)]):
+        s = static_start(concatenate(record, spans))
+        assert s is not None
+        assert abs(s.mass - stage.mass) < 0.02 * stage.mass and abs(s.Fc - 3.0) < 0.05 * 3.0
+        assert abs(s.offset - stage.offset) < 0.02 * 3.0

@@ -88,6 +88,28 @@ def derivatives(t: np.ndarray, x: np.ndarray, window: int = _WINDOW) -> tuple[np
             savgol_filter(x, w, 3, deriv=2, delta=h))
 
 
+def piece_edges(data: Motion) -> np.ndarray:
+    """The first sample of every piece of ``data`` and, last, its length: the junctions of a
+    :class:`prefriction.identify.pieces.Pieces` record (``[0, len(data)]`` for an ordinary one)."""
+    return np.r_[0, np.asarray(getattr(data, "breaks", ()), dtype=int), len(data)]
+
+
+def derivatives_of(data: Motion, window: int = _WINDOW) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`derivatives` of ``data``, of a :class:`prefriction.identify.pieces.Pieces` record
+    within each piece: no smoothing window reaches across a junction."""
+    edges = piece_edges(data)
+    if edges.size == 2:
+        return derivatives(data.t, data.x, window)
+    parts = [derivatives(data.t[a:b], data.x[a:b], window) for a, b in zip(edges[:-1], edges[1:])]
+    return tuple(np.concatenate([p[i] for p in parts]) for i in range(3))  # type: ignore[return-value]
+
+
+def _piece_index(data: Motion) -> np.ndarray:
+    """The piece of every sample of ``data`` (0 throughout for an ordinary record)."""
+    edges = piece_edges(data)
+    return np.repeat(np.arange(edges.size - 1), np.diff(edges))
+
+
 def static_start(data: Motion) -> StaticStart | None:
     """Least-squares Coulomb + viscous + offset (+ mass if ``data.mass`` is None) of a forced record.
 
@@ -108,14 +130,15 @@ def static_start(data: Motion) -> StaticStart | None:
     """
     if data.free_decay:
         return None
-    _x, v, _a = derivatives(data.t, data.x, _V_WINDOW)
+    _x, v, _a = derivatives_of(data, _V_WINDOW)
+    piece = _piece_index(data)
     moving = np.abs(v) > 0.1 * float(np.max(np.abs(v)))
     dt = np.diff(data.t)
     held = data.u[:-1] if data.hold == "zoh" else 0.5 * (data.u[:-1] + data.u[1:])
     cu = np.r_[0.0, np.cumsum(held * dt)]
     cs = np.r_[0.0, np.cumsum(np.sign(v[:-1]) * dt)]
     i = np.arange(0, data.x.size - _SPAN, _SPAN // 2)
-    i = i[[bool(np.all(moving[k:k + _SPAN + 1])) for k in i]]
+    i = i[[bool(np.all(moving[k:k + _SPAN + 1])) and piece[k] == piece[k + _SPAN] for k in i]]
     if i.size < 8:
         return None
     j = i + _SPAN
@@ -316,15 +339,18 @@ def stiffness_from_reversals(data: Motion, mass: float, offset: float,
     if data.free_decay:
         return None
     shape = secant(gamma)
-    xs, v, a = derivatives(data.t, data.x)
+    xs, v, a = derivatives_of(data)
+    piece = _piece_index(data)
     F = data.u - mass * a - offset
     moving = np.abs(v) > 0.05 * float(np.max(np.abs(v)))
     sgn = np.sign(v)
-    idx = np.flatnonzero((sgn[1:] * sgn[:-1] < 0.0))
+    idx = np.flatnonzero((sgn[1:] * sgn[:-1] < 0.0) & (piece[1:] == piece[:-1]))
     slopes = []
     for k in idx:
         s = sgn[k + 1]
-        end = k + 1 + int(np.argmax(moving[k + 1:])) if np.any(moving[k + 1:]) else data.x.size - 1
+        last = int(np.flatnonzero(piece == piece[k])[-1])   # the transient ends in its own piece
+        ahead = moving[k + 1:last + 1]
+        end = k + 1 + int(np.argmax(ahead)) if np.any(ahead) else last
         seg = slice(k, max(end, k + 3))
         Fs, xseg = F[seg], xs[seg]
         if xseg.size < 4:

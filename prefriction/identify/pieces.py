@@ -26,7 +26,7 @@ contiguous window. The pieces are concatenated as a :class:`Pieces` record; each
 own piece of the multiple-shooting chain (a node with its own free position, velocity and state,
 no continuity constraint into it), the step across the junction is not simulated (its time step
 is zero) and the smoothed node start values are computed within each piece
-(:func:`derivatives_of`); it is solved to :data:`PIECE_TOL`.
+(:func:`prefriction.identify.motion_start.derivatives_of`); it is solved to :data:`PIECE_TOL`.
 """
 
 from __future__ import annotations
@@ -39,7 +39,7 @@ import numpy as np
 from prefriction.identify.data import Motion
 from prefriction.identify.motion_start import derivatives
 
-__all__ = ["FEWEST", "MOST_PIECES", "PIECE_TOL", "Pieces", "breaks_of", "concatenate", "derivatives_of", "describe",
+__all__ = ["FEWEST", "MOST_PIECES", "PIECE_TOL", "Pieces", "breaks_of", "concatenate", "describe",
            "describe_moves", "direction_counts", "moves_of", "moving_flips", "piece_window", "reversal_samples"]
 
 FEWEST = 2
@@ -96,17 +96,6 @@ class Pieces(Motion):
 def breaks_of(data: Motion) -> np.ndarray:
     """Sample indices at which a new piece of ``data`` starts (empty for an ordinary record)."""
     return np.asarray(data.breaks if isinstance(data, Pieces) else (), dtype=int)
-
-
-def derivatives_of(data: Motion, window: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Smoothed position [m], velocity [m/s] and acceleration [m/s^2] of ``data``
-    (:func:`prefriction.identify.motion_start.derivatives`), of a :class:`Pieces` record within
-    each piece: no smoothing window reaches across a junction."""
-    edges = np.r_[0, breaks_of(data), len(data)]
-    if edges.size == 2:
-        return derivatives(data.t, data.x, window)
-    parts = [derivatives(data.t[a:b], data.x[a:b], window) for a, b in zip(edges[:-1], edges[1:])]
-    return tuple(np.concatenate([p[i] for p in parts]) for i in range(3))  # type: ignore[return-value]
 
 
 def moving_flips(v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -41,10 +41,10 @@ from prefriction.identify.constrained_lsq import solve
 from prefriction.identify.data import Motion
 from prefriction.identify.derivatives import derivatives as filtered_derivatives
 from prefriction.identify.held_first import held_first
-from prefriction.identify.motion_start import derivatives
+from prefriction.identify.motion_start import derivatives, derivatives_of
 from prefriction.identify.motion_step import STATE_CAP, segment_functions
 from prefriction.identify.parameters import ParameterSpace
-from prefriction.identify.pieces import (PIECE_TOL, breaks_of, derivatives_of, describe, describe_moves, moves_of,
+from prefriction.identify.pieces import (PIECE_TOL, breaks_of, describe, describe_moves, moves_of,
                                          moving_flips, piece_window)
 from prefriction.identify.polish import polish, valley_secant
 from prefriction.identify.reversals import locate_reversals
