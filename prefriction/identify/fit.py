@@ -290,9 +290,10 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
                               offset=max(abs(float(m.Fc)), abs(offset_start)) if offset else None,
                               offset0=offset_start)
 
-    def held_of(sp: ParameterSpace) -> ParameterSpace | None:
-        """``sp`` with the parameters a first stage holds (:mod:`prefriction.identify.held_first`) fixed."""
-        names = held_first(sp.model, sp)
+    def held_of(sp: ParameterSpace, also: tuple = ()) -> ParameterSpace | None:
+        """``sp`` with the parameters a first stage holds (:mod:`prefriction.identify.held_first`, and ``also``)
+        fixed."""
+        names = held_first(sp.model, sp) + tuple(n for n in also if n is not None)
         if not names:
             return None
         return ParameterSpace(sp.model, None if free is None else [n for n in free if n not in names],
@@ -301,28 +302,31 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
                               offset0=sp.start.get("offset", 0.0))
 
     space = space_of(model, start.mass, start.offset)
+    from prefriction.identify.balance_start import balance_start
     from prefriction.identify.element_start import element_start
 
-    elements = element_start(model, data, list(space.free), start.mass, start.offset, offset)
-    if elements is not None:  # Maxwell-slip, GMS: the grid search of the force balance, said in FitResult.start
+    hold: tuple[str, ...] = ()   # held in the first stage besides held_first's (a start from the force balance)
+    found = element_start(model, data, list(space.free), start.mass, start.offset, offset) \
+        or balance_start(model, data, space, free, fixed, bounds, offset)
+    if found is not None:  # said in FitResult.start, taken where its shooting segments follow the record better
         from prefriction.identify.shooting import start_error
 
-        space_el = space_of(elements.model, elements.mass, elements.offset)
-        given, found = _start_error(start_error, model, data, space), _start_error(start_error, elements.model,
-                                                                                  data, space_el)
-        said = (f"rms error of the 50-sample shooting segments {math.sqrt(found):.4g} m against "
+        space_el = space_of(found.model, found.mass, found.offset)
+        given, better = _start_error(start_error, model, data, space), _start_error(start_error, found.model,
+                                                                                   data, space_el)
+        said = (f"rms error of the 50-sample shooting segments {math.sqrt(better):.4g} m against "
                 f"{math.sqrt(given):.4g} m of the given start")
-        if found < given:
-            model, space = elements.model, space_el
-            start = dataclasses.replace(start, mass=elements.mass, offset=elements.offset,
-                                        steps=start.steps + (f"{elements.line}; {said}: it replaces the given start",))
+        if better < given:
+            model, space, hold = found.model, space_el, (getattr(found, "gamma", None),)
+            start = dataclasses.replace(start, mass=found.mass, offset=found.offset,
+                                        steps=start.steps + (f"{found.line}; {said}: it replaces the given start",))
         else:
             start = dataclasses.replace(start, steps=start.steps + (
-                f"{elements.line.split(':')[0]} not used ({said}): the given start kept",))
+                f"{found.line.split(':')[0]} not used ({said}): the given start kept",))
     first_steps = start.steps
     try:
         sol, error = fit_motion(model, data, space, n_sub=substeps, max_iter=max_iter, tol=tol,
-                                reversals=reversals, held=held_of(space)), None
+                                reversals=reversals, held=held_of(space, hold)), None
     except SolverError as err:
         sol, error = None, err
     retried = False

@@ -511,8 +511,12 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
                 return dataclasses.replace(done[0], steps=tuple(steps))
             fallback = None if long else held_stage
         if not stage.success:
+            closer = _closer(data, space, vals, dict(vals, **sp_k.values(stage.w[: sp_k.n_free])))
             steps.append(f"continuation: the fit of {name} did not converge ({stage.message}); the next stage "
-                         f"started from the values before it")
+                         + ("started from its estimates, whose shooting segments follow the record more closely "
+                            "than those of the values before it" if closer else "started from the values before it"))
+            if closer:
+                vals, moved = closer, True
             continue
         least, weight, moved = stage.n_sub, 10.0, True
         vals = dict(vals, **sp_k.values(stage.w[: sp_k.n_free]))
@@ -525,6 +529,26 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
         steps.append(f"the fit with every parameter free did not converge ({sol.message[-160:]}); {done[1]}")
         return dataclasses.replace(done[0], steps=tuple(steps))
     return dataclasses.replace(sol, steps=tuple(steps))
+
+
+def _closer(data: Motion, space: ParameterSpace, before: dict[str, float],
+            after: dict[str, float]) -> dict[str, float] | None:
+    """``after`` (the estimates of a stage that did not converge) if its shooting segments follow
+    ``data`` more closely than those of ``before`` (:func:`start_error`), else ``None``.
+
+    A stage with Dahl's ``gamma`` held near the truth (at the force balance's estimate,
+    :mod:`prefriction.identify.balance_start`) may stop in the rests of a closed loop and still
+    bring the other parameters close: on the 2.5 kg, 2 kHz, 10 nm closed-loop stage at 2,500
+    samples, the moves' fit with ``gamma`` held at 1.956 stopped after 200 evaluations with
+    ``sigma`` 2.3 % off and every other estimate within 0.4 %, and the free stage from there
+    converged within 0.01 % of every true value."""
+    if not all(math.isfinite(v) for v in after.values()):
+        return None
+    try:
+        errors = [start_error(space.build(v), data, space, space.theta_of(v)) for v in (after, before)]
+    except (ValueError, SolverError):
+        return None
+    return after if errors[0] < errors[1] else None
 
 
 def _first_window(model: FrictionModel, data: Motion, space: ParameterSpace, theta0: np.ndarray, n_sub: int | None,
@@ -739,15 +763,16 @@ def _event_substeps(data: Motion, space: ParameterSpace, sol: MotionSolution, ma
     return again if keep else sol
 
 
-def start_error(model: FrictionModel, data: Motion, space: ParameterSpace) -> float:
-    """Mean square position error [m^2] of the shooting segments at ``space``'s start values.
+def start_error(model: FrictionModel, data: Motion, space: ParameterSpace, theta: np.ndarray | None = None) -> float:
+    """Mean square position error [m^2] of the shooting segments at ``space``'s start values (or
+    at the scaled free entries ``theta``; ``model`` holds the same values).
 
     Each segment of :data:`SEGMENT` samples starts at the smoothed data (position, velocity) with
     the model state carried from the segment before (as the fit's first iterate) and runs open
     loop: how closely the start model follows the record, in the record's units whatever the
     model (interpreted steps: no compilation). ``inf`` if the motion is not finite.
     """
-    theta0 = space.theta0
+    theta0 = space.theta0 if theta is None else theta
     vals = space.values(theta0)
     mass_free = "mass" in space.start and "mass" in space.free
     mass = vals["mass"] if mass_free else float(data.mass)

@@ -1,0 +1,60 @@
+"""The start of a Motion fit with a free Dahl exponent from the force balance
+(``prefriction/identify/balance_start.py``), against the true values of seeded scipy records
+(``prefriction/identify/_success.py``: LSODA between the samples, an encoder after noise)."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+import prefriction as pf
+from prefriction.identify import Motion
+from prefriction.identify._success import STAGES, stage_record
+from prefriction.identify.balance_start import balance_start
+from prefriction.identify.parameters import ParameterSpace
+
+STAGE = dataclasses.replace(STAGES[2], closed=False, stroke=2.0)   # Dahl gamma = 2 + viscous, open loop
+
+
+@pytest.fixture(scope="module")
+def record() -> Motion:
+    return stage_record(STAGE, 1000, np.random.default_rng([0, 2]))
+
+
+def _space(model: pf.FrictionModel, fixed: list[str] | None = None) -> ParameterSpace:
+    return ParameterSpace(model, None, fixed, None, mass=4.0, offset=6.0, offset0=0.5)
+
+
+def test_the_force_balance_finds_gamma_from_a_start_far_off(record: Motion) -> None:
+    start = pf.Dahl(sigma=1e6, Fc=6.0, gamma=3.5) + pf.Viscous(4.0)      # sigma 0.5x, Fc 2x, gamma 1.75x
+    found = balance_start(start, record, _space(start), None, None, None, True)
+    assert found is not None and found.gamma == "gamma"
+    dahl, visc = found.model.models
+    assert abs(dahl.gamma - 2.0) < 0.3 and abs(dahl.Fc - 3.0) < 0.3 and abs(found.mass - 2.5) < 0.1
+    assert abs(found.offset - STAGE.offset) < 0.1
+    assert "gamma 3.5 -> " in found.line and "held at" in found.line
+
+
+def test_no_force_balance_start_without_a_free_gamma_or_with_events(record: Motion) -> None:
+    start = pf.Dahl(sigma=1e6, Fc=6.0, gamma=3.5) + pf.Viscous(4.0)
+    assert balance_start(start, record, _space(start, ["gamma"]), None, ["gamma"], None, True) is None
+    lugre = pf.LuGre(sigma0=1e6, sigma1=50.0, sigma2=4.0, Fc=3.0, Fs=3.0, vs=1e-3)
+    assert balance_start(lugre, record, _space(lugre), None, None, None, True) is None
+    below = pf.Dahl(sigma=1e6, Fc=6.0, gamma=0.6)        # gamma < 1: in-branch events, not this start
+    assert balance_start(below, record, _space(below), None, None, None, True) is None
+
+
+def test_a_stage_that_stopped_hands_on_its_estimates_only_where_they_follow_the_record(record: Motion) -> None:
+    """``shooting._closer``: the estimates of a stage that did not converge start the next stage only
+    where the shooting segments follow the scipy record more closely than at the values before it."""
+    from prefriction.identify.shooting import _closer
+
+    truth = STAGE.model()
+    space = ParameterSpace(truth, None, None, None, mass=STAGE.mass, offset=3.0, offset0=STAGE.offset)
+    exact = dict(space.start)
+    off = dict(exact, sigma=1.5 * exact["sigma"], gamma=2.6)
+    assert _closer(record, space, off, exact) == exact
+    assert _closer(record, space, exact, off) is None
+    assert _closer(record, space, exact, dict(off, Fc=float("nan"))) is None
