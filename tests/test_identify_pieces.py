@@ -204,7 +204,7 @@ def test_long_hovers_flag_runs_of_three_slow_segments_and_the_moves_keep_the_res
 
 def test_moves_fit_is_the_result_only_where_its_misfit_is_of_the_noise(monkeypatch):
     """``_without_hovers`` fits the moves of a record with a long rest and keeps that fit only if
-    its rms residual is within ``MOVES_MISFIT`` times the record's position noise (the noise
+    its rms residual is within ``MISFIT`` times the record's position noise (the noise
     estimate of ``identify.derivatives``, here of Gaussian noise of 3 nm on smooth moves): a
     solver stand-in returning residuals of 1 nm rms is kept, with the moves as its data; one
     returning 100 nm rms (a local minimum) is not, and the note says why."""
@@ -239,6 +239,43 @@ def test_moves_fit_is_the_result_only_where_its_misfit_is_of_the_noise(monkeypat
     assert kept.data.source == (0, 700) and kept.data.breaks == (500,)   # the 200-sample rest left out, not the short ones
     dropped, steps = run(1e-7)
     assert dropped is whole and "local minimum" in steps[0] and "whole chain's result kept" in steps[0]
+
+
+def test_a_cut_chain_far_above_the_noise_gives_way_to_the_moves(monkeypatch):
+    """``_solve``: a chain cut at the long hovers that converges with an rms residual above ``MISFIT``
+    times the record's position noise (3 nm of Gaussian noise on smooth moves) is a local minimum,
+    and the moves are fitted from its estimates; one within the limit is the result. The solver is a
+    stand-in (whole chain: stopped; cut chain: converged at the given rms; moves: converged at 1 nm),
+    so this tests the decision, not the fit."""
+    from prefriction.identify import shooting
+    from prefriction.identify.pieces import Pieces
+
+    n = 1_201
+    t = np.arange(n) * DT
+    s = np.clip((t - t[100]) / (t[500] - t[100]), 0.0, 1.0)
+    x = 1e-4 * (3.0 * s**2 - 2.0 * s**3) + 3e-9 * np.random.default_rng(0).standard_normal(n)
+    data = Motion(t, x, np.zeros(n), MASS, "zoh")
+    space = ParameterSpace(Dahl(sigma=SIGMA, Fc=FC, gamma=1.0), None, ["gamma"], None, mass=None, offset=FC,
+                           offset0=OFFSET)
+    w = np.r_[space.theta0, np.zeros(3)]
+
+    def run(cut_rms: float) -> tuple[shooting.MotionSolution, list[str]]:
+        def stand_in(model, record, sp, theta, n_sub, max_iter, tol, given, progress, weight, pieces=False,
+                     least=1):
+            m = len(record)
+            r = (1e-9 if isinstance(record, Pieces) else cut_rms) * np.where(np.arange(m) % 2, 1.0, -1.0)
+            done = isinstance(record, Pieces) or pieces
+            return shooting.MotionSolution(w, r, np.zeros((m, w.size)), None, np.zeros(m), {},
+                                           "converged" if done else "stopped", done)
+        monkeypatch.setattr(shooting, "_solve_record", stand_in)
+        steps: list[str] = []
+        return shooting._solve(space.model, data, space, space.theta0, 2, 200, 1e-10, None, None, 0.01, steps), steps
+
+    cut, steps = run(2e-9)
+    assert cut.success and cut.data is None and len(steps) == 1 and steps[0].endswith("converged")
+    moves, steps = run(1e-7)
+    assert isinstance(moves.data, Pieces) and "more than 4 times the record's position noise" in steps[0]
+    assert "FitResult.data holds the moves" in steps[1]
 
 
 def test_static_start_of_pieces_stays_inside_each_piece() -> None:

@@ -293,7 +293,7 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
     def held_of(sp: ParameterSpace, also: tuple = ()) -> ParameterSpace | None:
         """``sp`` with the parameters a first stage holds (:mod:`prefriction.identify.held_first`, and ``also``)
         fixed."""
-        names = held_first(sp.model, sp) + tuple(n for n in also if n is not None)
+        names = held_first(sp.model, sp) + also
         if not names:
             return None
         return ParameterSpace(sp.model, None if free is None else [n for n in free if n not in names],
@@ -302,7 +302,7 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
                               offset0=sp.start.get("offset", 0.0))
 
     space = space_of(model, start.mass, start.offset)
-    from prefriction.identify.balance_start import balance_start
+    from prefriction.identify.balance_start import HELD_EVALS, BalanceStart, balance_start
     from prefriction.identify.element_start import element_start
 
     hold: tuple[str, ...] = ()   # held in the first stage besides held_first's (a start from the force balance)
@@ -317,7 +317,8 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
         said = (f"rms error of the 50-sample shooting segments {math.sqrt(better):.4g} m against "
                 f"{math.sqrt(given):.4g} m of the given start")
         if better < given:
-            model, space, hold = found.model, space_el, (getattr(found, "gamma", None),)
+            model, space = found.model, space_el
+            hold = (found.gamma,) if isinstance(found, BalanceStart) else ()
             start = dataclasses.replace(start, mass=found.mass, offset=found.offset,
                                         steps=start.steps + (f"{found.line}; {said}: it replaces the given start",))
         else:
@@ -326,7 +327,8 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
     first_steps = start.steps
     try:
         sol, error = fit_motion(model, data, space, n_sub=substeps, max_iter=max_iter, tol=tol,
-                                reversals=reversals, held=held_of(space, hold)), None
+                                reversals=reversals, held=held_of(space, hold),
+                                held_iter=HELD_EVALS if hold else None), None
     except SolverError as err:
         sol, error = None, err
     retried = False

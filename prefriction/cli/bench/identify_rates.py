@@ -8,6 +8,8 @@ the cost of force-displacement fits against the record length.
   (:data:`SEEDS`), each stage and seed in a fresh process so that its peak resident set size
   (``ru_maxrss``) is its own; per model against the start distance, with the wall and CPU time
   and the memory, and the coverage of the fits' 95 % intervals per model.
+- A free Dahl ``gamma``: :func:`gamma_lines` (the 2.5 kg closed-loop ``gamma = 2`` stage of
+  :data:`prefriction.identify._success.STAGES`, starts within a factor 2).
 - Models with in-branch events (Maxwell-slip, GMS): :mod:`prefriction.cli.bench.identify_events`.
 - Coverage: :func:`prefriction.identify._coverage.coverage_table` (how often the 95 % intervals
   hold the truth on seeded records generated from the equations).
@@ -26,8 +28,9 @@ import subprocess
 import sys
 import time
 import warnings
+from typing import Any
 
-__all__ = ["coverage_lines", "cost_lines", "main_rates", "success_lines"]
+__all__ = ["coverage_lines", "cost_lines", "gamma_lines", "main_rates", "success_lines"]
 
 COVERAGE_TARGET = 0.90
 """Least fraction of the 95 % intervals that must hold the truth."""
@@ -39,12 +42,13 @@ def _rss_mb() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0  # kB on Linux
 
 
-def _success_stage(index: int, fits: int, samples: int, distances: tuple[float, ...], seed: int = 0) -> list[dict]:
-    """One stage of :data:`prefriction.identify._success.GRID` and one seed, in this process; rows
-    with the process's peak RSS."""
+def _success_stage(index: int, fits: int, samples: int, distances: tuple[float, ...], seed: int = 0,
+                   stages: str = "GRID") -> list[dict]:
+    """One stage of :data:`prefriction.identify._success.GRID` (or of ``STAGES``) and one seed, in this
+    process; rows with the process's peak RSS."""
     from prefriction.identify import _success
 
-    stage = _success.GRID[index]
+    stage = getattr(_success, stages)[index]
     rows = _success.success_table((stage,), distances, fits=fits, samples=samples, seed=seed,
                                   progress=lambda line: print(line, file=sys.stderr, flush=True))
     return [dataclasses.asdict(r) for r in rows]
@@ -67,17 +71,7 @@ def success_lines(quick: bool) -> tuple[list[str], bool]:
     fits, samples = 1, (500 if quick else 1000)
     distances, seeds = ((1.5, 2.0), (0,)) if quick else (DISTANCES, SEEDS)
     stages = QUICK_STAGES if quick else range(len(_success.GRID))
-    rows, failed = [], []
-    for seed, i in ((s, i) for s in seeds for i in stages):
-        stage = _success.GRID[i]
-        print(f"bench --identify: success rate of {stage.name}, seed {seed} ...", file=sys.stderr, flush=True)
-        out = subprocess.run([sys.executable, "-m", "prefriction.cli.bench.identify_rates", "success", str(i),
-                              str(fits), str(samples), ",".join(map(str, distances)), str(seed)],
-                             stdout=subprocess.PIPE, text=True, check=False)  # its progress on our stderr
-        if out.returncode != 0:
-            failed.append(f"{stage.name}, seed {seed}: exit code {out.returncode}, see the messages above")
-            continue
-        rows += [_success.row_from_dict(r) for r in json.loads(out.stdout.strip().splitlines()[-1])]
+    rows, failed = _stage_rows("GRID", stages, seeds, fits, samples, distances)
     lines = [f"Motion fits from starts log-uniform within a factor d of the truth (every free parameter, mass "
              f"and offset included), {fits} seeded start per distance on each of {len(seeds)} records per stage, "
              f"success = every estimate within 5 %", _success.table_text(rows), "",
@@ -88,6 +82,50 @@ def success_lines(quick: bool) -> tuple[list[str], bool]:
     top = [r for r in rows if r.distance == max(distances)]
     ok = not failed and sum(r.successes for r in top) >= 0.9 * sum(r.fits for r in top)
     lines.append(f"target >= 90 % of the fits within 5 % from a factor {max(distances):g}: {'PASS' if ok else 'FAIL'}")
+    return lines, ok
+
+
+def _stage_rows(stages: str, indices: Any, seeds: tuple[int, ...], fits: int, samples: int,
+                distances: tuple[float, ...]) -> tuple[list, list[str]]:
+    """The success rows of ``indices`` into ``_success.GRID`` or ``_success.STAGES`` (``stages``), one
+    fresh process per stage and seed, and a line per process that failed."""
+    from prefriction.identify import _success
+
+    rows, failed = [], []
+    for seed, i in ((s, i) for s in seeds for i in indices):
+        stage = getattr(_success, stages)[i]
+        print(f"bench --identify: success rate of {stage.name}, seed {seed} ...", file=sys.stderr, flush=True)
+        out = subprocess.run([sys.executable, "-m", "prefriction.cli.bench.identify_rates", "success", str(i),
+                              str(fits), str(samples), ",".join(map(str, distances)), str(seed), stages],
+                             stdout=subprocess.PIPE, text=True, check=False)  # its progress on our stderr
+        if out.returncode != 0:
+            failed.append(f"{stage.name}, seed {seed}: exit code {out.returncode}, see the messages above")
+            continue
+        rows += [_success.row_from_dict(r) for r in json.loads(out.stdout.strip().splitlines()[-1])]
+    return rows, failed
+
+
+GAMMA_STAGE = 2
+"""The stage of :data:`prefriction.identify._success.STAGES` with a free Dahl ``gamma`` (2.5 kg, 2 kHz,
+10 nm, closed loop, ``gamma = 2`` + viscous + offset)."""
+GAMMA_SEEDS = (0, 1, 2)
+"""Seeds of its full run (``--quick``: seed 0)."""
+
+
+def gamma_lines(quick: bool) -> tuple[list[str], bool]:
+    """Success of the stage with a free Dahl ``gamma`` (:data:`GAMMA_STAGE`, 1,000 samples, one start per
+    seed within a factor 2; the start from the force balance, ``identify/balance_start.py``); ``ok`` when
+    at least 90 % of the fits land within 5 %."""
+    from prefriction.identify import _success
+
+    seeds = (0,) if quick else GAMMA_SEEDS
+    rows, failed = _stage_rows("STAGES", (GAMMA_STAGE,), seeds, 1, 1000, (2.0,))
+    ok = not failed and sum(r.successes for r in rows) >= 0.9 * sum(r.fits for r in rows)
+    lines = [f"Dahl with a free gamma = 2 (stage {_success.STAGES[GAMMA_STAGE].name}), 1,000 samples, one start "
+             f"within a factor 2 on each of {len(seeds)} records", _success.table_text(rows),
+             "Coverage of their 95 % intervals", _success.coverage_text(rows)]
+    lines += [f"stage FAILED: {f}" for f in failed]
+    lines.append(f"target >= 90 % of the fits within 5 %: {'PASS' if ok else 'FAIL'}")
     return lines, ok
 
 
@@ -175,12 +213,12 @@ def cost_lines(quick: bool) -> tuple[list[str], bool]:
 
 
 def main_rates(quick: bool) -> bool:
-    """Print the four tables (the event models' from :mod:`prefriction.cli.bench.identify_events`);
+    """Print the five tables (the event models' from :mod:`prefriction.cli.bench.identify_events`);
     True if every target passes."""
     from prefriction.cli.bench.identify_events import event_lines
 
     ok = True
-    for part in (success_lines, event_lines, coverage_lines, cost_lines):
+    for part in (success_lines, gamma_lines, event_lines, coverage_lines, cost_lines):
         lines, good = part(quick)
         print("\n".join(lines) + "\n", flush=True)
         ok &= good
@@ -191,6 +229,7 @@ if __name__ == "__main__":
     if sys.argv[1] == "success":
         dist = tuple(float(d) for d in sys.argv[5].split(","))
         seed_arg = int(sys.argv[6]) if len(sys.argv) > 6 else 0
-        print(json.dumps(_success_stage(int(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4]), dist, seed_arg)))
+        which = sys.argv[7] if len(sys.argv) > 7 else "GRID"
+        print(json.dumps(_success_stage(int(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4]), dist, seed_arg, which)))
     elif sys.argv[1] == "cost":
         print(json.dumps(_cost_one(int(sys.argv[2]))))
