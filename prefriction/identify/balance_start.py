@@ -91,7 +91,8 @@ def balance_start(model: FrictionModel, data: Motion, space: ParameterSpace, fre
     found = {n: res.estimate(n) for n in res.names if n in space.free}
     if set(found) != set(space.free) or not all(math.isfinite(v) for v in found.values()):
         return None
-    if any(not space.low.get(n, -math.inf) <= v <= space.high.get(n, math.inf) for n, v in found.items()) or found[gamma] < 1.0:
+    inside = all(space.low.get(n, -math.inf) <= v <= space.high.get(n, math.inf) for n, v in found.items())
+    if not inside or found[gamma] < 1.0:
         return None
     try:
         new = space.build(dict(space.start, **found))

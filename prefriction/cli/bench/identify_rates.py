@@ -121,8 +121,9 @@ def gamma_lines(quick: bool) -> tuple[list[str], bool]:
     seeds = (0,) if quick else GAMMA_SEEDS
     rows, failed = _stage_rows("STAGES", (GAMMA_STAGE,), seeds, 1, 1000, (2.0,))
     ok = not failed and sum(r.successes for r in rows) >= 0.9 * sum(r.fits for r in rows)
+    records = f"{len(seeds)} record{'s' if len(seeds) > 1 else ''}"
     lines = [f"Dahl with a free gamma = 2 (stage {_success.STAGES[GAMMA_STAGE].name}), 1,000 samples, one start "
-             f"within a factor 2 on each of {len(seeds)} records", _success.table_text(rows),
+             f"within a factor 2 on each of {records}", _success.table_text(rows),
              "Coverage of their 95 % intervals", _success.coverage_text(rows)]
     lines += [f"stage FAILED: {f}" for f in failed]
     lines.append(f"target >= 90 % of the fits within 5 %: {'PASS' if ok else 'FAIL'}")
