@@ -311,13 +311,13 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
     if found is not None:  # said in FitResult.start, taken where its shooting segments follow the record better
         from prefriction.identify.shooting import start_error
 
-        space_el = space_of(found.model, found.mass, found.offset)
+        space_found = space_of(found.model, found.mass, found.offset)
         given, better = _start_error(start_error, model, data, space), _start_error(start_error, found.model,
-                                                                                   data, space_el)
+                                                                                   data, space_found)
         said = (f"rms error of the 50-sample shooting segments {math.sqrt(better):.4g} m against "
                 f"{math.sqrt(given):.4g} m of the given start")
         if better < given:
-            model, space = found.model, space_el
+            model, space = found.model, space_found
             hold = (found.gamma,) if isinstance(found, BalanceStart) else ()
             start = dataclasses.replace(start, mass=found.mass, offset=found.offset,
                                         steps=start.steps + (f"{found.line}; {said}: it replaces the given start",))

@@ -20,8 +20,8 @@ from scipy.signal import savgol_filter
 from prefriction.identify.data import Motion
 from prefriction.models.base import FrictionModel
 
-__all__ = ["Start", "StaticStart", "data_start", "derivatives", "secant", "start_values", "static_start",
-           "stiffness_from_reversals"]
+__all__ = ["Start", "StaticStart", "data_start", "derivatives", "derivatives_of", "piece_edges", "secant",
+           "start_values", "static_start", "stiffness_from_reversals"]
 
 _RESOLVED = 8
 """Fewest samples in the first third of a reversal transient for a stiffness estimate."""

@@ -37,7 +37,7 @@ from typing import Any
 import numpy as np
 
 from prefriction.identify.data import Motion
-from prefriction.identify.motion_start import derivatives
+from prefriction.identify.motion_start import derivatives, piece_edges
 
 __all__ = ["FEWEST", "MOST_PIECES", "PIECE_TOL", "Pieces", "breaks_of", "concatenate", "describe",
            "describe_moves", "direction_counts", "moves_of", "moving_flips", "piece_window", "reversal_samples"]
@@ -94,8 +94,9 @@ class Pieces(Motion):
 
 
 def breaks_of(data: Motion) -> np.ndarray:
-    """Sample indices at which a new piece of ``data`` starts (empty for an ordinary record)."""
-    return np.asarray(data.breaks if isinstance(data, Pieces) else (), dtype=int)
+    """Sample indices at which a new piece of ``data`` starts (empty for an ordinary record): the
+    inner edges of :func:`prefriction.identify.motion_start.piece_edges`."""
+    return piece_edges(data)[1:-1]
 
 
 def moving_flips(v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
