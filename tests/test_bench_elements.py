@@ -5,7 +5,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import prefriction as pf
 from prefriction.cli.bench import main
 from prefriction.cli.bench.elements import ElementRow, element_rows, element_system, element_table, element_targets
 

@@ -47,14 +47,14 @@ def test_no_force_balance_start_without_a_free_gamma_or_with_events(record: Moti
 
 
 def test_a_stage_that_stopped_hands_on_its_estimates_only_where_they_follow_the_record(record: Motion) -> None:
-    """``shooting._closer``: the estimates of a stage that did not converge start the next stage only
+    """``continuation.closer_estimates``: the estimates of a stage that did not converge start the next stage only
     where the shooting segments follow the scipy record more closely than at the values before it."""
-    from prefriction.identify.shooting import _closer
+    from prefriction.identify.continuation import closer_estimates
 
     truth = STAGE.model()
     space = ParameterSpace(truth, None, None, None, mass=STAGE.mass, offset=3.0, offset0=STAGE.offset)
     exact = dict(space.start)
     off = dict(exact, sigma=1.5 * exact["sigma"], gamma=2.6)
-    assert _closer(record, space, off, exact) == exact
-    assert _closer(record, space, exact, off) is None
-    assert _closer(record, space, exact, dict(off, Fc=float("nan"))) is None
+    assert closer_estimates(record, space, off, exact) == exact
+    assert closer_estimates(record, space, exact, off) is None
+    assert closer_estimates(record, space, exact, dict(off, Fc=float("nan"))) is None

@@ -152,6 +152,7 @@ def test_single_shooting_chain_carries_the_flags_of_a_gms_slip():
     flags cleared at the nodes (a node's state deciding its mode) those elements restart sticking
     and the chain leaves the reference."""
     from prefriction.identify import shooting as sh
+    from prefriction.identify.motion_start import derivatives
     from prefriction.identify.parameters import ParameterSpace
     from prefriction.identify.synthetic_events import event_motion
 
@@ -164,7 +165,7 @@ def test_single_shooting_chain_carries_the_flags_of_a_gms_slip():
     data = identify.Motion(t, run.x, u, MASS)
     space = ParameterSpace(model, None, GMS_FIXED, None, offset=1.0, offset0=0.1)
     X, V = model.Fc / model.sigma, model.Fc / math.sqrt(MASS * model.sigma)
-    xsm, v, a = sh.derivatives(t, run.x, 7)
+    xsm, v, a = derivatives(t, run.x, 7)
     lay = sh._layout(data, 50, sh._directions(t, run.x, v, None), np.array([X, V]))
     prob = sh._Problem(model, space, data, lay, 4, False, MASS, 1.0)
     single = sh.segment_functions(model, space, lay.K, 4, False)[0]

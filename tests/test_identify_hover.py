@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from prefriction import identify
-from prefriction.identify import shooting
+from prefriction.identify import hovers, shooting
 from prefriction.identify._success import STAGES, _moves, stage_record, start_model
 from prefriction.identify.data import Motion
 from prefriction.identify.motion_start import derivatives
@@ -62,8 +62,8 @@ def test_hover_nodes_follow_the_slow_stretches_of_the_true_motion():
     _x, vs, _a = derivatives(data.t, data.x, shooting._NODE_WINDOW)
     K = shooting.SEGMENT
     nodes = np.arange(math.ceil((len(data) - 1) / K)) * K
-    free = shooting._hover_nodes(np.abs(vs), nodes, K)
-    slow = np.abs(v) <= shooting.HOVER * float(np.max(np.abs(v)))
+    free = hovers.hover_nodes(np.abs(vs), nodes, K)
+    slow = np.abs(v) <= hovers.HOVER * float(np.max(np.abs(v)))
     runs, flips = [], []
     for k in nodes[:-1]:                          # the true stage in each segment
         best = cur = 0

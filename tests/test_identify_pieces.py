@@ -150,7 +150,8 @@ def test_window_weak_names_an_unpinned_parameter_and_a_stopped_fit():
     """``_window_weak``: a converged window whose residuals do not move with ``sigma`` (its
     Jacobian column zero, the other columns random) leaves ``sigma`` unpinned; with every column
     random it can start the record; a fit that did not converge cannot."""
-    from prefriction.identify.shooting import MotionSolution, _window_weak
+    from prefriction.identify.continuation import _window_weak
+    from prefriction.identify.shooting import MotionSolution
 
     space = ParameterSpace(Dahl(sigma=SIGMA, Fc=FC, gamma=1.0), None, ["gamma"], None, mass=None, offset=FC,
                            offset0=OFFSET)
@@ -176,18 +177,18 @@ def test_long_hovers_flag_runs_of_three_slow_segments_and_the_moves_keep_the_res
     samples; segment 3 ends on the rest's first sample), a run of four, so those are left out and
     the moves are the samples 0 to 199 and 400 to the end, each a whole number of segments."""
     from prefriction.identify.pieces import moves_of
-    from prefriction.identify.shooting import _hover_nodes, _long_hovers
+    from prefriction.identify.hovers import hover_nodes, long_hovers
 
     n = 601
     speed = np.ones(n)
     speed[200:400] = 0.0
     nodes = np.arange(12) * K
-    long = _long_hovers(speed, nodes, K)
+    long = long_hovers(speed, nodes, K)
     assert np.flatnonzero(long).tolist() == [4, 5, 6, 7]
-    assert np.flatnonzero(_hover_nodes(speed, nodes, K)).tolist() == [5, 6, 7, 8]   # the nodes after them
+    assert np.flatnonzero(hover_nodes(speed, nodes, K)).tolist() == [5, 6, 7, 8]   # the nodes after them
     short = speed.copy()
     short[300:400] = 1.0                                          # a rest of 100 samples: two segments, kept
-    assert not np.any(_long_hovers(short, nodes, K))
+    assert not np.any(long_hovers(short, nodes, K))
 
     t = np.arange(n) * DT
     x = np.cumsum(speed) * 1e-8
@@ -208,7 +209,7 @@ def test_moves_fit_is_the_result_only_where_its_misfit_is_of_the_noise(monkeypat
     estimate of ``identify.derivatives``, here of Gaussian noise of 3 nm on smooth moves): a
     solver stand-in returning residuals of 1 nm rms is kept, with the moves as its data; one
     returning 100 nm rms (a local minimum) is not, and the note says why."""
-    from prefriction.identify import shooting
+    from prefriction.identify import hovers, layouts, shooting
     from prefriction.identify.pieces import Pieces, moves_of
 
     n = 1_201
@@ -228,11 +229,11 @@ def test_moves_fit_is_the_result_only_where_its_misfit_is_of_the_noise(monkeypat
             assert isinstance(moves, Pieces) and len(moves) < n        # the fit sees the moves alone
             r = rms * np.where(np.arange(len(moves)) % 2, 1.0, -1.0)
             return shooting.MotionSolution(w, r, np.zeros((r.size, w.size)), None, np.zeros(r.size), {}, "converged")
-        monkeypatch.setattr(shooting, "_solve_record", stand_in)
+        monkeypatch.setattr(layouts, "_solve_record", stand_in)
         steps: list[str] = []
         _x, v, _a = derivatives_of(data, 7)
-        moves = moves_of(data, shooting._long_hovers(np.abs(v), np.arange(24) * K, K), K)
-        return shooting._without_hovers(data, moves, space, whole, None, 200, 1e-10, None, None, steps, 1), steps
+        moves = moves_of(data, hovers.long_hovers(np.abs(v), np.arange(24) * K, K), K)
+        return layouts._without_hovers(data, moves, space, whole, None, 200, 1e-10, None, None, steps, 1), steps
 
     kept, steps = run(1e-9)
     assert isinstance(kept.data, Pieces) and kept.success and "FitResult.data holds the moves" in steps[0]
@@ -242,12 +243,12 @@ def test_moves_fit_is_the_result_only_where_its_misfit_is_of_the_noise(monkeypat
 
 
 def test_a_cut_chain_far_above_the_noise_gives_way_to_the_moves(monkeypatch):
-    """``_solve``: a chain cut at the long hovers that converges with an rms residual above ``MISFIT``
+    """``layouts.solve_layouts``: a chain cut at the long hovers that converges with an rms residual above ``MISFIT``
     times the record's position noise (3 nm of Gaussian noise on smooth moves) is a local minimum,
     and the moves are fitted from its estimates; one within the limit is the result. The solver is a
     stand-in (whole chain: stopped; cut chain: converged at the given rms; moves: converged at 1 nm),
     so this tests the decision, not the fit."""
-    from prefriction.identify import shooting
+    from prefriction.identify import layouts, shooting
     from prefriction.identify.pieces import Pieces
 
     n = 1_201
@@ -267,9 +268,9 @@ def test_a_cut_chain_far_above_the_noise_gives_way_to_the_moves(monkeypatch):
             done = isinstance(record, Pieces) or pieces
             return shooting.MotionSolution(w, r, np.zeros((m, w.size)), None, np.zeros(m), {},
                                            "converged" if done else "stopped", done)
-        monkeypatch.setattr(shooting, "_solve_record", stand_in)
+        monkeypatch.setattr(layouts, "_solve_record", stand_in)
         steps: list[str] = []
-        return shooting._solve(space.model, data, space, space.theta0, 2, 200, 1e-10, None, None, 0.01, steps), steps
+        return layouts.solve_layouts(space.model, data, space, space.theta0, 2, 200, 1e-10, None, None, 0.01, steps), steps
 
     cut, steps = run(2e-9)
     assert cut.success and cut.data is None and len(steps) == 1 and steps[0].endswith("converged")

@@ -192,12 +192,12 @@ def test_recommend_names_the_route(monkeypatch):
     assert identify.recommend(identify.Motion(np.arange(n) * dt, xq, uq, None)).route == "inverse"
     assert identify.recommend(identify.Motion(t[:100], x[:100], u[:100], None)).route == "motion"
     # the open-loop Motion fit says which route to use when it fails on such a record
-    import prefriction.identify.shooting as shooting
+    import prefriction.identify.continuation as continuation
 
     def stalled(*_a, **_k):
         raise pf.SolverError("the segments stopped meeting")
 
-    monkeypatch.setattr(shooting, "fit_motion", stalled)
+    monkeypatch.setattr(continuation, "fit_motion", stalled)
     with pytest.raises(pf.SolverError, match=r"segments stopped meeting; this record suits another route \(inverse"
                                              r".*identify\.fit_inverse"):
         identify.fit(pf.Dahl(sigma=1e6, Fc=10.0) + pf.Viscous(100.0), identify.Motion(np.arange(n) * dt, xq, uq, None),

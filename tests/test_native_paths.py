@@ -135,7 +135,7 @@ def test_forced_lugre_against_scipy() -> None:
     sol = solve_ivp(rhs, (0.0, T_END), [0.0, 0.0, 0.0], method="DOP853", rtol=1e-12, atol=1e-16, events=vzero,
                     dense_output=True)
     times = [t for t in sol.t_events[0] if t > 0.0]
-    ts, xs = [td], [sol.sol(td)[0]]
+    xs = [sol.sol(td)[0]]
     tab = res.reversals
     ref_t = np.array(times)
     n = min(len(tab), len(ref_t))

@@ -266,7 +266,7 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
                 offset: bool) -> FitResult:
     from prefriction.identify.held_first import held_first
     from prefriction.identify.motion_start import data_start, start_values
-    from prefriction.identify.shooting import fit_motion
+    from prefriction.identify.continuation import fit_motion
     from prefriction.identify.structures import gamma_entry
 
     if data.mass is None:
@@ -389,7 +389,7 @@ def _fit_motion(model: FrictionModel, data: Motion, free: Any, fixed: Any, bound
                 f"the fit from these start values ended with {why}; second start from {second[3]}: {said}",))
     held = bool(held_first(space.model, space))
     short = _short_of_minimum(space, sol, stats, held)
-    from prefriction.identify.shooting import WINDOW
+    from prefriction.identify.continuation import WINDOW
 
     # once more, the held stage from where it stopped (a long record: its cost, and the flag, instead)
     if short and held and len(data) <= 2 * WINDOW:
@@ -431,7 +431,7 @@ def _fit_from(second: tuple, data: Motion, space_of: Any, substeps: Any, max_ite
     """The Motion fit from a second start ``(model, mass, offset, origin)``
     (:func:`prefriction.identify.motion_start.data_start`): ``(solution, space, None)``, or
     ``(None, None, error)`` where building its space or solving raised."""
-    from prefriction.identify.shooting import fit_motion
+    from prefriction.identify.continuation import fit_motion
 
     try:
         space2 = space_of(second[0], second[1], second[2])
@@ -487,7 +487,7 @@ def _gamma_continuation(model: FrictionModel, data: Motion, space: ParameterSpac
         The second stage's solution (``None`` if either stage failed or it is doubtful itself,
         :func:`_doubtful`) and a line for :attr:`FitResult.start`.
     """
-    from prefriction.identify.shooting import fit_motion
+    from prefriction.identify.continuation import fit_motion
 
     mass_start = space.start.get("mass")
     offset_start = space.start.get("offset", 0.0)

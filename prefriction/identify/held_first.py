@@ -14,7 +14,7 @@ with the stiffnesses 3 standard errors from the truth.
 
 Held at any value of ``C``, the valley's cross-section in ``Fs`` is a clean minimum (``Fs`` has
 all of ``[Fc, inf)`` to reach it), so the first stage fits with ``C`` held at its start and lands
-on the valley floor; the second frees ``C`` from there (:func:`prefriction.identify.shooting.fit_motion`).
+on the valley floor; the second frees ``C`` from there (:func:`prefriction.identify.continuation.fit_motion`).
 On the floor, the parameters the record does pin (stiffnesses, ``Fc``, mass, offset) take the
 values of the truth's neighbourhood wherever along the valley ``C`` and ``Fs`` end, and the
 statistics report ``C`` and ``Fs`` as not identifiable when the valley is that flat.

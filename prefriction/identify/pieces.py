@@ -1,7 +1,7 @@
 """The first window of a long Motion fit cut from pieces of the record around its reversals.
 
-A long record first fits a window of :data:`prefriction.identify.shooting.WINDOW` samples
-(continuation, :func:`prefriction.identify.shooting.fit_motion`). A slow record turns seldom: the
+A long record first fits a window of :data:`prefriction.identify.continuation.WINDOW` samples
+(continuation, :func:`prefriction.identify.continuation.fit_motion`). A slow record turns seldom: the
 open-loop record of a 2.5 kg stage driven by three periods of a two-tone force over 25,000 samples
 (5 s at 5 kHz) reverses five times, and its busiest 2,000-sample window holds one reversal. In one
 direction of sliding the friction is ``Fc + F_off``, in the other ``-Fc + F_off``, and the mass and
@@ -14,7 +14,7 @@ record holds more, and at least two of its turns are short (the stage slides aga
 window: an open-loop record that turns while sliding, not a closed loop resting at its set points
 between moves), the first window is cut from up to :data:`MOST_PIECES` pieces of the record, each
 centred on a velocity reversal, about half in each direction (:func:`piece_window`), and fitted
-before the contiguous one (:func:`prefriction.identify.shooting.fit_motion`): each piece slides
+before the contiguous one (:func:`prefriction.identify.continuation.fit_motion`): each piece slides
 one way, turns through its pre-sliding transient and slides the other way. Measured at 25,000
 samples from factor-2 starts: on the slow open-loop records of the success harness the
 contiguous window either stops (the 10 kg LuGre stage: 850 s of CPU before the pieces ran) or
@@ -59,7 +59,7 @@ truth, from a factor-2 start (continuity defects of 5e-6) and from the truth ali
 (52 and 50 s of CPU, the chain cut at the long hovers of the slow turns)."""
 MOVING = 0.05
 """Fraction of the top smoothed speed above which a sample counts as moving for the reversal count
-(:func:`moving_flips`, also for :func:`prefriction.identify.shooting._busiest_window`)."""
+(:func:`moving_flips`, also for :func:`prefriction.identify.continuation._busiest_window`)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -208,7 +208,7 @@ def concatenate(data: Motion, spans: list[tuple[int, int]]) -> Pieces:
 
 def moves_of(data: Motion, left_out: np.ndarray, K: int) -> Pieces | None:
     """``data`` without the shooting segments of ``K`` samples flagged in ``left_out`` (the long
-    hovers of :func:`prefriction.identify.shooting._long_hovers`): the moves between them, one
+    hovers of :func:`prefriction.identify.hovers.long_hovers`): the moves between them, one
     piece each; ``None`` when no segment is left out or every one is."""
     keep = ~np.asarray(left_out, dtype=bool)
     if keep.all() or not keep.any():

@@ -1,4 +1,4 @@
-"""Fit a friction model to the motion of a mass (:class:`Motion`) by multiple shooting.
+"""Fit a friction model to the motion of a mass (:class:`Motion`) by multiple shooting: one layout.
 
 The record is cut into segments of ``K`` samples (:data:`SEGMENT`). Each segment starts at a
 node with a free position, velocity and model state and is simulated sample by sample
@@ -7,15 +7,12 @@ or linear over each sample as the data say, reversals located inside the sub-ste
 of a segment must meet the next node. The objective is the sum of squared position residuals,
 minimised subject to the continuity of the segments by scipy's trust-region least squares in an
 augmented Lagrangian on sparse matrices (:mod:`prefriction.identify.constrained_lsq`), with
-forward sensitivities propagated sample by sample. A record longer than ``2 WINDOW`` samples
-fits its :data:`WINDOW` samples with the most reversals first and starts the full record from
-their estimates (continuation; where that window holds fewer than two reversals each way and
-the record turns while sliding, a window cut from pieces of the record around its reversals
-first, :mod:`prefriction.identify.pieces`, :func:`_first_window`); parameters the record pins only together with another
-(:mod:`prefriction.identify.held_first`) are held at their start values in the window and in a
-first fit of the full record, and freed in the last. Nothing holds more than a few numbers per sample and sensitivity column, so the
-time and the memory of a fit grow linearly with the samples (measured:
-``docs/identify_motion.md``).
+forward sensitivities propagated sample by sample (:func:`_solve_record`). Which layouts a record
+runs (the chain whole, cut after the long hovers, the moves alone) is
+:mod:`prefriction.identify.layouts`; the continuation over a long record's first window and
+over held parameters is :mod:`prefriction.identify.continuation`. Nothing holds more than a few
+numbers per sample and sensitivity column, so the time and the memory of a fit grow linearly
+with the samples (measured: ``docs/identify_motion.md``).
 
 The statistics need the residual Jacobian on the constraint manifold: chaining the segment
 sensitivities node to node gives it with respect to the parameters and the first node alone
@@ -35,34 +32,27 @@ import casadi as ca
 import numpy as np
 import scipy.sparse as sp
 
-from prefriction._blas_threads import with_one_blas_thread
 from prefriction.errors import SolverError
 from prefriction.identify.constrained_lsq import solve
 from prefriction.identify.data import Motion
-from prefriction.identify.derivatives import derivatives as filtered_derivatives
 from prefriction.identify.held_first import held_first
-from prefriction.identify.motion_start import derivatives, derivatives_of
+from prefriction.identify.hovers import hover_nodes
+from prefriction.identify.motion_start import derivatives_of
 from prefriction.identify.motion_step import STATE_CAP, segment_functions
 from prefriction.identify.parameters import ParameterSpace
-from prefriction.identify.pieces import (PIECE_TOL, breaks_of, describe, describe_moves, moves_of,
-                                         moving_flips, piece_window)
-from prefriction.identify.polish import polish, valley_secant
+from prefriction.identify.pieces import breaks_of
+from prefriction.identify.polish import polish
 from prefriction.identify.reversals import locate_reversals
 from prefriction.identify.substep_rule import follows_data, rates_along
 from prefriction.models.base import FrictionModel
 
-__all__ = ["LONG", "SEGMENT", "MotionSolution", "fit_motion", "start_error"]
+__all__ = ["SEGMENT", "MotionSolution", "start_error"]
 
 SEGMENT = 50
 """Samples per shooting segment."""
 GTOL = 1e-5
 """Largest continuity defect of a converged fit, in the node scales (``1e-5`` of the pre-sliding
 distance ``Fc / sigma`` in position, of the velocity unit, of the normalised state)."""
-WINDOW = 2_000
-"""Samples of the window a longer record fits first (continuation): the full record starts from
-its estimates, so it needs few iterations and its cost stays linear in the samples."""
-LONG = 5_000
-"""Records of at least this many samples report each iteration on stderr (long work)."""
 NATIVE_FROM = 1_000
 """Records of a model with in-branch events of at least this many samples run the compiled steps
 (compiling once per structure takes 10 to 30 s and makes every evaluation about 7 times faster)."""
@@ -83,7 +73,7 @@ _MAPPED: dict[Any, tuple[ca.Function, ca.Function]] = {}
 
 @dataclass(frozen=True)
 class MotionSolution:
-    """What :func:`fit_motion` returns to :func:`prefriction.identify.fit`."""
+    """What :func:`prefriction.identify.continuation.fit_motion` returns to :func:`prefriction.identify.fit`."""
 
     w: np.ndarray
     residuals: np.ndarray
@@ -106,7 +96,7 @@ class MotionSolution:
     first flags): ``w``'s nodes are in its scales."""
     data: Motion | None = dataclasses.field(default=None, repr=False, compare=False)
     """The record the residuals and prediction are of when it is not the one given: its moves,
-    the long hovers left out (:func:`_solve`)."""
+    the long hovers left out (:func:`prefriction.identify.layouts.solve_layouts`)."""
 
 
 @dataclass(frozen=True)
@@ -148,7 +138,7 @@ class _Layout:
 
 def _layout(data: Motion, K: int, directions: np.ndarray, scl: np.ndarray, speed: np.ndarray | None = None) -> _Layout:
     """Segments of ``K`` samples; with the smoothed speed of the data, the nodes after hovering
-    segments (:func:`_hover_nodes`) start pieces of the chain. The first node of every piece of a
+    segments (:func:`prefriction.identify.hovers.hover_nodes`) start pieces of the chain. The first node of every piece of a
     :class:`prefriction.identify.pieces.Pieces` record starts a piece of the chain too, and the
     step into it from the sample before (the junction) has a zero time step: not simulated."""
     n = len(data)
@@ -162,7 +152,7 @@ def _layout(data: Motion, K: int, directions: np.ndarray, scl: np.ndarray, speed
     u1 = u0.copy() if data.hold == "zoh" else np.zeros(total)
     if data.hold == "linear":
         u1[: n - 1] = data.u[1:]
-    free = _hover_nodes(speed, nodes, K) if speed is not None else np.zeros(J, dtype=bool)
+    free = hover_nodes(speed, nodes, K) if speed is not None else np.zeros(J, dtype=bool)
     free[0] = True
     breaks = breaks_of(data)
     if np.any(breaks % K):
@@ -174,62 +164,6 @@ def _layout(data: Motion, K: int, directions: np.ndarray, scl: np.ndarray, speed
     s_to = np.r_[s[1:], s[-1]]
     s_to[breaks // K - 1] = directions[breaks - 1]
     return _Layout(K, nodes, u0, u1, dt, s, scl, n, free, s_to, int(breaks.size))
-
-
-HOVER = 0.02
-"""Fraction of the record's top speed below which the smoothed speed of the data counts as slow."""
-HOVER_RUN = 10
-"""A segment *hovers* when it holds at least this many consecutive slow samples (:data:`HOVER`):
-a stage held about its set point, or settling into or breaking away from a rest. A reversal
-inside a move is slow for a few samples only (measured on the 2.5 kg stage at 10,000 samples:
-2 to 7)."""
-HOVER_SEGMENTS = 3
-"""Fewest consecutive hovering segments of a *long* hover, after whose segments the chain is cut
-(:func:`_hover_nodes`); a short rest stays chained (it converges, and the chain through it
-carries information: on the 1,000-sample EMPS-like record of the first example, cutting after
-every hovering segment widened the intervals 2.5 times)."""
-
-
-def _hover_nodes(speed: np.ndarray, nodes: np.ndarray, K: int) -> np.ndarray:
-    """Nodes after the segments of a long hover (:data:`HOVER_RUN`, :data:`HOVER_SEGMENTS`).
-
-    A stage held about its set point near the friction limit reverses a dozen times per segment
-    under the noise its loop feeds back (the bristle of LuGre at ``z ~ 0.95``: the state's rate
-    is ``v (1 - z)`` one way and ``v (1 + z)`` the other), so a segment's end state is a
-    piecewise-smooth function of its start with kinks on the scale of ``1e-3`` of the node
-    scales, and continuity defects or Gauss-Newton steps of that size cannot be resolved. In a
-    long hover the node after each of its segments carries no continuity constraint: it starts a new piece of the
-    chain with its own free state (a nuisance variable of the statistics). No constraint then
-    passes through a hovering segment: its kinks reach only its own residuals, where the
-    positions change by a fraction of an encoder step, and each move is chained from its start."""
-    hover = _long_hovers(speed, nodes, K)
-    free = np.zeros(nodes.size, dtype=bool)
-    free[1:] = hover[:-1]
-    return free
-
-
-def _long_hovers(speed: np.ndarray, nodes: np.ndarray, K: int) -> np.ndarray:
-    """The segments of long hovers: runs of at least :data:`HOVER_SEGMENTS` segments that each
-    hold at least :data:`HOVER_RUN` consecutive slow samples (:data:`HOVER`)."""
-    top = float(np.max(speed, initial=0.0))
-    if not top > 0.0:
-        return np.zeros(nodes.size, dtype=bool)
-    slow = np.r_[0, (speed <= HOVER * top).astype(int), 0]
-    edges = np.flatnonzero(np.diff(slow))                       # starts and ends of the slow runs
-    starts, ends = edges[::2], edges[1::2]
-    hover = np.zeros(nodes.size, dtype=bool)
-    for a, b in zip(starts, ends):                              # samples a..b-1 are slow
-        first, last = np.searchsorted(nodes, a, side="right") - 1, np.searchsorted(nodes, b - 1, side="right") - 1
-        for j in range(max(first, 0), last + 1):
-            lo, hi = max(a, nodes[j]), min(b, nodes[j] + K + 1)
-            hover[j] |= hi - lo >= HOVER_RUN
-    long = np.zeros(nodes.size, dtype=bool)
-    run = np.r_[0, hover.astype(int), 0]
-    edges = np.flatnonzero(np.diff(run))
-    for a, b in zip(edges[::2], edges[1::2]):                  # segments a..b-1 hover
-        if b - a >= HOVER_SEGMENTS:
-            long[a:b] = True
-    return long
 
 
 def native_steps(model: FrictionModel, n: int) -> bool:
@@ -458,330 +392,6 @@ def _tag(progress: Any, name: str, t0: float) -> Any:
     return lambda line: progress(f"{name}, {time.perf_counter() - t0:.0f} s: {line}")
 
 
-@with_one_blas_thread
-def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_sub: int | None, max_iter: int,
-               tol: float, reversals: Any = None, verbose: bool = False,
-               held: ParameterSpace | None = None, held_iter: int | None = None) -> MotionSolution:
-    """Multiple-shooting least-squares fit of ``space``'s free parameters to ``data``.
-
-    Parameters
-    ----------
-    verbose : bool, default False
-        One line per outer iteration of the solver on stderr (always for records of :data:`LONG`
-        samples or more).
-    held : ParameterSpace, optional
-        ``space`` with some free parameters held at their start values
-        (:func:`prefriction.identify.held_first.held_first`): the first stages (the window of a
-        long record, then the whole record) fit this space, and the record is then fitted with
-        every parameter of ``space`` free from their estimates.
-    held_iter : int, optional
-        Most Jacobian evaluations of each layout of those first stages (default ``max_iter``): a
-        stage that only settles the other parameters (:mod:`prefriction.identify.balance_start`)
-        hands on its estimates where they follow the record more closely (:func:`_closer`).
-
-    Raises
-    ------
-    ValueError
-        If given reversal times are invalid.
-    prefriction.SolverError
-        If the motion is not finite at the start values (a fit that does not converge returns
-        with ``success = False`` instead).
-    """
-    steps: list[str] = []
-    progress, t0 = (_progress if verbose or len(data) >= LONG else None), time.perf_counter()
-    stages: list[tuple[Motion | None, ParameterSpace, Any, str]] = []   # None: the first window
-    long = len(data) > 2 * WINDOW
-    what = "" if held is None else f" with {', '.join(n for n in space.free if n not in held.free)} held"
-    if long:
-        stages.append((None, space if held is None else held, reversals, "the first window"))
-    if held is not None:
-        stages.append((data, held, reversals, f"the record{what}"))
-    vals, least, weight, moved = dict(space.start), 1, 0.01, False
-    fallback = None   # a short record's held stage: the solution if the free stage does not converge
-    for i, (head, sp_k, given, name) in enumerate(stages):   # continuation (module notes, identify/held_first.py)
-        at = sp_k.build(vals) if moved else model
-        budget = max_iter if held_iter is None else min(max_iter, held_iter)
-        if long and i == 0:
-            stage, head, name = _first_window(at, data, sp_k, sp_k.theta_of(vals), n_sub, budget, tol, reversals,
-                                              progress, t0, weight, steps, what)
-        else:
-            stage = _solve(at, head, sp_k, sp_k.theta_of(vals), n_sub, budget, tol, given, _tag(progress, name, t0),
-                           weight, steps, least)
-        if head is data and stage.success:  # the full record with the held parameters held
-            held_stage = (at, data if stage.data is None else stage.data, space,
-                          dict(vals, **sp_k.values(stage.w[: sp_k.n_free])), stage, name)
-            done = _settled_without(*held_stage) if long else None
-            if done is not None:
-                steps.append(done[1])
-                return dataclasses.replace(done[0], steps=tuple(steps))
-            fallback = None if long else held_stage
-        if not stage.success:
-            closer = _closer(data, space, vals, dict(vals, **sp_k.values(stage.w[: sp_k.n_free])))
-            steps.append(f"continuation: the fit of {name} did not converge ({stage.message}); the next stage "
-                         + ("started from its estimates, whose shooting segments follow the record more closely "
-                            "than those of the values before it" if closer else "started from the values before it"))
-            if closer:
-                vals, moved = closer, True
-            continue
-        least, weight, moved = stage.n_sub, 10.0, True
-        vals = dict(vals, **sp_k.values(stage.w[: sp_k.n_free]))
-        steps.append(f"continuation: {name} fitted ({stage.message}); the next stage started from these estimates "
-                     f"({_at(sp_k, stage.w)})")
-    # the sub-steps of the full record from the last stage's estimates
-    sol = _solve(space.build(vals) if moved else model, data, space, space.theta_of(vals), n_sub, max_iter, tol,
-                 reversals, _tag(progress, "the record", t0), weight, steps, least)
-    if not sol.success and fallback is not None and (done := _settled_without(*fallback)) is not None:
-        steps.append(f"the fit with every parameter free did not converge ({sol.message[-160:]}); {done[1]}")
-        return dataclasses.replace(done[0], steps=tuple(steps))
-    return dataclasses.replace(sol, steps=tuple(steps))
-
-
-def _closer(data: Motion, space: ParameterSpace, before: dict[str, float],
-            after: dict[str, float]) -> dict[str, float] | None:
-    """``after`` (the estimates of a stage that did not converge) if its shooting segments follow
-    ``data`` more closely than those of ``before`` (:func:`start_error`), else ``None``.
-
-    A stage with Dahl's ``gamma`` held near the truth (at the force balance's estimate,
-    :mod:`prefriction.identify.balance_start`) may stop in the rests of a closed loop and still
-    bring the other parameters close: on the 2.5 kg, 2 kHz, 10 nm closed-loop stage at 2,500
-    samples, the moves' fit with ``gamma`` held at 1.956 stopped after 200 evaluations with
-    ``sigma`` 2.3 % off and every other estimate within 0.4 %, and the free stage from there
-    converged within 0.01 % of every true value."""
-    if not all(math.isfinite(v) for v in after.values()):
-        return None
-    try:
-        errors = [start_error(space.build(v), data, space, space.theta_of(v)) for v in (after, before)]
-    except (ValueError, SolverError):
-        return None
-    return after if errors[0] < errors[1] else None
-
-
-def _first_window(model: FrictionModel, data: Motion, space: ParameterSpace, theta0: np.ndarray, n_sub: int | None,
-                  max_iter: int, tol: float, reversals: Any, progress: Any, t0: float, weight: float,
-                  steps: list[str], what: str) -> tuple[MotionSolution, Motion, str]:
-    """The fit of a long record's first window (continuation): ``(solution, window, name)``.
-
-    The window is one cut from pieces of the record around its reversals where
-    :func:`prefriction.identify.pieces.piece_window` gives one (solved to at least
-    :data:`prefriction.identify.pieces.PIECE_TOL`), else the busiest contiguous :data:`WINDOW`
-    samples. When the pieces cannot start the record (:func:`_window_weak`) the contiguous window
-    is fitted from the same start; the first fit that converges is kept when neither pins every
-    parameter. Notes go to ``steps``; ``what`` names held parameters."""
-    k0 = _busiest_window(data)
-    part = slice(k0, k0 + WINDOW)
-    inside = None if reversals is None else [r for r in reversals if data.t[k0] < r < data.t[k0 + WINDOW - 1]]
-    span = f"samples {k0} to {k0 + WINDOW - 1}"
-    choices: list[tuple[Motion, Any, str, str, float]] = [
-        (Motion(data.t[part], data.x[part], data.u[part], data.mass, data.hold), inside, f"{span}{what}", span, tol)]
-    pieces = piece_window(data, k0, WINDOW, SEGMENT)
-    if pieces is not None:
-        choices.insert(0, (pieces, None if reversals is None else pieces.to_piece_times(reversals),
-                           f"{describe(pieces)}{what}", f"{len(pieces.source)} pieces around reversals",
-                           max(tol, PIECE_TOL)))
-    kept = None
-    for k, (window, given, name, short, tol_k) in enumerate(choices):
-        stage = _solve(model, window, space, theta0, n_sub, max_iter, tol_k, given, _tag(progress, short, t0), weight,
-                       steps)
-        weak = _window_weak(stage, space)
-        if kept is None or (stage.success and not kept[0].success):
-            kept = (stage, window, name)
-        if not weak:
-            return stage, window, name
-        if k + 1 < len(choices):
-            steps.append(f"continuation: the fit of {name} {weak}: the first window is {choices[k + 1][2]} instead")
-    return kept
-
-
-def _window_weak(stage: MotionSolution, space: ParameterSpace) -> str:
-    """Why the fit ``stage`` of a long record's first window cannot start the record: it did not
-    converge, or it leaves a free parameter of ``space`` unpinned (relative standard error above
-    50 % under white residuals, :func:`prefriction.identify.statistics.gauss_newton`; measured: the
-    busiest contiguous window of a 25,000-sample 0.3 kg open-loop Dahl + viscous + offset record
-    converges without pinning ``sigma``, and the record started from it ends with ``sigma`` 99 %
-    low); ``""`` when it can."""
-    from prefriction.identify.statistics import gauss_newton
-
-    if not stage.success:
-        return f"did not converge ({stage.message[-160:]})"
-    theta = stage.w[: space.n_free]
-    at = space.values(theta)
-    Jp, sc = space.physical_jacobian(stage.jacobian, theta)
-    stats = gauss_newton(Jp, stage.residuals, space.free, np.array([at[n] for n in space.free]), sc, limit=0.5)
-    loose = "; ".join(f"{n}: {why}" for n, why in stats.unidentifiable)
-    return f"converged without pinning every parameter ({loose})" if loose else ""
-
-
-def _settled_without(at: FrictionModel, data: Motion, space: ParameterSpace, after: dict,
-                     stage: MotionSolution, name: str) -> tuple[MotionSolution, str] | None:
-    """The solution ``stage`` of a long record with the held parameters held (started at the model
-    ``at``, ended at the values ``after``, its nodes in the scales of ``stage.problem``) as a solution of ``space`` (every
-    parameter free), when the record does not pin every parameter there and the pinned estimates
-    sit within :data:`prefriction.identify.settled.SETTLED` standard errors of the minimum of the
-    linearised problem with every parameter free: ``(solution, note)``, else ``None`` (the free
-    stage runs).
-
-    In the flat valley of the held parameters (:mod:`prefriction.identify.held_first`) the free
-    stage of a long record creeps for hundreds of evaluations (measured: 25,000 GMS(2) samples,
-    more than 5 min of CPU) and ends where this point already is; the statistics at it, with every
-    parameter free, report the ones the record does not pin with their full spread."""
-    from prefriction.identify.settled import SETTLED, unsettled
-    from prefriction.identify.statistics import gauss_newton, widen_statistics
-
-    held = stage.problem
-    if held is None:
-        return None
-    mass_free = "mass" in space.start and "mass" in space.free
-    prob = _Problem(at, space, data, held.lay, stage.n_sub, mass_free, held.mass, held.xs, held.native)
-    prob.first_flags, prob.gw = list(held.first_flags), held.gw
-    prob.args["m0"] = held.args["m0"].copy()
-    xs, mass = held.xs, held.mass
-    theta = space.theta_of(after)
-    w = np.r_[theta, stage.w[held.nth:]]
-    r, _g, out = prob.residuals(w)
-    if not (r.size == stage.residuals.size and np.allclose(r * xs, stage.residuals, rtol=1e-6,
-                                                            atol=1e-9 * float(np.max(np.abs(stage.residuals))))):
-        return None    # the held values do not give the stage's motion in the free space: run the free stage
-    J = prob.reduced_jacobian(w)
-    Jp, sc = space.physical_jacobian(J * xs, theta)
-    est = np.array([after[n] for n in space.free])
-    stats = gauss_newton(Jp, r * xs, space.free, est, sc, limit=0.5, covariance="hac")
-    widen = valley_secant(prob, w, J, r, space, at, stage.n_sub, mass_free, stats)
-    if widen:
-        stats = widen_statistics(stats, space.free, est, widen, 0.5)
-    loose = {n for n, _ in stats.unidentifiable}
-    if not loose or unsettled(Jp, r * xs, space.free, sc, stats.stderr, np.array([n not in loose for n in space.free])):
-        return None
-    pred, vel = out["X"][0, prob.rows], out["X"][1, prob.rows]
-    said = "" if not widen else (" (" + ", ".join(f"{n}'s standard error widened {f:.3g} times" for n, f in widen.items())
-                                 + ": along the valley the sum of squares rises less than its linearisation says, "
-                                 "identify/polish.py)")
-    return (MotionSolution(w, r * xs, J * xs, None, pred, _nuisance(at, space, w, prob, data, vel, mass_free, mass),
-                           stage.message, True, n_sub=stage.n_sub, widen=widen, problem=prob,
-                           data=stage.data),
-            f"continuation: the fit of {name} is the solution: with every parameter free the record does not pin "
-            f"{', '.join(sorted(loose))} there either{said}, and the other estimates sit within "
-            f"{SETTLED:g} standard errors of the linearised minimum (identify/settled.py), so no free stage was run")
-
-
-def _solve(model: FrictionModel, data: Motion, space: ParameterSpace, theta0: np.ndarray, n_sub: int | None,
-           max_iter: int, tol: float, reversals: Any, progress: Any, weight: float,
-           steps: list[str], least_sub: int = 1) -> MotionSolution:
-    """:func:`_solve_record` with the chain whole; if that does not converge and the record has
-    long hovers (:func:`_hover_nodes`), again from its estimates with the chain cut there (the
-    continuity through a long hover is piecewise smooth on the scale of the defects; a chain kept
-    whole where it converges keeps the information the rests carry); if that does not converge
-    either, or converges to a misfit above :data:`MISFIT` times the record's noise (a local
-    minimum), the record's moves alone, the long hovers left out (:func:`_without_hovers`; an
-    ordinary record only, not a window of pieces). Notes go to ``steps``;
-    ``least_sub``: fewest automatic sub-steps (those a window's fit found necessary)."""
-    sol = _solve_record(model, data, space, theta0, n_sub, max_iter, tol, reversals, progress, weight, False,
-                        least_sub)
-    if n_sub is None and model.n_events:
-        sol = _event_substeps(data, space, sol, max_iter, tol, reversals, progress, steps)
-    if sol.success:
-        return sol
-    _x, v, _a = derivatives_of(data, _NODE_WINDOW)
-    K = min(SEGMENT, len(data) - 1)
-    long = _long_hovers(np.abs(v), np.arange(max(1, math.ceil((len(data) - 1) / K))) * K, K)
-    cut = int(long[:-1].sum())     # the nodes after them (_hover_nodes)
-    theta = sol.w[: space.n_free]
-    if not cut or not np.all(np.isfinite(theta)):
-        return sol
-    again = _solve_record(space.build(space.values(theta)), data, space, theta, n_sub, max_iter, tol, reversals,
-                          progress, 10.0, True, max(least_sub, sol.n_sub))
-    rms, noise = _misfit(again, data)
-    pieces = breaks_of(data).size > 0   # a window of pieces keeps its layout: no moves step
-    explains = again.success and (pieces or rms <= MISFIT * noise)
-    steps.append(f"samples {len(data)}: the whole chain did not converge ({sol.message[-160:]}); the {cut} nodes after "
-                 f"the segments of long hovers then started pieces of the chain, from its estimates: "
-                 + ("converged" if explains else f"converged to a misfit of {rms:.3g} m rms, more than {MISFIT:g} "
-                    f"times the record's position noise ({noise:.3g} m): a local minimum" if again.success
-                    else "did not converge either"))
-    best = again if again.success else sol
-    if explains or pieces:
-        return best
-    return _without_hovers(data, moves_of(data, long, K), space, best, n_sub, max_iter, tol, reversals, progress,
-                           steps, least_sub)
-
-
-def _misfit(sol: MotionSolution, data: Motion) -> tuple[float, float]:
-    """The rms residual [m] of ``sol`` and the position noise [m] of ``data``
-    (:func:`prefriction.identify.derivatives.derivatives`), compared through :data:`MISFIT`."""
-    return float(np.sqrt(np.mean(np.square(sol.residuals)))), filtered_derivatives(data.t, data.x).noise
-
-
-def _without_hovers(data: Motion, moves: Motion | None, space: ParameterSpace, sol: MotionSolution,
-                    n_sub: int | None, max_iter: int, tol: float, reversals: Any, progress: Any, steps: list[str],
-                    least_sub: int) -> MotionSolution:
-    """The fit of the record's ``moves`` alone (:func:`prefriction.identify.pieces.moves_of`; ``None``:
-    ``sol``), from the estimates of ``sol``: where the chain cut at the long hovers stopped, or where it
-    converged to a misfit above :data:`MISFIT` times the noise; kept if it converges within that misfit (its
-    :attr:`MotionSolution.data` the moves), else ``sol``.
-
-    In a long hover a stage with a stiff reversal branch (Dahl ``gamma > 1``: ``2^gamma sigma``)
-    swings back on it and then creeps at a fraction of ``Fc``, its velocity changing sign many
-    times below the encoder step, so each hovering segment's positions depend on its start state
-    steeply and not monotonically: with free states at its nodes (the cut chain) every such
-    segment still adds residuals with many local minima. Left out, the hovers add nothing (their
-    positions stay within the encoder step) and each move starts a piece of the chain with its own
-    free position, velocity and state. Measured on the 2.5 kg, 2 kHz, 10 nm closed-loop Dahl
-    ``gamma = 2`` stage at 2,500 samples (docs/identify_motion.md#limits)."""
-    if moves is None:
-        return sol
-    theta = sol.w[: space.n_free]
-    given = None if reversals is None else moves.to_piece_times(reversals)
-    # the constraint weight of a fresh start: the moves' nodes start from the data, not from a converged chain
-    # (measured from the whole chain's estimates at 2,500 samples: 0.01 converges in 119 evaluations, 10 does not)
-    third = _solve_record(space.build(space.values(theta)), moves, space, theta, n_sub, max_iter, tol, given,
-                          progress, 0.01, False, max(least_sub, sol.n_sub))
-    rms, noise = _misfit(third, data)
-    kept = "the cut chain's" if sol.success else "the whole chain's"
-    explains = third.success and rms <= MISFIT * noise
-    said = ("converged, FitResult.data holds the moves" if explains
-            else f"converged to a misfit of {rms:.3g} m rms, more than {MISFIT:g} times the record's position "
-                 f"noise ({noise:.3g} m): a local minimum, {kept} result kept" if third.success
-            else f"did not converge either, {kept} result kept")
-    steps.append(f"samples {len(data)}: the {len(data) - len(moves)} samples of long hovers then left out, "
-                 f"{describe_moves(moves)}, from the estimates: {said}")
-    return dataclasses.replace(third, data=moves) if explains else sol
-
-
-MISFIT = 4.0
-"""Largest rms residual of a fit of the chain cut at the long hovers or of the record's moves
-(:func:`_solve`, :func:`_without_hovers`), in units of the record's position noise
-(:func:`prefriction.identify.derivatives.derivatives`: the standard deviation of the positions
-about their low-pass), for the fit to be the result. Measured on the 2.5 kg, 2 kHz, 10 nm
-closed-loop Dahl ``gamma = 2`` stage at 2,500 samples (noise 3.2e-9 m): the fit of the moves with
-``gamma`` held at the truth ends within 0.074 % of every true value at 7.8e-9 m; a fit of the
-moves with ``gamma`` free from the second start's estimates (at a constraint weight of 10) ended
-with every parameter up to 10 % off at 2.1e-7 m, and a cut chain of the seed-2 record converged
-with ``sigma`` and ``b`` 4.4 % off at 2.2e-7 m."""
-
-
-def _event_substeps(data: Motion, space: ParameterSpace, sol: MotionSolution, max_iter: int, tol: float,
-                    reversals: Any, progress: Any, steps: list[str]) -> MotionSolution:
-    """A model with in-branch events keeps the sub-steps of its start (no doubling check,
-    :func:`_refine_substeps`); where :func:`_substeps` at the estimates asks for more (a start's
-    softer stiffness had chosen too few), the fit is solved again from the estimates with that many,
-    kept if it converges or the first did not. Notes go to ``steps``."""
-    theta = sol.w[: space.n_free]
-    if not np.all(np.isfinite(theta)):
-        return sol
-    vals = space.values(theta)
-    fitted = space.build(vals)
-    _x, v, _a = derivatives_of(data, _NODE_WINDOW)
-    need = _substeps(fitted, data, vals["mass"] if "mass" in space.free else float(data.mass), v, None)
-    if need <= sol.n_sub:
-        return sol
-    again = _solve_record(fitted, data, space, theta, None, max_iter, tol, reversals, progress, 10.0, False, need)
-    keep = again.success or not sol.success
-    steps.append(f"samples {len(data)}: {sol.n_sub} RK4 sub-steps per sample from the start values, {need} from the "
-                 f"estimates ({'converged' if sol.success else 'not converged'}); solved again from them with "
-                 f"{again.n_sub}: {'converged' if again.success else 'did not converge'}, "
-                 f"{'its result kept' if keep else 'the first result kept'}")
-    return again if keep else sol
-
-
 def start_error(model: FrictionModel, data: Motion, space: ParameterSpace, theta: np.ndarray | None = None) -> float:
     """Mean square position error [m^2] of the shooting segments at ``space``'s start values (or
     at the scaled free entries ``theta``; ``model`` holds the same values).
@@ -804,22 +414,6 @@ def start_error(model: FrictionModel, data: Motion, space: ParameterSpace, theta
     w0, prob.first_flags = _start(model, data, theta0, lay, xsm, v, a, mass, vals.get("offset", 0.0), 0.5)
     r, _g = prob.plain_eval(prob.carry_states(w0, single))
     return float(np.mean(r * r)) if np.all(np.isfinite(r)) else math.inf
-
-
-def _busiest_window(data: Motion) -> int:
-    """First sample of the :data:`WINDOW`-sample window (starts every ``WINDOW / 4`` samples) with
-    the most velocity reversals of the smoothed positions, then the most travel: the part of the
-    record that excites the friction most."""
-    _x, v, _a = derivatives(data.t, data.x)
-    flips = np.zeros(len(data))
-    flips[moving_flips(v)[1]] = 1.0
-    travel = np.abs(np.diff(data.x, prepend=data.x[0]))
-    best, key = 0, (-1.0, -1.0)
-    for k in range(0, len(data) - WINDOW + 1, WINDOW // 4):
-        cand = (float(flips[k:k + WINDOW].sum()), float(travel[k:k + WINDOW].sum()))
-        if cand > key:
-            best, key = k, cand
-    return best
 
 
 def _solve_record(model: FrictionModel, data: Motion, space: ParameterSpace, theta0: np.ndarray,
