@@ -123,6 +123,35 @@ def test_polish_lands_on_the_constrained_minimum() -> None:
     assert abs(out.w[2] - out.w[0] * out.w[1]) <= 1e-12
 
 
+def test_constraints_that_cannot_be_met_stop_the_solve_and_say_so() -> None:
+    """``min 0.5 |w - 1|^2`` subject to ``w_0^2 + 1 = 0`` (no real solution, like segments that
+    cannot close near the data): as the weight rises the violation only falls from 2 towards 1
+    while the constraint term outweighs the data, so the solve stops after three tenfold raises
+    and says so, long before its budget; a feasible twin (``w_0^2 - 0.25 = 0``) converges to its
+    closed-form minimum ``w_0 = 0.5`` (the other entries at 1)."""
+    from prefriction.identify.constrained_lsq import solve
+
+    n = 5
+
+    def problem(c: float):
+        def plain(w):
+            return w - 1.0, np.array([w[0] ** 2 + c])
+
+        def full(w):
+            A = np.zeros((1, n))
+            A[0, 0] = 2.0 * w[0]
+            return w - 1.0, sp.identity(n, format="csr"), np.array([w[0] ** 2 + c]), sp.csr_matrix(A)
+        return full, plain
+
+    full, plain = problem(1.0)
+    out = solve(full, plain, np.ones(n), np.zeros(0), np.zeros(0), max_iter=500, tol=1e-10, gtol=1e-9, weight=0.01)
+    assert not out.success and "the segments do not close" in out.message and out.iterations < 200
+    full, plain = problem(-0.25)
+    out = solve(full, plain, np.ones(n), np.zeros(0), np.zeros(0), max_iter=500, tol=1e-12, gtol=1e-10, weight=0.01)
+    assert out.success, out.message
+    np.testing.assert_allclose(out.w, [0.5] + [1.0] * (n - 1), rtol=0, atol=1e-8)
+
+
 @pytest.mark.slow
 def test_motion_fit_of_25000_samples_from_a_factor_2_start() -> None:
     """The EMPS-like stage of the success harness (LuGre, 95.1 kg, PD at 1 kHz, 50 nm encoder,
