@@ -242,10 +242,8 @@ def _apart(history: list[tuple[float, float, float, bool]]) -> str:
         return ""
     (r0, g0, *_), (r1, g1, p1, _) = history[-_APART - 1], history[-1]
     if abs(g1 - g0) < _FROZEN * g0 and abs(r1 - r0) < _FROZEN * r0 and p1 >= r1:
-        return (f"the segments do not close: over the last {_APART} multiplier updates, each raising the "
-                f"constraint weight tenfold, the constraint violation went only from {g0:.2e} to {g1:.2e} and "
-                f"0.5 |r|^2 from {0.5 * r0:.4g} to {0.5 * r1:.4g}, the constraint term outweighing the data "
-                f"(mu |g|^2 = {p1:.3g} against |r|^2 = {r1:.3g}): more weight does not move the fit")
+        return (f"defects {g0:.2e} -> {g1:.2e}, 0.5 |r|^2 {0.5 * r0:.4g} -> {0.5 * r1:.4g} over {_APART} tenfold "
+                f"weight raises (mu |g|^2 {p1:.3g} > |r|^2 {r1:.3g}): the segments do not close")
     return ""
 
 
