@@ -14,7 +14,8 @@ multipliers). Early outer iterations hold the continuity of the shooting segment
 fit first matches the data segment by segment and tightens the chain as it goes, which keeps it
 from the drifting open-loop simulations that trap a fit started far from the optimum. The trust
 region globalises each inner solve; the matrices of multiple shooting are block-sparse, so the
-cost of an iteration grows linearly with the number of samples.
+cost of an iteration grows linearly with the number of samples. A solve that three tenfold
+raises of the weight no longer move stops as frozen (:data:`_APART`).
 
 A large problem (beyond :data:`_DENSE`) solves the trust-region steps by LSMR, whose inexact steps
 on these ill-conditioned matrices stall a little above the defect tolerance. Once its defects are
