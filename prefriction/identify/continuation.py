@@ -89,8 +89,8 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
             stage, head, name = _first_window(at, data, sp_k, sp_k.theta_of(vals), n_sub, budget, tol, reversals,
                                               progress, t0, weight, steps, what)
         else:
-            stage = solve_layouts(at, head, sp_k, sp_k.theta_of(vals), n_sub, budget, tol, given, _tag(progress, name, t0),
-                           weight, steps, least)
+            stage = solve_layouts(at, head, sp_k, sp_k.theta_of(vals), n_sub, budget, tol, given,
+                                  _tag(progress, name, t0), weight, steps, least)
         if head is data and stage.success:  # the full record with the held parameters held
             held_stage = (at, data if stage.data is None else stage.data, space,
                           dict(vals, **sp_k.values(stage.w[: sp_k.n_free])), stage, name)
@@ -112,8 +112,8 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
         steps.append(f"continuation: {name} fitted ({stage.message}); the next stage started from these estimates "
                      f"({_at(sp_k, stage.w)})")
     # the sub-steps of the full record from the last stage's estimates
-    sol = solve_layouts(space.build(vals) if moved else model, data, space, space.theta_of(vals), n_sub, max_iter, tol,
-                 reversals, _tag(progress, "the record", t0), weight, steps, least)
+    sol = solve_layouts(space.build(vals) if moved else model, data, space, space.theta_of(vals), n_sub, max_iter,
+                        tol, reversals, _tag(progress, "the record", t0), weight, steps, least)
     if not sol.success and fallback is not None and (done := _settled_without(*fallback)) is not None:
         steps.append(f"the fit with every parameter free did not converge ({sol.message[-160:]}); {done[1]}")
         return dataclasses.replace(done[0], steps=tuple(steps))
@@ -164,8 +164,8 @@ def _first_window(model: FrictionModel, data: Motion, space: ParameterSpace, the
                            max(tol, PIECE_TOL)))
     kept = None
     for k, (window, given, name, short, tol_k) in enumerate(choices):
-        stage = solve_layouts(model, window, space, theta0, n_sub, max_iter, tol_k, given, _tag(progress, short, t0), weight,
-                       steps)
+        stage = solve_layouts(model, window, space, theta0, n_sub, max_iter, tol_k, given, _tag(progress, short, t0),
+                              weight, steps)
         weak = _window_weak(stage, space)
         if kept is None or (stage.success and not kept[0].success):
             kept = (stage, window, name)

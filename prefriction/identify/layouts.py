@@ -6,7 +6,6 @@ where that one did not converge (:func:`solve_layouts`)."""
 from __future__ import annotations
 
 import dataclasses
-import math
 from typing import Any
 
 import numpy as np
@@ -17,23 +16,24 @@ from prefriction.identify.hovers import long_hovers
 from prefriction.identify.motion_start import derivatives_of
 from prefriction.identify.parameters import ParameterSpace
 from prefriction.identify.pieces import breaks_of, describe_moves, moves_of
+from prefriction.identify.shooting import (_NODE_WINDOW, SEGMENT, MotionSolution, _solve_record, _substeps,
+                                           node_starts)
 from prefriction.models.base import FrictionModel
-from prefriction.identify.shooting import (_NODE_WINDOW, SEGMENT, MotionSolution, _solve_record,
-                                           _substeps)
 
 __all__ = ["MISFIT", "solve_layouts"]
 
+
 def solve_layouts(model: FrictionModel, data: Motion, space: ParameterSpace, theta0: np.ndarray, n_sub: int | None,
-           max_iter: int, tol: float, reversals: Any, progress: Any, weight: float,
-           steps: list[str], least_sub: int = 1) -> MotionSolution:
+                  max_iter: int, tol: float, reversals: Any, progress: Any, weight: float,
+                  steps: list[str], least_sub: int = 1) -> MotionSolution:
     """:func:`_solve_record` with the chain whole; if that does not converge and the record has
-    long hovers (:func:`hover_nodes`), again from its estimates with the chain cut there (the
-    continuity through a long hover is piecewise smooth on the scale of the defects; a chain kept
-    whole where it converges keeps the information the rests carry); if that does not converge
-    either, or converges to a misfit above :data:`MISFIT` times the record's noise (a local
-    minimum), the record's moves alone, the long hovers left out (:func:`_without_hovers`; an
-    ordinary record only, not a window of pieces). Notes go to ``steps``;
-    ``least_sub``: fewest automatic sub-steps (those a window's fit found necessary)."""
+    long hovers (:func:`prefriction.identify.hovers.hover_nodes`), again from its estimates with
+    the chain cut there (the continuity through a long hover is piecewise smooth on the scale of
+    the defects; a chain kept whole where it converges keeps the information the rests carry); if
+    that does not converge either, or converges to a misfit above :data:`MISFIT` times the
+    record's noise (a local minimum), the record's moves alone, the long hovers left out
+    (:func:`_without_hovers`; an ordinary record only, not a window of pieces). Notes go to
+    ``steps``; ``least_sub``: fewest automatic sub-steps (those a window's fit found necessary)."""
     sol = _solve_record(model, data, space, theta0, n_sub, max_iter, tol, reversals, progress, weight, False,
                         least_sub)
     if n_sub is None and model.n_events:
@@ -42,7 +42,7 @@ def solve_layouts(model: FrictionModel, data: Motion, space: ParameterSpace, the
         return sol
     _x, v, _a = derivatives_of(data, _NODE_WINDOW)
     K = min(SEGMENT, len(data) - 1)
-    long = long_hovers(np.abs(v), np.arange(max(1, math.ceil((len(data) - 1) / K))) * K, K)
+    long = long_hovers(np.abs(v), node_starts(len(data), K), K)
     cut = int(long[:-1].sum())     # the nodes after them (hover_nodes)
     theta = sol.w[: space.n_free]
     if not cut or not np.all(np.isfinite(theta)):

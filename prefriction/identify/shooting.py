@@ -136,14 +136,21 @@ class _Layout:
         return idx.ravel()
 
 
+def node_starts(n: int, K: int) -> np.ndarray:
+    """First sample of each shooting segment of ``K`` samples over a record of ``n`` samples (the
+    last segment padded past the record's end)."""
+    return np.arange(max(1, math.ceil((n - 1) / K))) * K
+
+
 def _layout(data: Motion, K: int, directions: np.ndarray, scl: np.ndarray, speed: np.ndarray | None = None) -> _Layout:
     """Segments of ``K`` samples; with the smoothed speed of the data, the nodes after hovering
-    segments (:func:`prefriction.identify.hovers.hover_nodes`) start pieces of the chain. The first node of every piece of a
-    :class:`prefriction.identify.pieces.Pieces` record starts a piece of the chain too, and the
-    step into it from the sample before (the junction) has a zero time step: not simulated."""
+    segments (:func:`prefriction.identify.hovers.hover_nodes`) start pieces of the chain. The
+    first node of every piece of a :class:`prefriction.identify.pieces.Pieces` record starts a
+    piece of the chain too, and the step into it from the sample before (the junction) has a zero
+    time step: not simulated."""
     n = len(data)
-    J = max(1, math.ceil((n - 1) / K))
-    nodes = np.arange(J) * K
+    nodes = node_starts(n, K)
+    J = nodes.size
     total = J * K
     dt = np.zeros(total)
     dt[: n - 1] = np.diff(data.t)
