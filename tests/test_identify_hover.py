@@ -36,7 +36,7 @@ def _true_run(stage, n: int, seed) -> tuple[Motion, np.ndarray]:
     loop = stage.loop
     rng = np.random.default_rng(seed)
     noise = loop.noise * rng.standard_normal(n)
-    r = _moves(n, rng, stage.stroke)
+    r = _moves(n, rng, stage.stroke, n)
     rhs = _rhs(loop)
     x, u, state = np.empty(n), np.empty(n), np.empty((3, n))
     y = np.array([r[0], 0.0, 0.0])

@@ -271,3 +271,25 @@ def test_a_failed_fit_with_free_gamma_says_what_helps(dahl_record):
         res = identify.fit(start, dahl_record, offset=True, mass0=m0, offset0=off0, max_iter=1)
     assert not res.success and "gamma" in res.names
     assert "fixed=['gamma']" in res.message and "max_iter" in res.message
+
+
+def test_a_record_at_a_given_pace_repeats_the_moves_at_that_pace():
+    """``pace``: the moves of a record ``pace`` samples long, continued at that pace, so a record four
+    paces long turns about four times as often as one pace (the reference's sign changes of its
+    slope, counted directly); the default scales the moves to the record; a pace below the
+    pattern's 28 samples is refused, naming it."""
+    from prefriction.identify._success import _moves
+
+    def turns(r: np.ndarray) -> int:
+        d = np.sign(np.diff(r))
+        d = d[d != 0]
+        return int(np.count_nonzero(d[1:] != d[:-1]))
+
+    one = turns(_moves(2_000, np.random.default_rng(5), 1e-3, 2_000))
+    four = turns(_moves(8_000, np.random.default_rng(5), 1e-3, 2_000))
+    stretched = turns(_moves(8_000, np.random.default_rng(5), 1e-3, 8_000))
+    assert one >= 4 and 3.5 * one <= four <= 4.5 * one + 2
+    assert abs(stretched - one) <= 1          # the same pattern, stretched (its rounding aside)
+    closed = STAGES[2]
+    with pytest.raises(ValueError, match="pace must be an integer of at least 28 samples.*got 3"):
+        stage_record(closed, 100, np.random.default_rng(0), pace=3)

@@ -167,21 +167,23 @@ GRID = _grid()
 {closed loop (PID), open loop}, 24 stages."""
 
 
-def stage_record(stage: Stage, n: int, rng: np.random.Generator) -> Motion:
+def stage_record(stage: Stage, n: int, rng: np.random.Generator, pace: int | None = None) -> Motion:
     """``n`` samples of ``stage`` (mass not given: fitted), from scipy (see the module text).
 
     Closed loop: six moves of random length up to ``stage.stroke`` [m] with alternating
-    directions, cosine velocity profiles and rests, scaled to the record; the loop a PD (a PID
-    with ``stage.pid``: ``u = Kp e + Ki sum(e) dt - Kd dx/dt``). Open loop: the force
+    directions, cosine velocity profiles and rests, scaled to ``pace`` samples (default ``n``: a
+    longer record moves more slowly) and continued at that pace to the record's end; the loop a PD
+    (a PID with ``stage.pid``: ``u = Kp e + Ki sum(e) dt - Kd dx/dt``). Open loop: the force
     ``u = A Fc (sin(w t) + 0.4 sin(2.7 w t + 1))`` with ``A = stage.stroke`` and three periods
-    of ``w`` in the record, from rest.
+    of ``w`` in ``pace`` samples, from rest.
     """
+    pace = n if pace is None else _pace(pace)
     loop = stage.loop
     dt = loop.dt
     t = np.arange(n) * dt
     noise = loop.noise * rng.standard_normal(n)
     if stage.closed:
-        r = _moves(n, rng, stage.stroke)
+        r = _moves(n, rng, stage.stroke, pace)
         rhs = _rhs(loop)
         x, u = np.empty(n), np.empty(n)
         y = np.array([r[0], 0.0, 0.0])
@@ -197,7 +199,7 @@ def stage_record(stage: Stage, n: int, rng: np.random.Generator) -> Motion:
             if k < n - 1:
                 y = _interval(rhs, y, k * dt, (k + 1) * dt, u[k], RTOL)
     else:
-        w = 2.0 * math.pi * 3.0 / (n * dt)
+        w = 2.0 * math.pi * 3.0 / (pace * dt)
         Fc = stage.friction.Fc
         u = stage.stroke * Fc * (np.sin(w * t) + 0.4 * np.sin(2.7 * w * t + 1.0))
         xt = replay(loop, t, u, 0.0, 0.0, 0.0, rtol=RTOL)
@@ -205,10 +207,18 @@ def stage_record(stage: Stage, n: int, rng: np.random.Generator) -> Motion:
     return Motion(t, x, u, None, hold="zoh")
 
 
-def _moves(n: int, rng: np.random.Generator, stroke: float) -> np.ndarray:
-    """Reference [m]: a rest, then six moves (cosine velocity profile) each followed by a rest."""
+def _pace(pace: int) -> int:
+    """``pace`` checked: samples of the six moves' pattern (:func:`stage_record`)."""
+    if not isinstance(pace, (int, np.integer)) or pace < 28:
+        raise ValueError(f"pace must be an integer of at least 28 samples (the moves' pattern), got {pace!r}")
+    return int(pace)
+
+
+def _moves(n: int, rng: np.random.Generator, stroke: float, pace: int) -> np.ndarray:
+    """Reference [m]: a rest, then moves (cosine velocity profile) each followed by a rest, six in
+    ``pace`` samples, to the record's end."""
     r = np.zeros(n)
-    unit = n // 28
+    unit = pace // 28
     k, pos, sign = 2 * unit, 0.0, 1.0
     while k < n:
         steps = max(int(rng.uniform(2.0, 3.0) * unit), 2)
@@ -296,7 +306,7 @@ def start_model(stage: Stage, rng: np.random.Generator,
 
 
 def success_table(stages: tuple = STAGES, distances: tuple = (1.25, 1.5, 2.0), *, fits: int = 10, samples: int = 1000,
-                  seed: int = 0, progress=None) -> list[SuccessRow]:
+                  seed: int = 0, progress=None, pace: int | None = None) -> list[SuccessRow]:
     """Fit every stage from ``fits`` seeded starts at each start distance; count the successes.
 
     Parameters
@@ -313,6 +323,8 @@ def success_table(stages: tuple = STAGES, distances: tuple = (1.25, 1.5, 2.0), *
         Seed of the records and the starts.
     progress : callable, optional
         Called with one line per fit.
+    pace : int, optional
+        Samples of the records' moves pattern (:func:`stage_record`); default ``samples``.
 
     Returns
     -------
@@ -323,7 +335,7 @@ def success_table(stages: tuple = STAGES, distances: tuple = (1.25, 1.5, 2.0), *
     for i, stage in enumerate(stages):
         known = STAGES + GRID
         i = next((k for k, st in enumerate(known) if st is stage), i)  # a stage's draws do not depend on
-        data = stage_record(stage, samples, np.random.default_rng([seed, i]))  # which others run with it
+        data = stage_record(stage, samples, np.random.default_rng([seed, i]), pace)  # which others run with it
         for d in distances:
             rng = np.random.default_rng([seed, i, int(round(100 * d))])
             fits_done = []
@@ -552,7 +564,7 @@ def _rate(ok: int, n: int) -> str:
 
 def main(argv: list[str] | None = None) -> None:
     """``python -m prefriction.identify._success [--grid] [--stages 0,3] [--fits N] [--samples N]
-    [--distances 1.25,1.5,2] [--seeds 0,1] [--jsonl FILE] [--report FILE] [--by model|loop|mass]``: fit,
+    [--distances 1.25,1.5,2] [--seeds 0,1] [--pace N] [--jsonl FILE] [--report FILE] [--by model|loop|mass]``: fit,
     print the tables
     (one progress line per fit on stderr); each seed gives every stage a new record and new
     starts; ``--jsonl`` appends each row as a JSON line, ``--report`` prints the tables of such a
@@ -572,6 +584,8 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--stages", default="", help="indices into the stage list (default: all)")
     ap.add_argument("--jsonl", default="", help="append the rows to this file, one JSON line each")
     ap.add_argument("--report", default="", help="print the tables of --jsonl files (comma-separated) and stop")
+    ap.add_argument("--pace", type=int, default=None,
+                    help="samples of the six moves' pattern, repeated to the record's end (default: --samples)")
     ap.add_argument("--by", default="model", choices=sorted(KEYS), help="group the pooled tables by this")
     args = ap.parse_args(argv)
     if args.report:
@@ -587,7 +601,7 @@ def main(argv: list[str] | None = None) -> None:
         rows = []
         for seed, stage in ((s, st) for s in seeds for st in stages):
             new = success_table((stage,), tuple(float(d) for d in args.distances.split(",")), fits=args.fits,
-                                samples=args.samples, seed=seed,
+                                samples=args.samples, seed=seed, pace=args.pace,
                                 progress=lambda line: print(line, file=sys.stderr, flush=True))
             rows += new
             if args.jsonl:
