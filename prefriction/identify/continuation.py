@@ -81,6 +81,7 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
     if held is not None:
         stages.append((data, held, reversals, f"the record{what}"))
     vals, least, weight, moved = dict(space.start), 1, 0.01, False
+    on_moves = False   # a stage converged on its record's moves only: the next ones fit the moves first
     fallback = None   # a short record's held stage: the solution if the free stage does not converge
     for i, (head, sp_k, given, name) in enumerate(stages):   # continuation (module notes, identify/held_first.py)
         at = sp_k.build(vals) if moved else model
@@ -90,7 +91,7 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
                                               progress, t0, weight, steps, what)
         else:
             stage = solve_layouts(at, head, sp_k, sp_k.theta_of(vals), n_sub, budget, tol, given,
-                                  _tag(progress, name, t0), weight, steps, least)
+                                  _tag(progress, name, t0), weight, steps, least, on_moves)
         if head is data and stage.success:  # the full record with the held parameters held
             held_stage = (at, data if stage.data is None else stage.data, space,
                           dict(vals, **sp_k.values(stage.w[: sp_k.n_free])), stage, name)
@@ -108,12 +109,13 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
                 vals, moved = closer, True
             continue
         least, weight, moved = stage.n_sub, 10.0, True
+        on_moves = stage.data is not None   # converged on the moves of its record
         vals = dict(vals, **sp_k.values(stage.w[: sp_k.n_free]))
         steps.append(f"continuation: {name} fitted ({stage.message}); the next stage started from these estimates "
                      f"({_at(sp_k, stage.w)})")
     # the sub-steps of the full record from the last stage's estimates
     sol = solve_layouts(space.build(vals) if moved else model, data, space, space.theta_of(vals), n_sub, max_iter,
-                        tol, reversals, _tag(progress, "the record", t0), weight, steps, least)
+                        tol, reversals, _tag(progress, "the record", t0), weight, steps, least, on_moves)
     if not sol.success and fallback is not None and (done := _settled_without(*fallback)) is not None:
         steps.append(f"the fit with every parameter free did not converge ({sol.message[-160:]}); {done[1]}")
         return dataclasses.replace(done[0], steps=tuple(steps))

@@ -1,5 +1,6 @@
-"""The long hovers of a record: where a stage rests about its set point, the shooting chain is cut
-(:func:`hover_nodes`) or the samples are left out (:func:`prefriction.identify.pieces.moves_of`)."""
+"""The hovers of a record: where a stage rests about its set point, the shooting chain is cut after
+the long ones (:func:`hover_nodes`), or the samples of every rest are left out
+(:func:`prefriction.identify.pieces.moves_of`)."""
 
 from __future__ import annotations
 
@@ -43,9 +44,10 @@ def hover_nodes(speed: np.ndarray, nodes: np.ndarray, K: int) -> np.ndarray:
     return free
 
 
-def long_hovers(speed: np.ndarray, nodes: np.ndarray, K: int) -> np.ndarray:
-    """The segments of long hovers: runs of at least :data:`HOVER_SEGMENTS` segments that each
-    hold at least :data:`HOVER_RUN` consecutive slow samples (:data:`HOVER`)."""
+def long_hovers(speed: np.ndarray, nodes: np.ndarray, K: int, least: int = HOVER_SEGMENTS) -> np.ndarray:
+    """The segments of long hovers: runs of at least ``least`` (:data:`HOVER_SEGMENTS`) segments
+    that each hold at least :data:`HOVER_RUN` consecutive slow samples (:data:`HOVER`); ``least = 1``:
+    every hovering segment, the rests between moves too."""
     top = float(np.max(speed, initial=0.0))
     if not top > 0.0:
         return np.zeros(nodes.size, dtype=bool)
@@ -62,6 +64,6 @@ def long_hovers(speed: np.ndarray, nodes: np.ndarray, K: int) -> np.ndarray:
     run = np.r_[0, hover.astype(int), 0]
     edges = np.flatnonzero(np.diff(run))
     for a, b in zip(edges[::2], edges[1::2]):                  # segments a..b-1 hover
-        if b - a >= HOVER_SEGMENTS:
+        if b - a >= least:
             long[a:b] = True
     return long

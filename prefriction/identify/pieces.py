@@ -207,8 +207,8 @@ def concatenate(data: Motion, spans: list[tuple[int, int]]) -> Pieces:
 
 
 def moves_of(data: Motion, left_out: np.ndarray, K: int) -> Pieces | None:
-    """``data`` without the shooting segments of ``K`` samples flagged in ``left_out`` (the long
-    hovers of :func:`prefriction.identify.hovers.long_hovers`): the moves between them, one
+    """``data`` without the shooting segments of ``K`` samples flagged in ``left_out`` (the rests of
+    :func:`prefriction.identify.hovers.long_hovers` with ``least=1``): the moves between them, one
     piece each; ``None`` when no segment is left out or every one is."""
     keep = ~np.asarray(left_out, dtype=bool)
     if keep.all() or not keep.any():

@@ -96,7 +96,7 @@ class MotionSolution:
     first flags): ``w``'s nodes are in its scales."""
     data: Motion | None = dataclasses.field(default=None, repr=False, compare=False)
     """The record the residuals and prediction are of when it is not the one given: its moves,
-    the long hovers left out (:func:`prefriction.identify.layouts.solve_layouts`)."""
+    every rest left out (:func:`prefriction.identify.layouts.solve_layouts`)."""
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,77 @@
+"""A Motion fit of a record's moves leaves every rest out (issue 25): a short rest kept inside a
+move's piece of the chain traps the fit of a closed-loop Dahl ``gamma = 2`` stage in a misfit above
+the measurement error, with intervals that miss the truth.
+
+References independent of the fitter: the record and the true motion come from scipy LSODA
+integrations of the equations (prefriction.identify._success.stage_record's loop, re-run with its
+true state kept), and the measurement error is the rms of the recorded positions about the true
+ones.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+from prefriction import identify
+from prefriction.identify import hovers
+from prefriction.identify._success import STAGES, _moves, stage_record
+from prefriction.identify.data import Motion
+from prefriction.identify.motion_start import derivatives
+from prefriction.identify.pieces import moves_of
+from prefriction.identify.shooting import SEGMENT, node_starts
+from prefriction.identify.synthetic_loop import _interval, _rhs
+
+DAHL = STAGES[2]      # Dahl gamma 2 + viscous + offset, 2.5 kg, 2 kHz, 10 nm encoder, closed loop
+
+
+def _true_positions(n: int, seed) -> tuple[Motion, np.ndarray]:
+    """The harness's record and the true positions [m] of the stage, from one scipy integration."""
+    loop = DAHL.loop
+    rng = np.random.default_rng(seed)
+    noise = loop.noise * rng.standard_normal(n)
+    r = _moves(n, rng, DAHL.stroke, n)
+    rhs = _rhs(loop)
+    x, u, true = np.empty(n), np.empty(n), np.empty(n)
+    y = np.array([r[0], 0.0, 0.0])
+    prev = np.round(r[0] / loop.quantum) * loop.quantum
+    for k in range(n):
+        true[k] = y[0]
+        x[k] = np.round((y[0] + noise[k]) / loop.quantum) * loop.quantum
+        u[k] = loop.Kp * (r[k] - x[k]) - loop.Kd * (x[k] - prev) / loop.dt
+        prev = x[k]
+        if k < n - 1:
+            y = _interval(rhs, y, k * loop.dt, (k + 1) * loop.dt, u[k], 1e-12)
+    return Motion(np.arange(n) * loop.dt, x, u, None, hold="zoh"), true
+
+
+@pytest.mark.slow   # a scipy record of 2,500 samples and a fit of 400 of them: about 40 s
+def test_the_moves_without_a_short_rest_fit_to_the_measurement_error():
+    """Samples 200 to 699 of the seed-0 record at 2,500 samples: a move, a rest of about 60 samples
+    (too short for a long hover) and the next move. Every rest left out (``least=1``), the fit of
+    the two moves from the truth ends at the measurement error and every 95 % interval holds the
+    truth; the rest is a long hover for nobody, so ``long_hovers`` keeps it."""
+    data, true = _true_positions(2500, [0, 2])
+    assert np.array_equal(data.x, stage_record(DAHL, 2500, np.random.default_rng([0, 2])).x)  # the harness's record
+    part = slice(200, 700)
+    record = Motion(data.t[part], data.x[part], data.u[part], None, hold="zoh")
+    error = float(np.sqrt(np.mean(np.square(record.x - true[part]))))     # noise and rounding, about 4.5e-9 m
+    _x, v, _a = derivatives(record.t, record.x)
+    nodes = node_starts(len(record), SEGMENT)
+    assert not hovers.long_hovers(np.abs(v), nodes, SEGMENT).any()
+    rests = hovers.long_hovers(np.abs(v), nodes, SEGMENT, least=1)
+    assert 1 <= rests.sum() <= 3
+    moves = moves_of(record, rests, SEGMENT)
+    assert len(moves.source) == 2
+    truth = DAHL.truth()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = identify.fit(DAHL.model(), moves, offset=True, offset0=truth["offset"], mass0=truth["mass"])
+    assert res.success
+    rms = float(np.sqrt(np.mean(np.square(res.residuals))))
+    assert rms <= 1.1 * error
+    for name, value in truth.items():
+        lo, hi = res.interval(name)
+        assert lo <= value <= hi, (name, lo, value, hi)
