@@ -18,37 +18,15 @@ import pytest
 
 from prefriction import identify
 from prefriction.identify import hovers, shooting
-from prefriction.identify._success import STAGES, _moves, stage_record, start_model
-from prefriction.identify.data import Motion
+from prefriction.identify._success import STAGES, stage_record, start_model
 from prefriction.identify.motion_start import derivatives
 from prefriction.identify.motion_step import segment_functions
 from prefriction.identify.parameters import ParameterSpace, _entries
-from prefriction.identify.synthetic_loop import _interval, _rhs
+
+from _true_loop import true_run as _true_run
 
 USER = STAGES[1]      # LuGre, 2.5 kg, 2e6 N/m, 3 N, 5 kHz, 10 nm encoder, closed loop
 EMPS_LIKE = STAGES[3]
-
-
-def _true_run(stage, n: int, seed) -> tuple[Motion, np.ndarray]:
-    """The record of ``stage_record`` (closed loop) and the true state of the stage at each sample
-    (rows: position [m], velocity [m/s], LuGre's bristle deflection [m]), from the same scipy
-    integration (LSODA per sample, restarted at reversals)."""
-    loop = stage.loop
-    rng = np.random.default_rng(seed)
-    noise = loop.noise * rng.standard_normal(n)
-    r = _moves(n, rng, stage.stroke, n)
-    rhs = _rhs(loop)
-    x, u, state = np.empty(n), np.empty(n), np.empty((3, n))
-    y = np.array([r[0], 0.0, 0.0])
-    prev = np.round(r[0] / loop.quantum) * loop.quantum
-    for k in range(n):
-        state[:, k] = y
-        x[k] = np.round((y[0] + noise[k]) / loop.quantum) * loop.quantum
-        u[k] = loop.Kp * (r[k] - x[k]) - loop.Kd * (x[k] - prev) / loop.dt
-        prev = x[k]
-        if k < n - 1:
-            y = _interval(rhs, y, k * loop.dt, (k + 1) * loop.dt, u[k], 1e-10)
-    return Motion(np.arange(n) * loop.dt, x, u, None, hold="zoh"), state
 
 
 @pytest.mark.slow   # a scipy record of 2,000 samples: 10 to 20 s on a loaded machine

@@ -17,34 +17,15 @@ import pytest
 
 from prefriction import identify
 from prefriction.identify import hovers
-from prefriction.identify._success import STAGES, _moves, stage_record
+from prefriction.identify._success import STAGES, stage_record
 from prefriction.identify.data import Motion
 from prefriction.identify.motion_start import derivatives
 from prefriction.identify.pieces import moves_of
 from prefriction.identify.shooting import SEGMENT, node_starts
-from prefriction.identify.synthetic_loop import _interval, _rhs
+
+from _true_loop import true_run
 
 DAHL = STAGES[2]      # Dahl gamma 2 + viscous + offset, 2.5 kg, 2 kHz, 10 nm encoder, closed loop
-
-
-def _true_positions(n: int, seed) -> tuple[Motion, np.ndarray]:
-    """The harness's record and the true positions [m] of the stage, from one scipy integration."""
-    loop = DAHL.loop
-    rng = np.random.default_rng(seed)
-    noise = loop.noise * rng.standard_normal(n)
-    r = _moves(n, rng, DAHL.stroke, n)
-    rhs = _rhs(loop)
-    x, u, true = np.empty(n), np.empty(n), np.empty(n)
-    y = np.array([r[0], 0.0, 0.0])
-    prev = np.round(r[0] / loop.quantum) * loop.quantum
-    for k in range(n):
-        true[k] = y[0]
-        x[k] = np.round((y[0] + noise[k]) / loop.quantum) * loop.quantum
-        u[k] = loop.Kp * (r[k] - x[k]) - loop.Kd * (x[k] - prev) / loop.dt
-        prev = x[k]
-        if k < n - 1:
-            y = _interval(rhs, y, k * loop.dt, (k + 1) * loop.dt, u[k], 1e-12)
-    return Motion(np.arange(n) * loop.dt, x, u, None, hold="zoh"), true
 
 
 @pytest.mark.slow   # a scipy record of 2,500 samples and a fit of 400 of them: about 40 s
@@ -53,7 +34,8 @@ def test_the_moves_without_a_short_rest_fit_to_the_measurement_error():
     (too short for a long hover) and the next move. Every rest left out (``least=1``), the fit of
     the two moves from the truth ends at the measurement error and every 95 % interval holds the
     truth; the rest is a long hover for nobody, so ``long_hovers`` keeps it."""
-    data, true = _true_positions(2500, [0, 2])
+    data, state = true_run(DAHL, 2500, [0, 2], rtol=1e-12)
+    true = state[0]
     assert np.array_equal(data.x, stage_record(DAHL, 2500, np.random.default_rng([0, 2])).x)  # the harness's record
     part = slice(200, 700)
     record = Motion(data.t[part], data.x[part], data.u[part], None, hold="zoh")
