@@ -208,7 +208,10 @@ def test_moves_fit_is_the_result_only_where_its_misfit_is_of_the_noise(monkeypat
     its rms residual is within ``MISFIT`` times the record's position noise (the noise
     estimate of ``identify.derivatives``, here of Gaussian noise of 3 nm on smooth moves): a
     solver stand-in returning residuals of 1 nm rms is kept, with the moves as its data; one
-    returning 100 nm rms (a local minimum) is not, and the note says why."""
+    returning 100 nm rms (a local minimum) is not, and the note says why (the next stage of a
+    continuation still fits the moves first: ``moves_converged``)."""
+    import dataclasses
+
     from prefriction.identify import hovers, layouts, shooting
     from prefriction.identify.pieces import Pieces, moves_of
 
@@ -239,7 +242,8 @@ def test_moves_fit_is_the_result_only_where_its_misfit_is_of_the_noise(monkeypat
     assert isinstance(kept.data, Pieces) and kept.success and "FitResult.data holds the moves" in steps[0]
     assert kept.data.source == (0, 700) and kept.data.breaks == (500,)   # the 200-sample rest left out, not the short ones
     dropped, steps = run(1e-7)
-    assert dropped is whole and "local minimum" in steps[0] and "whole chain's result kept" in steps[0]
+    assert dropped == dataclasses.replace(whole, moves_converged=True)   # the chain's, the moves' convergence noted
+    assert "local minimum" in steps[0] and "whole chain's result kept" in steps[0]
 
 
 def test_a_cut_chain_far_above_the_noise_gives_way_to_the_moves(monkeypatch):

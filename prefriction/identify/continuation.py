@@ -81,7 +81,7 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
     if held is not None:
         stages.append((data, held, reversals, f"the record{what}"))
     vals, least, weight, moved = dict(space.start), 1, 0.01, False
-    on_moves = False   # a stage converged on its record's moves only: the next ones fit the moves first
+    on_moves = False   # a stage's moves converged: the next one fits the moves first
     fallback = None   # a short record's held stage: the solution if the free stage does not converge
     for i, (head, sp_k, given, name) in enumerate(stages):   # continuation (module notes, identify/held_first.py)
         at = sp_k.build(vals) if moved else model
@@ -100,6 +100,7 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
                 steps.append(done[1])
                 return dataclasses.replace(done[0], steps=tuple(steps))
             fallback = None if long else held_stage
+        on_moves = stage.moves_converged   # the next stage fits the moves first (solve_layouts)
         if not stage.success:
             closer = closer_estimates(data, space, vals, dict(vals, **sp_k.values(stage.w[: sp_k.n_free])))
             steps.append(f"continuation: the fit of {name} did not converge ({stage.message}); the next stage "
@@ -109,7 +110,6 @@ def fit_motion(model: FrictionModel, data: Motion, space: ParameterSpace, *, n_s
                 vals, moved = closer, True
             continue
         least, weight, moved = stage.n_sub, 10.0, True
-        on_moves = stage.data is not None   # converged on the moves of its record
         vals = dict(vals, **sp_k.values(stage.w[: sp_k.n_free]))
         steps.append(f"continuation: {name} fitted ({stage.message}); the next stage started from these estimates "
                      f"({_at(sp_k, stage.w)})")

@@ -35,9 +35,10 @@ def solve_layouts(model: FrictionModel, data: Motion, space: ParameterSpace, the
     (:func:`_without_hovers`; an ordinary record only, not a window of pieces). Notes go to
     ``steps``; ``least_sub``: fewest automatic sub-steps (those a window's fit found necessary).
     ``moves_first``: the stage before (a window, or the record with parameters held) converged on
-    its moves only, so the moves are fitted first, from ``theta0``, and the chains only if that
-    fit does not explain the record (a chain through rests that did not close for the stage before
-    costs most of a fit's time and closes rarely from its estimates)."""
+    its moves (:attr:`MotionSolution.moves_converged`), so the moves are fitted first, from
+    ``theta0``, and the chains only if that fit does not explain the record (a chain through rests
+    that did not close for the stage before costs most of a fit's time and closes rarely from its
+    estimates)."""
     pieces = breaks_of(data).size > 0   # a window of pieces keeps its layout: no moves step
     _x, v, _a = derivatives_of(data, _NODE_WINDOW)
     K = min(SEGMENT, len(data) - 1)
@@ -46,11 +47,11 @@ def solve_layouts(model: FrictionModel, data: Motion, space: ParameterSpace, the
     if moves_first and not pieces and (moves := moves_of(data, rests, K)) is not None:
         first = _moves_fit(data, moves, space, theta0, n_sub, max_iter, tol, reversals, progress, least_sub)
         if first[1]:
-            steps.append(f"samples {len(data)}: the stage before converged on its moves only; the "
+            steps.append(f"samples {len(data)}: the stage before converged on its moves; the "
                          f"{len(data) - len(moves)} samples of rests left out, {describe_moves(moves)}, "
                          f"from its estimates: {first[2]}")
             return first[0]
-        steps.append(f"samples {len(data)}: the stage before converged on its moves only; this record's moves from "
+        steps.append(f"samples {len(data)}: the stage before converged on its moves; this record's moves from "
                      f"its estimates {first[2]}: the chains then")
     sol = _solve_record(model, data, space, theta0, n_sub, max_iter, tol, reversals, progress, weight, False,
                         least_sub)
@@ -112,7 +113,7 @@ def _without_hovers(data: Motion, moves: Motion | None, space: ParameterSpace, s
     steps.append(f"samples {len(data)}: the {len(data) - len(moves)} samples of rests then left out, "
                  f"{describe_moves(moves)}, from the estimates: {said}"
                  + ("" if explains else f", {kept} result kept"))
-    return third if explains else sol
+    return third if explains else dataclasses.replace(sol, moves_converged=third.success)
 
 
 def _moves_fit(data: Motion, moves: Motion, space: ParameterSpace, theta: np.ndarray, n_sub: int | None,
@@ -131,7 +132,7 @@ def _moves_fit(data: Motion, moves: Motion, space: ParameterSpace, theta: np.nda
     said = ("converged, FitResult.data holds the moves" if explains
             else f"converged to a misfit of {rms:.3g} m rms, more than {MISFIT:g} times the record's position "
                  f"noise ({noise:.3g} m): a local minimum" if sol.success else "did not converge")
-    return (dataclasses.replace(sol, data=moves) if explains else sol), explains, said
+    return (dataclasses.replace(sol, data=moves, moves_converged=True) if explains else sol), explains, said
 
 
 MISFIT = 4.0

@@ -97,6 +97,10 @@ class MotionSolution:
     data: Motion | None = dataclasses.field(default=None, repr=False, compare=False)
     """The record the residuals and prediction are of when it is not the one given: its moves,
     every rest left out (:func:`prefriction.identify.layouts.solve_layouts`)."""
+    moves_converged: bool = False
+    """The fit of the record's moves converged, whether or not it became the solution (a misfit
+    above :data:`prefriction.identify.layouts.MISFIT` keeps the chain's): the next stage of a
+    continuation fits the moves first."""
 
 
 @dataclass(frozen=True)
