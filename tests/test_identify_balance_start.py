@@ -58,3 +58,45 @@ def test_a_stage_that_stopped_hands_on_its_estimates_only_where_they_follow_the_
     assert closer_estimates(record, space, off, exact) == exact
     assert closer_estimates(record, space, exact, off) is None
     assert closer_estimates(record, space, exact, dict(off, Fc=float("nan"))) is None
+
+
+@pytest.mark.parametrize("held_iter", [100, None])
+def test_a_long_record_held_from_the_balance_fits_its_window_again_free(monkeypatch, held_iter) -> None:
+    """``continuation.fit_motion`` on a record longer than two windows with a held stage: with the
+    budget of a start from the force balance (``held_iter``) the stages are the first window with
+    ``gamma`` held, the same window with every parameter free, then the record once; without it
+    (``held_first``'s holds), the window, the record held, then the record free. The solver is a
+    stand-in that converges at once (this tests the order of the stages, not the fit)."""
+    from prefriction.identify import continuation, shooting
+
+    n = 2 * continuation.WINDOW + 500
+    t = np.arange(n) * 1e-3
+    data = Motion(t, 1e-6 * np.sin(7.0 * t), np.zeros(n), None, "zoh")
+    truth = STAGE.model()
+    space = ParameterSpace(truth, None, None, None, mass=STAGE.mass, offset=3.0, offset0=STAGE.offset)
+    held = ParameterSpace(truth, None, ["gamma"], None, mass=STAGE.mass, offset=3.0, offset0=STAGE.offset)
+    window = Motion(t[:50], data.x[:50], data.u[:50], None, "zoh")
+    calls = []
+
+    def solved(sp: ParameterSpace, theta: np.ndarray) -> shooting.MotionSolution:
+        w = np.r_[theta, np.zeros(3)]
+        return shooting.MotionSolution(w, np.zeros(50), np.zeros((50, w.size)), None, np.zeros(50), {}, "converged")
+
+    def first_window(model, record, sp, theta, *args):
+        calls.append(("first window", record is data, tuple(sp.free)))
+        return solved(sp, theta), window, "the window"
+
+    def layouts(model, record, sp, theta, *args):
+        calls.append(("window" if record is window else "record" if record is data else "?", True, tuple(sp.free)))
+        return solved(sp, theta)
+
+    monkeypatch.setattr(continuation, "_first_window", first_window)
+    monkeypatch.setattr(continuation, "solve_layouts", layouts)
+    monkeypatch.setattr(continuation, "_settled_without", lambda *args: None)
+    continuation.fit_motion(truth, data, space, n_sub=4, max_iter=10, tol=1e-8, held=held, held_iter=held_iter)
+    free, kept = tuple(space.free), tuple(held.free)
+    assert "gamma" in free and "gamma" not in kept
+    if held_iter is not None:
+        assert calls == [("first window", True, kept), ("window", True, free), ("record", True, free)]
+    else:
+        assert calls == [("first window", True, kept), ("record", True, kept), ("record", True, free)]
