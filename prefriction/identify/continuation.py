@@ -46,9 +46,10 @@ _WINDOW = object()
 """Stands for the first window in the list of stages (known once it is fitted): with a held
 start of the force balance (:mod:`prefriction.identify.balance_start`) a long record's window is
 fitted again with every parameter free, and the record once, from those estimates. The record
-with the parameters held (the short records' second stage) cost most of a long fit: on the
-25,000-sample closed-loop ``gamma = 2`` record (moves at the 2,500-sample pace), 240 and 330 s of
-the 515 and 442 s of CPU of seeds 0 and 1, its moves kept from a ``gamma`` held off the truth."""
+with the parameters held (the short records' second stage) cost about half of a long fit: on the
+25,000-sample closed-loop ``gamma = 2`` record (moves at the 2,500-sample pace, seeds 0 and 1)
+the fits took 515 and 442 s of CPU with it and 302 and 196 s without, to the same largest errors
+and intervals (docs/identify_motion.md#limits)."""
 
 
 @with_one_blas_thread
