@@ -54,6 +54,20 @@ def _rk4(f: Any, y: list[Any], tau: Any, h: Any) -> list[Any]:
     return [a + h / 6.0 * (b1 + 2.0 * b2 + 2.0 * b3 + b4) for a, b1, b2, b3, b4 in zip(y, k1, k2, k3, k4)]
 
 
+def _sub_samples(U0: ca.MX, U1: ca.MX, DT: ca.MX, fold: int) -> tuple[ca.MX, ca.MX, ca.MX]:
+    """The rows ``U0``, ``U1``, ``DT`` (``1 x K``: force [N] at the start and end of each sample,
+    its interval [s]) split into ``fold`` equal sub-samples each (``1 x K fold``, the applied force
+    interpolated linearly as in :func:`step_function`)."""
+    if fold == 1:
+        return U0, U1, DT
+    K = U0.size2()
+    a = ca.DM([k / fold for k in range(fold)])
+    D = U1 - U0
+    rows = [ca.repmat(U0, fold, 1) + ca.mtimes(a, D), ca.repmat(U0, fold, 1) + ca.mtimes(a + 1.0 / fold, D),
+            ca.repmat(DT / fold, fold, 1)]
+    return tuple(ca.reshape(r, 1, K * fold) for r in rows)   # type: ignore[return-value]
+
+
 def step_function(model: FrictionModel, n_sub: int) -> ca.Function:
     """``(y, u0, u1, dt, pp) -> y+``: one sample of the forced oscillator (SX ``Function``).
 
@@ -204,11 +218,12 @@ def segment_functions(model: FrictionModel, space: ParameterSpace, K: int, n_sub
     (``ncol x (K + 1)``: ``dx/dw`` of each position) and ``dYe`` (``ny x ncol``), ``w`` the
     segment's ``[theta, node]``.
 
-    ``native``: the one-sample steps are compiled to C (:func:`prefriction.simulation.compiled`,
-    cached on disk per structure; the interpreted steps if no compiler is found). A model with
-    in-branch events locates them in every sub-step, so its step has tens of thousands of
-    operations (Maxwell-slip(3): 42,000 with sensitivities): compiled, a sample costs about a
-    seventh of the interpreted one; compiling it takes 10 to 30 s once.
+    ``native``: one Runge-Kutta sub-step (with and without its sensitivities) is compiled to C
+    (:func:`prefriction.simulation.compiled`, cached on disk per structure and free set, whatever
+    ``n_sub``; the interpreted steps if no compiler is found) and repeated ``n_sub`` times per
+    sample over the sample split into equal sub-samples: the same arithmetic as the interpreted
+    step of ``n_sub`` sub-steps, the sensitivities carried sub-step by sub-step
+    (``S <- (dy+/dy) S + (dy+/dp) (dp/dw)``, the chain rule of the interpreted step's Jacobian).
     """
     key = (type(model), model.structure_key(), tuple(space.free), tuple(space.fixed), K, n_sub, mass_free, native)
     if key in _CACHE:
@@ -216,7 +231,8 @@ def segment_functions(model: FrictionModel, space: ParameterSpace, K: int, n_sub
     nz, nf, nq = model.n_states, model.n_flags, len(model.runtime_params())
     ny, nth = 2 + nz, space.n_free
     ncol = nth + ny
-    step = step_function(model, n_sub)
+    fold = n_sub if native else 1   # compiled: one sub-step, repeated (one library per structure, any n_sub)
+    step = step_function(model, 1 if native else n_sub)
     units = _units_function(model, space, mass_free)
 
     # one sample with sensitivities: carry c = [y (ny + nf + 1); vec(S) (ny * ncol)]
@@ -238,8 +254,9 @@ def segment_functions(model: FrictionModel, space: ParameterSpace, K: int, n_sub
 
         sens_step = compiled(sens_step, "Motion fit step with sensitivities")[0]
         plain_step = compiled(plain_step, "Motion fit step")[0]
-    sens_acc = sens_step.mapaccum("sens_segment", K)
-    plain_acc = plain_step.mapaccum("plain_segment", K)
+    sens_acc = sens_step.mapaccum("sens_segment", K * fold)
+    plain_acc = plain_step.mapaccum("plain_segment", K * fold)
+    last = ca.Slice(fold - 1, K * fold, fold)   # the sub-steps that end a sample
 
     # the end state in the coordinates of the next node's direction, scaled
     ye = ca.SX.sym("ye", ny + nf + 1)
@@ -271,18 +288,21 @@ def segment_functions(model: FrictionModel, space: ParameterSpace, K: int, n_sub
     inputs = [node, m0, s0, s_next, th, scale, fx, mass, U0, U1, DT, sc]
     names = ["node", "m0", "s0", "s_to", "theta", "scale", "fixed", "mass", "U0", "U1", "DT", "scl"]
 
-    C, O = plain_acc(y0, U0, U1, DT, ca.repmat(p_mx, 1, K))
-    X = ca.horzcat(y0[:2], O)
-    Ye, Me = end(C[:, K - 1], s_next, p_mx, sc)
+    U0f, U1f, DTf = _sub_samples(U0, U1, DT, fold)
+    C, O = plain_acc(y0, U0f, U1f, DTf, ca.repmat(p_mx, 1, K * fold))
+    X = ca.horzcat(y0[:2], O[:, last])
+    Ye, Me = end(C[:, K * fold - 1], s_next, p_mx, sc)
     plain = ca.Function("segment", inputs, [X, Ye, Me], names, ["X", "Ye", "Me"])
 
     w = ca.vertcat(th, node)
     dp_mx = ca.horzcat(ca.jacobian(p_mx, th), ca.MX.zeros(4 + nq, ny))
     S0 = ca.jacobian(y0[:ny], w)
-    C, O = sens_acc(ca.vertcat(y0, ca.vec(S0)), U0, U1, DT, ca.repmat(p_mx, 1, K), ca.repmat(dp_mx, 1, K))
+    C, O = sens_acc(ca.vertcat(y0, ca.vec(S0)), U0f, U1f, DTf, ca.repmat(p_mx, 1, K * fold),
+                    ca.repmat(dp_mx, 1, K * fold))
+    O = O[:, last]
     X = ca.horzcat(y0[:2], O[:2, :])
     dX = ca.horzcat(S0[0, :].T, O[2:, :])
-    cK = C[:, K - 1]
+    cK = C[:, K * fold - 1]
     Ye, Me, dYe = end_sens(cK[: ny + nf + 1], ca.reshape(cK[ny + nf + 1:], ny, ncol), s_next, p_mx, dp_mx, sc)
     sens = ca.Function("segment_sens", inputs, [X, Ye, Me, dX, dYe], names, ["X", "Ye", "Me", "dX", "dYe"])
     _CACHE[key] = (plain, sens)

@@ -54,8 +54,11 @@ GTOL = 1e-5
 """Largest continuity defect of a converged fit, in the node scales (``1e-5`` of the pre-sliding
 distance ``Fc / sigma`` in position, of the velocity unit, of the normalised state)."""
 NATIVE_FROM = 1_000
-"""Records of a model with in-branch events of at least this many samples run the compiled steps
-(compiling once per structure takes 10 to 30 s and makes every evaluation about 7 times faster)."""
+"""Records of at least this many samples run the compiled sub-steps (:func:`segment_functions`).
+Compiling once per structure and free set takes about 1 s for Dahl and LuGre and 9 s for
+Maxwell-slip(3) (gcc ``-O1``, cached on disk); an evaluation of segments with sensitivities then
+costs a fourth (Dahl, LuGre) to a twelfth (Maxwell-slip(3)) of the interpreted one
+(``tests/test_identify_native_steps.py``)."""
 INNER_TOL_EVENTS = 1e-5
 """``ftol`` of the inner solves before the last of a model with in-branch events
 (:func:`prefriction.identify.constrained_lsq.solve`): its motion is only piecewise smooth in the
@@ -177,9 +180,9 @@ def _layout(data: Motion, K: int, directions: np.ndarray, scl: np.ndarray, speed
     return _Layout(K, nodes, u0, u1, dt, s, scl, n, free, s_to, int(breaks.size))
 
 
-def native_steps(model: FrictionModel, n: int) -> bool:
+def native_steps(n: int) -> bool:
     """Whether a fit of ``n`` samples runs the compiled steps (:func:`segment_functions`)."""
-    return model.n_events > 0 and n >= NATIVE_FROM
+    return n >= NATIVE_FROM
 
 
 def _mapped(model: FrictionModel, space: ParameterSpace, K: int, n_sub: int, mass_free: bool,
@@ -204,7 +207,7 @@ class _Problem:
     def __init__(self, model: FrictionModel, space: ParameterSpace, data: Motion, lay: _Layout, n_sub: int,
                  mass_free: bool, mass: float, xs: float, native: bool | None = None) -> None:
         self.lay, self.nth, self.ny = lay, space.n_free, 2 + model.n_states
-        self.native = native_steps(model, len(data)) if native is None else native
+        self.native = native_steps(len(data)) if native is None else native
         self.plain, self.sens = _mapped(model, space, lay.K, n_sub, mass_free, lay.J, self.native)
         self.fixed, self.mass, self.xs = space.fixed_values(), mass, xs
         self.samples = lay.samples()
@@ -441,8 +444,6 @@ def _solve_record(model: FrictionModel, data: Motion, space: ParameterSpace, the
     directions = _directions(data.t, data.x, v, reversals)
     requested = n_sub
     n_sub = max(_substeps(model, data, mass, v, n_sub), 1 if requested else least_sub)
-    if requested is None and native_steps(model, len(data)):  # compiled per count: powers of 2 only
-        n_sub = min(64, 2 ** math.ceil(math.log2(n_sub)))
     X, V = model.Fc / model.sigma, model.Fc / math.sqrt(mass * model.sigma)
     offset0 = space.values(theta0).get("offset", 0.0)
     lay = _layout(data, min(SEGMENT, len(data) - 1), directions, np.array([X, V]),
@@ -522,8 +523,8 @@ def _refine_substeps(prob: _Problem, single: ca.Function, out: Any, w: np.ndarra
     at most 64; each refinement solves the fit again from ``w`` (``resolve``), polishes it and is checked again.
     Not for models with in-branch events: their residual moves in kinks as an event crosses from one
     sub-step to the next, which the comparison of two sub-step counts can take for a bias (checked,
-    the Maxwell-slip(3) fit of ``tests/test_identify_motion_events.py`` took 107 s instead of 1.5 s). The doubled steps of the measurement are interpreted (a model with in-branch events
-    compiles them only if the fit is solved again).
+    the Maxwell-slip(3) fit of ``tests/test_identify_motion_events.py`` took 107 s instead of 1.5 s). The doubled steps of
+    the measurement run as the fit's own (compiled or interpreted: :func:`native_steps`).
 
     Returns
     -------
@@ -541,9 +542,9 @@ def _refine_substeps(prob: _Problem, single: ca.Function, out: Any, w: np.ndarra
         wc = prob.carry_states(w, single, everything=True)
         r, _g = prob.plain_eval(wc)
         J = prob.reduced_jacobian(wc)
-        fine = _Problem(model, space, data, lay, 2 * n_sub, mass_free, mass, xs, False)
+        fine = _Problem(model, space, data, lay, 2 * n_sub, mass_free, mass, xs, prob.native)
         fine.first_flags = list(prob.first_flags)
-        fine_single = segment_functions(model, space, lay.K, 2 * n_sub, mass_free, False)[0]
+        fine_single = segment_functions(model, space, lay.K, 2 * n_sub, mass_free, prob.native)[0]
         rf, _gf = fine.plain_eval(fine.carry_states(w, fine_single, everything=True))
         prob.args["m0"][...] = saved
         with np.errstate(invalid="ignore"):
