@@ -24,6 +24,8 @@ MODELS = {
     "dahl_gamma_0.6": (pf.Dahl(1e5, 1.0, 0.6), None),
     "maxwell_slip": (pf.MaxwellSlip([6e4, 3e4, 1e4], [0.3, 0.4, 0.3]), None),
 }
+NAMES = ["dahl_gamma_2", "dahl_gamma_0.6",
+         pytest.param("maxwell_slip", marks=pytest.mark.slow)]   # its compilation takes about 10 s
 
 
 def _drive(model: pf.FrictionModel, n: int, step: float = 0.1) -> tuple[np.ndarray, np.ndarray]:
@@ -48,7 +50,7 @@ def _native_segment(name: str, K: int, n_sub: int, s0: float):
     return model, space, plain, sens, t, u, z0, args
 
 
-@pytest.mark.parametrize("name", list(MODELS))
+@pytest.mark.parametrize("name", NAMES)
 def test_native_positions_match_the_scipy_integration(name):
     """Positions of a compiled 80-sample segment from rest (16 sub-steps per sample) against the
     scipy integration of the same held force with every reversal and event located (DOP853 at
@@ -63,7 +65,7 @@ def test_native_positions_match_the_scipy_integration(name):
     assert np.max(np.abs(x - ref)) <= 1e-9 * travel, (name, np.max(np.abs(x - ref)) / travel)
 
 
-@pytest.mark.parametrize("name", list(MODELS))
+@pytest.mark.parametrize("name", NAMES)
 def test_native_sensitivities_match_finite_differences(name):
     """dX/dw and dYe/dw of a compiled segment that moves through reversals (and events): the
     sub-step-by-sub-step chain rule against central differences of the compiled segment itself."""
