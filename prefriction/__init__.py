@@ -50,7 +50,7 @@ if TYPE_CHECKING:  # the names below, imported on first use (module __getattr__)
     from prefriction.sensitivity import sensitivities
     from prefriction.analysis.exact import exact_reversals
 
-__version__ = "0.8.7"
+__version__ = "0.8.8"
 del annotations, TYPE_CHECKING  # bound by the imports above; not part of the API
 
 # where each public name lives: _WHERE, the module it is an attribute of; _MODULES, the public
