@@ -22,7 +22,8 @@ a differentiable function of the state and the parameters, so the sensitivities 
 
 Forward sensitivities ride along: the carried matrix ``S = dy/dw`` of a segment is propagated
 sample by sample, ``S <- (dy+/dy) S + (dy+/dp) (dp/dw)``, with the small Jacobians of one sample
-built symbolically once. A segment is that step repeated with ``mapaccum`` over ``K`` samples;
+built symbolically once. A segment is that step repeated with ``mapaccum`` over ``K`` samples
+(compiled: one sub-step repeated over ``K n_sub`` sub-samples, :func:`segment_functions`);
 the segments of a record are evaluated with ``map``. Memory grows with the samples only through
 the inputs and outputs (``K`` samples times the number of sensitivity columns per segment).
 """
