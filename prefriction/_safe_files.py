@@ -162,7 +162,9 @@ def _read(path: Path, limit: int, owned: bool) -> bytes:
             raise UnsafeFile(problem)
         if st.st_size > limit:
             raise UnsafeFile(f"{path} holds {st.st_size} bytes, more than the {limit} expected")
-        data = fh.read(limit + 1)
+        data = fh.read(st.st_size + 1)   # not read(limit + 1): that allocates the limit (a GiB for a library)
+        if len(data) > st.st_size:       # grown since fstat: the rest, up to one byte past the limit
+            data += fh.read(limit + 1 - len(data))
     if len(data) > limit:
         raise UnsafeFile(f"{path} holds more than the {limit} bytes expected")
     return data

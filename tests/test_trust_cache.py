@@ -299,6 +299,27 @@ def test_safe_files_refuse_links_and_foreign_or_shared_files(tmp_path) -> None:
             safe.open_lock(real)
 
 
+def test_reading_a_small_file_under_a_large_limit_allocates_the_file_not_the_limit(tmp_path) -> None:
+    """The cache reads libraries under a 1 GiB limit: a 4-byte file read so must not allocate
+    that limit (tracemalloc's peak, which numbers Python's buffers), and a file at the limit is
+    still read whole."""
+    import tracemalloc
+
+    from prefriction import _safe_files as safe
+
+    real = tmp_path / "real"
+    real.write_bytes(b"data")
+    os.chmod(real, 0o600)
+    tracemalloc.start()
+    try:
+        assert safe.read_owned(real, 1 << 30) == b"data"
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 1 << 20, peak
+    assert safe.read_owned(real, 4) == b"data"
+
+
 def test_write_atomic_replaces_a_link_without_following_it(tmp_path) -> None:
     from prefriction import _safe_files as safe
 
