@@ -48,8 +48,8 @@ start of the force balance (:mod:`prefriction.identify.balance_start`) a long re
 fitted again with every parameter free, and the record once, from those estimates. The record
 with the parameters held (the short records' second stage) cost about half of a long fit: on the
 25,000-sample closed-loop ``gamma = 2`` record (moves at the 2,500-sample pace, seeds 0 and 1)
-the fits took 515 and 442 s of CPU with it and 302 and 196 s without, to the same largest errors
-and intervals (docs/identify_motion.md#limits)."""
+the fits took 515 and 442 s of CPU with it and 302 and 196 s without (interpreted steps), to the
+same largest errors and intervals (docs/identify_motion.md#time-and-memory-against-the-record-length)."""
 
 
 @with_one_blas_thread

@@ -104,7 +104,7 @@ def _without_hovers(data: Motion, moves: Motion | None, space: ParameterSpace, s
     piece the same way (a fit of a move, a 60-sample rest and the next move from the truth ends at
     1.6 times the measurement error, with the rest left out at 1.0 times), so every rest is left
     out, not only the long hovers. Measured on the 2.5 kg, 2 kHz, 10 nm closed-loop Dahl
-    ``gamma = 2`` stage at 2,500 samples (docs/identify_motion.md#limits)."""
+    ``gamma = 2`` stage at 2,500 samples (docs/identify_motion.md#how-the-fit-works)."""
     if moves is None:
         return sol
     third, explains, said = _moves_fit(data, moves, space, sol.w[: space.n_free], n_sub, max_iter, tol, reversals,

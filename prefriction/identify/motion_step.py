@@ -63,9 +63,8 @@ def _sub_samples(U0: ca.MX, U1: ca.MX, DT: ca.MX, fold: int) -> tuple[ca.MX, ca.
         return U0, U1, DT
     K = U0.size2()
     a = ca.DM([k / fold for k in range(fold)])
-    D = U1 - U0
-    rows = [ca.repmat(U0, fold, 1) + ca.mtimes(a, D), ca.repmat(U0, fold, 1) + ca.mtimes(a + 1.0 / fold, D),
-            ca.repmat(DT / fold, fold, 1)]
+    D, start = U1 - U0, ca.repmat(U0, fold, 1)
+    rows = [start + ca.mtimes(a, D), start + ca.mtimes(a + 1.0 / fold, D), ca.repmat(DT / fold, fold, 1)]
     return tuple(ca.reshape(r, 1, K * fold) for r in rows)   # type: ignore[return-value]
 
 
